@@ -1,0 +1,1 @@
+//! Reproducible seeded shards of a truss Monte Carlo job, written as JSON Lines.

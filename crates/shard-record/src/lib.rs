@@ -1,0 +1,395 @@
+//! # shard-record: the JSON Lines format of one Monte Carlo shard
+//!
+//! One crate, used by both the writer (`mc-shard`) and the reader (`mc-merge`), so that the
+//! two can never disagree about what a shard file holds.
+//!
+//! ## Overview
+//!
+//! A Monte Carlo job has `job_samples` samples, numbered by a *global index* `0..job_samples`
+//! that runs over the job's cases in order (case 0's samples first). A *shard* is a contiguous
+//! range `start..end` of that index, computed by one process and written to one file,
+//! `shard-{start:010}-{end:010}.jsonl` (see [`ShardRange::file_name`]).
+//!
+//! ## Wire format
+//!
+//! The file is [JSON Lines](https://jsonlines.org): UTF-8, one JSON object per line, each line
+//! ended by `\n`. Every object has a `record` field naming its kind:
+//!
+//! 1. One `begin` line ([`Begin`]): `format` (always `"truss-mc-shard"`), `format_version`
+//!    ([`FORMAT_VERSION`]), `program` and `program_version` (the writer), `job_id` (64 lower-case
+//!    hex digits: the SHA-256 of the job's canonical form), `range` (`{"start": A, "end": B}`),
+//!    `job_samples`, and `cases`: every case of the job (not only those in this range) with its
+//!    `name`, the global index of its first sample `start`, its `samples` count and `parameters`,
+//!    named numbers that describe the case for sweeps (for example `sigma` in mm, `stages`).
+//! 2. One `sample` line ([`Sample`]) for each global index of the range, in increasing order
+//!    with no gaps: `index` (global), `case` (name), `sample` (index within the case),
+//!    `status` (`"converged"` or `"failed"`), `iterations` (Newton iterations), and
+//!    - when converged: `theta_p`, `tan_theta_x`, `tan_theta_y` (rad and dimensionless, paper
+//!      eqs. 2, 8, 9), `residual` (final out-of-balance force, N), optionally `slack_cables`
+//!      (how many tension-only members ended slack) and `loose_joints` (backlash joints whose
+//!      virtual cable ended slack);
+//!    - when failed: `reason`, a sentence saying why.
+//!
+//!    A failed solve is a line with its status, never a missing line.
+//! 3. One `end` line ([`End`]): `samples` (the number of sample lines), `failed` (how many of
+//!    them failed) and `sha256`, the SHA-256 (lower-case hex) of the exact bytes of all sample
+//!    lines in file order, each including its terminating `\n`.
+//!
+//! Numbers are written in the shortest form that reads back to the same `f64` (serde_json with
+//! `float_roundtrip`), so a reader recovers every bit the writer had.
+//!
+//! Units: lengths in mm, forces in N, angles in rad.
+//!
+//! ## Example
+//!
+//! ```text
+//! {"record":"begin","format":"truss-mc-shard","format_version":1,"program":"mc-shard","program_version":"0.1.0","job_id":"6f1e…","range":{"start":0,"end":2},"job_samples":2,"cases":[{"name":"sigma-0.0063","start":0,"samples":2,"parameters":{"sigma":0.0063,"stages":5.0}}]}
+//! {"record":"sample","index":0,"case":"sigma-0.0063","sample":0,"status":"converged","iterations":3,"theta_p":4.1e-5,"tan_theta_x":-2.2e-5,"tan_theta_y":3.5e-5,"residual":2.1e-11,"slack_cables":4}
+//! {"record":"sample","index":1,"case":"sigma-0.0063","sample":1,"status":"failed","iterations":60,"reason":"Newton did not converge in 60 iterations (residual 3.2e-4 N)"}
+//! {"record":"end","samples":2,"failed":1,"sha256":"9b0c…"}
+//! ```
+//!
+//! ## Torn and incomplete files
+//!
+//! A writer appends and flushes whole lines. A file whose last line lacks its `\n` was torn by
+//! a crash: [`scan_shard`] reports the valid prefix so that a writer can truncate and resume,
+//! and a reader can name the torn line. A file without an `end` line is incomplete.
+//!
+//! ## Versioning
+//!
+//! Readers accept `format_version` up to [`FORMAT_VERSION`] and ignore unknown fields, so a
+//! later version may add optional fields; a change in meaning increments the version.
+
+mod range;
+mod scan;
+
+pub use range::{ShardRange, ShardRangeError};
+pub use scan::{ScanError, ShardScan, Tail, parse_record, read_shard, scan_shard};
+
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+
+/// The value of the `format` field of every begin line.
+pub const FORMAT: &str = "truss-mc-shard";
+
+/// The format version this crate writes and the highest it reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// One line of a shard file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "record", rename_all = "snake_case")]
+pub enum Record {
+    /// The first line.
+    Begin(Begin),
+    /// One line per sample.
+    Sample(Sample),
+    /// The last line.
+    End(End),
+}
+
+/// The header line of a shard.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Begin {
+    /// Always [`FORMAT`].
+    pub format: String,
+    /// The format version the file was written in.
+    pub format_version: u32,
+    /// The writing program's name.
+    pub program: String,
+    /// The writing program's version.
+    pub program_version: String,
+    /// SHA-256 (hex) of the job's canonical form.
+    pub job_id: String,
+    /// The global sample indices this shard holds.
+    pub range: ShardRange,
+    /// The total number of samples of the job, over all cases.
+    pub job_samples: u64,
+    /// Every case of the job, in order.
+    pub cases: Vec<CaseInfo>,
+}
+
+/// One case of a job, as the header describes it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseInfo {
+    /// The case's unique name.
+    pub name: String,
+    /// The global index of the case's first sample.
+    pub start: u64,
+    /// How many samples the case has.
+    pub samples: u64,
+    /// Named numbers describing the case (`sigma` in mm, `stages`, …), for sweeps.
+    #[serde(default)]
+    pub parameters: BTreeMap<String, f64>,
+}
+
+impl CaseInfo {
+    /// The global index range of the case's samples.
+    pub fn range(&self) -> ShardRange {
+        ShardRange {
+            start: self.start,
+            end: self.start + self.samples,
+        }
+    }
+}
+
+/// Whether a sample's solve converged.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// The equilibrium was found; the angles are present.
+    Converged,
+    /// The solve failed; `reason` says why.
+    Failed,
+}
+
+/// One sample line. Optional fields are present or absent according to `status`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Sample {
+    /// Global sample index.
+    pub index: u64,
+    /// Case name.
+    pub case: String,
+    /// Index of the sample within its case.
+    pub sample: u64,
+    /// Converged or failed.
+    pub status: Status,
+    /// Newton iterations taken.
+    pub iterations: u32,
+    /// Distortion angle θ_P between top and bottom normals [rad].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta_p: Option<f64>,
+    /// tan θ_x of the top surface (paper eq. 8) [-].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tan_theta_x: Option<f64>,
+    /// tan θ_y of the top surface (paper eq. 9) [-].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tan_theta_y: Option<f64>,
+    /// Final out-of-balance force, max norm over free DOFs [N].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub residual: Option<f64>,
+    /// Number of tension-only members that ended slack.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slack_cables: Option<u32>,
+    /// Number of backlash joints whose virtual cable ended slack (the joint is loose).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub loose_joints: Option<u32>,
+    /// Why the solve failed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
+/// The angles of a converged sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Angles {
+    /// θ_P [rad].
+    pub theta_p: f64,
+    /// tan θ_x [-].
+    pub tan_theta_x: f64,
+    /// tan θ_y [-].
+    pub tan_theta_y: f64,
+}
+
+impl Sample {
+    /// The angles, if the sample converged and all three are present and finite.
+    pub fn angles(&self) -> Option<Angles> {
+        match (
+            self.status,
+            self.theta_p,
+            self.tan_theta_x,
+            self.tan_theta_y,
+        ) {
+            (Status::Converged, Some(theta_p), Some(tan_theta_x), Some(tan_theta_y))
+                if theta_p.is_finite() && tan_theta_x.is_finite() && tan_theta_y.is_finite() =>
+            {
+                Some(Angles {
+                    theta_p,
+                    tan_theta_x,
+                    tan_theta_y,
+                })
+            }
+            _ => None,
+        }
+    }
+
+    /// Checks that the fields present agree with `status`: a converged sample carries three
+    /// finite angles with θ_P ≥ 0; a failed one carries a reason.
+    pub fn check(&self) -> Result<(), String> {
+        match self.status {
+            Status::Converged => match self.angles() {
+                Some(a) if a.theta_p >= 0.0 => Ok(()),
+                Some(_) => Err("theta_p is negative".into()),
+                None => Err(
+                    "a converged sample needs finite theta_p, tan_theta_x and tan_theta_y".into(),
+                ),
+            },
+            Status::Failed => match &self.reason {
+                Some(_) => Ok(()),
+                None => Err("a failed sample needs a reason".into()),
+            },
+        }
+    }
+
+    /// The line this sample is written as, with its terminating `\n`.
+    pub fn to_line(&self) -> String {
+        to_line(&Record::Sample(self.clone()))
+    }
+}
+
+/// The closing line of a shard.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct End {
+    /// Number of sample lines.
+    pub samples: u64,
+    /// Number of failed samples among them.
+    pub failed: u64,
+    /// SHA-256 (hex) of all sample lines' bytes, each with its `\n`.
+    pub sha256: String,
+}
+
+/// Serialises a record as one line with its terminating `\n`.
+pub fn to_line(record: &Record) -> String {
+    // Serialising these plain types cannot fail: no maps with non-string keys, no I/O.
+    let mut line = serde_json::to_string(record).expect("records always serialise");
+    line.push('\n');
+    line
+}
+
+/// Running SHA-256 over sample lines, for the `end` record.
+#[derive(Clone, Default)]
+pub struct SampleDigest {
+    hasher: Sha256,
+    samples: u64,
+    failed: u64,
+}
+
+impl std::fmt::Debug for SampleDigest {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SampleDigest")
+            .field("samples", &self.samples)
+            .field("failed", &self.failed)
+            .finish_non_exhaustive()
+    }
+}
+
+impl SampleDigest {
+    /// An empty digest.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds one sample line (its bytes including `\n`) and whether it failed.
+    pub fn add_line(&mut self, line: &[u8], failed: bool) {
+        self.hasher.update(line);
+        self.samples += 1;
+        self.failed += u64::from(failed);
+    }
+
+    /// Number of lines added so far.
+    pub fn samples(&self) -> u64 {
+        self.samples
+    }
+
+    /// The end record for the lines added so far.
+    pub fn end(&self) -> End {
+        End {
+            samples: self.samples,
+            failed: self.failed,
+            sha256: hex(&self.hasher.clone().finalize()),
+        }
+    }
+}
+
+/// Lower-case hex of bytes.
+pub fn hex(bytes: &[u8]) -> String {
+    use std::fmt::Write;
+    bytes
+        .iter()
+        .fold(String::with_capacity(2 * bytes.len()), |mut s, b| {
+            let _ = write!(s, "{b:02x}");
+            s
+        })
+}
+
+impl Begin {
+    /// A header for `range` of job `job_id`, written by this program version.
+    pub fn new(
+        program: &str,
+        program_version: &str,
+        job_id: &str,
+        range: ShardRange,
+        job_samples: u64,
+        cases: Vec<CaseInfo>,
+    ) -> Self {
+        Self {
+            format: FORMAT.to_string(),
+            format_version: FORMAT_VERSION,
+            program: program.to_string(),
+            program_version: program_version.to_string(),
+            job_id: job_id.to_string(),
+            range,
+            job_samples,
+            cases,
+        }
+    }
+
+    /// Checks the header's own consistency: format name and version, job id shape, the
+    /// range inside the job, and the cases tiling `0..job_samples` in order.
+    pub fn check(&self) -> Result<(), String> {
+        if self.format != FORMAT {
+            return Err(format!("format is {:?}, expected {FORMAT:?}", self.format));
+        }
+        if self.format_version == 0 || self.format_version > FORMAT_VERSION {
+            return Err(format!(
+                "format_version {} is not supported (this reader knows 1..={FORMAT_VERSION})",
+                self.format_version
+            ));
+        }
+        if self.job_id.len() != 64
+            || !self
+                .job_id
+                .bytes()
+                .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
+        {
+            return Err(format!(
+                "job_id {:?} is not 64 lower-case hex digits",
+                self.job_id
+            ));
+        }
+        if self.range.start > self.range.end || self.range.end > self.job_samples {
+            return Err(format!(
+                "range {} is not inside the job's 0..{}",
+                self.range, self.job_samples
+            ));
+        }
+        let mut next = 0;
+        for case in &self.cases {
+            if case.start != next {
+                return Err(format!(
+                    "case {:?} starts at {} where {} was expected",
+                    case.name, case.start, next
+                ));
+            }
+            next += case.samples;
+        }
+        if next != self.job_samples {
+            return Err(format!(
+                "cases cover 0..{next} but job_samples is {}",
+                self.job_samples
+            ));
+        }
+        Ok(())
+    }
+
+    /// The case that global index `index` belongs to, with the index within that case.
+    pub fn case_of(&self, index: u64) -> Option<(&CaseInfo, u64)> {
+        let pos = self.cases.partition_point(|c| c.start + c.samples <= index);
+        self.cases
+            .get(pos)
+            .filter(|c| c.range().contains(index))
+            .map(|c| (c, index - c.start))
+    }
+}
+
+#[cfg(test)]
+mod tests;
