@@ -1,0 +1,191 @@
+//! The `truss` command: generate the paper's prism, solve a model file, and (see the
+//! `diagnose` issue) compare simulation with measurements.
+//!
+//! ## Commands
+//!
+//! - `truss model prism --stages N [options]` writes the model file of the paper's N-stage
+//!   truss to stdout (Table 1 defaults, every one overridable).
+//! - `truss solve MODEL.json [--length-error ID=MM]...` solves the model's equilibrium and
+//!   prints a JSON result (see [`solve::SolveOutput`]).
+//!
+//! ## Exit codes
+//!
+//! | code | meaning |
+//! |---|---|
+//! | 0 | success |
+//! | 1 | the solve failed (not converged, mechanism); the JSON result says why |
+//! | 2 | usage error (bad arguments) |
+//! | 3 | the model file is invalid (the message names the item) |
+//! | 4 | a file could not be read or written |
+
+pub mod solve;
+
+use clap::{Args, Parser, Subcommand};
+use std::io::Write;
+use std::path::PathBuf;
+use truss_core::prism::{PrismOptions, TABLE1_DIAGONAL_LENGTH};
+
+/// Exit code: the solve failed.
+pub const EXIT_SOLVE_FAILED: u8 = 1;
+/// Exit code: bad arguments.
+pub const EXIT_USAGE: u8 = 2;
+/// Exit code: invalid model.
+pub const EXIT_BAD_MODEL: u8 = 3;
+/// Exit code: I/O error.
+pub const EXIT_IO: u8 = 4;
+
+/// Generate, solve and diagnose truss models. Units: mm, N, MPa, rad.
+#[derive(Debug, Parser)]
+#[command(
+    name = "truss",
+    version,
+    about,
+    after_help = "Exit codes: 0 success, 1 solve failed, 2 usage error, 3 invalid model, 4 I/O error."
+)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Write a model file to stdout.
+    Model {
+        /// Which model.
+        #[command(subcommand)]
+        kind: ModelKind,
+    },
+    /// Solve a model file's equilibrium and print the result as JSON.
+    Solve(SolveArgs),
+}
+
+/// Model generators.
+#[derive(Debug, Subcommand)]
+pub enum ModelKind {
+    /// The paper's N-stage triangular prism (section 2.1, Table 1).
+    Prism(PrismArgs),
+}
+
+/// Options of `truss model prism`; defaults are the paper's Table 1.
+#[derive(Debug, Args)]
+pub struct PrismArgs {
+    /// Number of stages N.
+    #[arg(long, default_value_t = 5)]
+    pub stages: usize,
+    /// Batten length l, the triangle's side [mm].
+    #[arg(long, default_value_t = 380.0)]
+    pub side: f64,
+    /// Stage height h, the longeron length [mm].
+    #[arg(long, default_value_t = 380.0)]
+    pub height: f64,
+    /// Batten cross-section [mm²].
+    #[arg(long, default_value_t = 14.9)]
+    pub batten_area: f64,
+    /// Batten Young's modulus [MPa].
+    #[arg(long, default_value_t = 70_000.0)]
+    pub batten_modulus: f64,
+    /// Longeron cross-section [mm²].
+    #[arg(long, default_value_t = 14.9)]
+    pub longeron_area: f64,
+    /// Longeron Young's modulus [MPa].
+    #[arg(long, default_value_t = 70_000.0)]
+    pub longeron_modulus: f64,
+    /// Diagonal cable cross-section [mm²].
+    #[arg(long, default_value_t = 3.1)]
+    pub diagonal_area: f64,
+    /// Diagonal cable Young's modulus [MPa].
+    #[arg(long, default_value_t = 70_000.0)]
+    pub diagonal_modulus: f64,
+    /// Diagonal natural length [mm] (Table 1: 537.4).
+    #[arg(long, default_value_t = TABLE1_DIAGONAL_LENGTH, conflicts_with = "exact_diagonals")]
+    pub diagonal_length: f64,
+    /// Give the diagonals the exact face-diagonal length √(l² + h²) instead.
+    #[arg(long)]
+    pub exact_diagonals: bool,
+    /// Cables' compression stiffness / tension stiffness.
+    #[arg(long, default_value_t = truss_core::DEFAULT_COMPRESSION_RATIO)]
+    pub compression_ratio: f64,
+}
+
+impl PrismArgs {
+    /// The generator options.
+    pub fn options(&self) -> PrismOptions {
+        PrismOptions {
+            stages: self.stages,
+            side: self.side,
+            height: self.height,
+            batten_area: self.batten_area,
+            batten_modulus: self.batten_modulus,
+            longeron_area: self.longeron_area,
+            longeron_modulus: self.longeron_modulus,
+            diagonal_area: self.diagonal_area,
+            diagonal_modulus: self.diagonal_modulus,
+            diagonal_length: (!self.exact_diagonals).then_some(self.diagonal_length),
+            compression_ratio: self.compression_ratio,
+        }
+    }
+}
+
+/// Options of `truss solve`.
+#[derive(Debug, Args)]
+pub struct SolveArgs {
+    /// The model file.
+    pub model: PathBuf,
+    /// A member's length error, `ID=MM` (natural length = the model's + MM); repeatable.
+    #[arg(long = "length-error", value_name = "ID=MM")]
+    pub length_errors: Vec<String>,
+    /// Record and print every Newton iteration.
+    #[arg(long)]
+    pub iterations: bool,
+}
+
+/// What went wrong, classified for the exit code.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// Bad arguments.
+    #[error("{0}")]
+    Usage(String),
+    /// An invalid model.
+    #[error(transparent)]
+    Model(truss_core::ModelError),
+    /// The solve failed (the JSON result was printed).
+    #[error("the solve failed: {0}")]
+    Solve(truss_core::SolveError),
+    /// Output could not be written.
+    #[error("cannot write output: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+impl From<truss_core::ModelError> for CliError {
+    fn from(e: truss_core::ModelError) -> Self {
+        CliError::Model(e)
+    }
+}
+
+/// The exit code for an error (see the crate doc).
+pub fn exit_code(e: &anyhow::Error) -> u8 {
+    match e.downcast_ref::<CliError>() {
+        Some(CliError::Usage(_)) => EXIT_USAGE,
+        Some(CliError::Model(truss_core::ModelError::Io { .. })) | Some(CliError::Io(_)) => EXIT_IO,
+        Some(CliError::Model(_)) => EXIT_BAD_MODEL,
+        Some(CliError::Solve(_)) => EXIT_SOLVE_FAILED,
+        None => EXIT_IO,
+    }
+}
+
+/// Runs a command, writing its output to `out`.
+pub fn run(cli: Cli, out: &mut dyn Write) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Model {
+            kind: ModelKind::Prism(args),
+        } => {
+            let model = args.options().model().map_err(CliError::from)?;
+            out.write_all(model.to_file().to_json().as_bytes())
+                .map_err(CliError::from)?;
+        }
+        Command::Solve(args) => solve::run(&args, out)?,
+    }
+    Ok(())
+}

@@ -1,0 +1,193 @@
+//! Benchmark of one equilibrium solve of the paper's prism with random length errors
+//! (σ = 0.0063 mm on battens and longerons), for 5, 30 and 300 stages.
+//!
+//! Prints, per model: the median, 10th and 90th percentile time per solve over the samples
+//! (each solve timed on its own, one thread), the median and mean Newton iterations,
+//! factorisations and force evaluations, and the time of each kernel measured on its own
+//! (factorise, triangular solves, evaluate, assemble) with the share of the solve that
+//! counts × kernel time accounts for. For comparison, a dense Cholesky of the same 5-stage
+//! tangent with faer. Run with `cargo bench -p truss-core`; `-- --quick` for fewer samples.
+//! The machine is shared: run it several times and quote medians.
+
+use std::hint::black_box;
+use std::time::Instant;
+use truss_core::block::BlockBandMatrix;
+use truss_core::prism::PrismOptions;
+use truss_core::{SolveOptions, Solver};
+
+/// SplitMix64 + Box–Muller: deterministic sample errors.
+struct Normals(u64);
+
+impl Normals {
+    fn uniform(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+    fn normal(&mut self) -> f64 {
+        let (a, b) = (self.uniform(), self.uniform());
+        (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
+    }
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    sorted[((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1]
+}
+
+/// Median time of `f` over `reps` calls, in µs, from 7 batches.
+fn kernel_time(reps: usize, mut f: impl FnMut()) -> f64 {
+    let mut batches: Vec<f64> = (0..7)
+        .map(|_| {
+            let t = Instant::now();
+            for _ in 0..reps {
+                f();
+            }
+            t.elapsed().as_secs_f64() * 1e6 / reps as f64
+        })
+        .collect();
+    batches.sort_by(f64::total_cmp);
+    batches[3]
+}
+
+fn bench(stages: usize, samples: usize) {
+    let model = PrismOptions::with_stages(stages).model().unwrap();
+    let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
+    let mut rng = Normals(2024);
+    let sigma = 0.0063;
+    let errors: Vec<Vec<f64>> = (0..samples)
+        .map(|_| {
+            model
+                .members()
+                .iter()
+                .map(|m| {
+                    if m.group == "diagonal" {
+                        0.0
+                    } else {
+                        sigma * rng.normal()
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    // Warm up.
+    for e in errors.iter().take(samples.min(200)) {
+        solver.solve(e).unwrap();
+    }
+    let (mut times, mut its, mut facts, mut evals) = (vec![], vec![], vec![], vec![]);
+    for e in &errors {
+        let t = Instant::now();
+        let r = black_box(solver.solve(black_box(e))).unwrap();
+        times.push(t.elapsed().as_secs_f64() * 1e6);
+        its.push(r.iterations as f64);
+        facts.push(r.factorisations as f64);
+        evals.push(r.evaluations as f64);
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (mi, mf, me) = (mean(&its), mean(&facts), mean(&evals));
+    let median_time = {
+        let mut t = times.clone();
+        t.sort_by(f64::total_cmp);
+        (
+            percentile(&t, 0.5),
+            percentile(&t, 0.1),
+            percentile(&t, 0.9),
+        )
+    };
+    let mut sorted_its = its.clone();
+    sorted_its.sort_by(f64::total_cmp);
+
+    // Kernels on their own: the nominal stiffness of this model (same size and band).
+    let s = std::sync::Arc::clone(solver.structure());
+    let (nb, q) = (s.free_dofs() / 3, s.bandwidth());
+    let mut k = BlockBandMatrix::new(nb, q);
+    for i in 0..nb {
+        for j in i.saturating_sub(q)..=i {
+            let b = k.block_mut(i, j);
+            for (r, row) in b.iter_mut().enumerate() {
+                for (c, x) in row.iter_mut().enumerate() {
+                    *x = if i == j && r == c {
+                        4.0 * (q as f64 + 1.0)
+                    } else {
+                        0.1 * ((i + j + r + c) % 5) as f64 - 0.2
+                    };
+                }
+            }
+        }
+    }
+    let reps = (200_000 / nb).max(20);
+    let mut f = k.clone();
+    let t_factor = kernel_time(reps, || {
+        f.clone_from(&k);
+        f.factor().unwrap();
+    });
+    let t_copy = kernel_time(reps, || f.clone_from(&k));
+    f.clone_from(&k);
+    f.factor().unwrap();
+    let mut rhs = vec![1.0; 3 * nb];
+    let t_solve = kernel_time(reps, || {
+        f.solve_in_place(black_box(&mut rhs));
+    });
+    let e0 = &errors[0];
+    let t_iteration = kernel_time(reps / 10 + 1, || {
+        solver.solve(black_box(e0)).unwrap();
+    });
+    let r0 = solver.solve(e0).unwrap();
+    println!(
+        "{stages:>3} stages ({} DOF, {} members, block band {q}): median {:.2} µs per solve (p10 {:.2}, p90 {:.2}) over {samples} samples",
+        s.free_dofs(),
+        s.member_count(),
+        median_time.0,
+        median_time.1,
+        median_time.2
+    );
+    println!(
+        "      iterations median {} mean {mi:.2}; factorisations mean {mf:.2}; force evaluations mean {me:.2}",
+        percentile(&sorted_its, 0.5)
+    );
+    println!(
+        "      kernels: factorise {:.2} µs, two triangular solves {:.2} µs; sample 0 ({} it, {} fact, {} eval) {:.2} µs",
+        t_factor - t_copy,
+        t_solve,
+        r0.iterations,
+        r0.factorisations,
+        r0.evaluations,
+        t_iteration
+    );
+    println!(
+        "      share of the median solve in factorisations ≈ {:.0} %, in triangular solves ≈ {:.0} %",
+        100.0 * mf * (t_factor - t_copy) / median_time.0,
+        100.0 * (mi + 1.0) * t_solve / median_time.0
+    );
+}
+
+/// A dense Cholesky (faer) of a 45 × 45 matrix the shape of the 5-stage tangent, for
+/// comparison with the block band.
+fn dense_comparison() {
+    use faer::Mat;
+    let n = 45;
+    let a = Mat::<f64>::from_fn(n, n, |i, j| {
+        if i == j {
+            100.0
+        } else if i.abs_diff(j) <= 17 {
+            0.1 * ((i + j) % 5) as f64 - 0.2
+        } else {
+            0.0
+        }
+    });
+    let t = kernel_time(20_000, || {
+        black_box(a.llt(faer::Side::Lower).unwrap());
+    });
+    println!("dense faer LLT of a 45 × 45 matrix: {t:.2} µs per factorisation (for comparison)");
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let n = |full: usize| if quick { full / 10 } else { full };
+    bench(5, n(20_000));
+    bench(30, n(2_000));
+    bench(300, n(100).max(10));
+    dense_comparison();
+}

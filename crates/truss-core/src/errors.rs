@@ -1,0 +1,138 @@
+//! Errors of model validation and of solving, each carrying what is needed to find the fault.
+
+use std::path::PathBuf;
+
+/// A model that cannot be used: each variant names the offending item.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// The model file could not be read.
+    #[error("{}: cannot read: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
+    /// The text is not a model file (bad JSON, a missing or misspelled field).
+    #[error("{origin}: line {line}, column {column}: {message}")]
+    Syntax {
+        /// Where the text came from (a path, or `<string>`).
+        origin: String,
+        /// Line of the fault, from 1.
+        line: usize,
+        /// Column of the fault, from 1.
+        column: usize,
+        /// serde_json's description.
+        message: String,
+    },
+    /// The model has no nodes or no members.
+    #[error("the model has no {what}")]
+    Empty {
+        /// `nodes` or `members`.
+        what: &'static str,
+    },
+    /// Two items of the same kind share an id.
+    #[error("{kind} id {id:?} is used twice (at {kind}s[{first}] and [{second}])")]
+    DuplicateId {
+        /// `node`, `member` or `joint`.
+        kind: &'static str,
+        /// The repeated id.
+        id: String,
+        /// Index of the first use.
+        first: usize,
+        /// Index of the second use.
+        second: usize,
+    },
+    /// An item refers to a node that does not exist.
+    #[error("{item} refers to unknown node {node:?}")]
+    UnknownNode {
+        /// The referring item, as a JSON path (`members[3] (id "batten.0.1")`).
+        item: String,
+        /// The missing node id.
+        node: String,
+    },
+    /// A number that must be finite is not.
+    #[error("{item}: {field} is not a finite number")]
+    NotFinite {
+        /// The item, as a JSON path.
+        item: String,
+        /// The field.
+        field: &'static str,
+    },
+    /// A number that must be positive is not.
+    #[error("{item}: {field} must be positive, got {value}")]
+    NotPositive {
+        /// The item, as a JSON path.
+        item: String,
+        /// The field.
+        field: &'static str,
+        /// The value found.
+        value: f64,
+    },
+    /// A member joins a node to itself or to a node at the same position.
+    #[error("{item}: zero-length member (its two nodes {a:?} and {b:?} coincide)")]
+    ZeroLength {
+        /// The member, as a JSON path.
+        item: String,
+        /// First node id.
+        a: String,
+        /// Second node id.
+        b: String,
+    },
+    /// Any other invalid value, explained.
+    #[error("{item}: {message}")]
+    Invalid {
+        /// The item, as a JSON path.
+        item: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// The nominal structure cannot carry load: a node can move without straining any member.
+    #[error(
+        "the model is a mechanism: node {node:?} can move in {dof} without straining any member (add a member or a support)"
+    )]
+    Mechanism {
+        /// The node id.
+        node: String,
+        /// The direction, `x`, `y` or `z`.
+        dof: char,
+    },
+}
+
+/// A solve that did not produce an equilibrium. Never returned as NaN.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SolveError {
+    /// Newton's method did not meet the tolerance.
+    #[error(
+        "Newton did not converge in {iterations} iterations (out-of-balance force {residual:.3e} N, last step {step:.3e} mm)"
+    )]
+    NotConverged {
+        /// Iterations taken.
+        iterations: u32,
+        /// Final out-of-balance force, max over free DOFs [N].
+        residual: f64,
+        /// Size of the last step, max over free DOFs [mm].
+        step: f64,
+    },
+    /// The tangent stiffness is singular: a mechanism in the deformed state.
+    #[error("mechanism at iteration {iteration}: node {node:?} can move in {dof} freely")]
+    Mechanism {
+        /// Iteration at which it was found.
+        iteration: u32,
+        /// The node id.
+        node: String,
+        /// The direction, `x`, `y` or `z`.
+        dof: char,
+    },
+    /// A number became NaN or infinite (for example a member collapsed to zero length).
+    #[error("non-finite value at iteration {iteration}: {what}")]
+    NonFinite {
+        /// Iteration at which it appeared.
+        iteration: u32,
+        /// What became non-finite.
+        what: String,
+    },
+    /// The per-sample input does not fit the model.
+    #[error("bad input: {0}")]
+    Input(String),
+}

@@ -1,0 +1,473 @@
+//! The validated truss model: nodes, members, supports, loads, and the measured surface.
+//!
+//! A [`Model`] is built only by validating a [`ModelFile`]; from then on its invariants hold:
+//! ids are unique, every reference resolves to an index, every number is finite, areas,
+//! moduli and natural lengths are positive, no member has zero length, and the nominal
+//! structure is not a mechanism.
+
+use crate::model_file::{
+    BehaviourSpec, LoadSpec, MemberSpec, ModelFile, NodeSpec, SupportSpec, TopSurfaceSpec,
+};
+use crate::{DEFAULT_COMPRESSION_RATIO, ModelError};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// A node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Node {
+    /// Unique id.
+    pub id: String,
+    /// Nominal position [mm].
+    pub xyz: [f64; 3],
+}
+
+/// How a member carries axial load.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Behaviour {
+    /// Carries tension and compression with the same stiffness `E·A/L₀`.
+    Bar,
+    /// Carries tension with stiffness `E·A/L₀`; in compression (shorter than its natural
+    /// length, "slack") its stiffness is `compression_ratio·E·A/L₀`.
+    Cable {
+        /// Compression stiffness / tension stiffness, in [0, 1).
+        compression_ratio: f64,
+    },
+}
+
+impl Behaviour {
+    /// Whether the member is tension-only.
+    pub fn is_cable(self) -> bool {
+        matches!(self, Behaviour::Cable { .. })
+    }
+}
+
+/// A member: a straight two-force element between two nodes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Member {
+    /// Unique id.
+    pub id: String,
+    /// Indices of its two nodes in [`Model::nodes`].
+    pub nodes: [usize; 2],
+    /// Group name; length-error distributions are given per group.
+    pub group: String,
+    /// Cross-sectional area [mm²].
+    pub area: f64,
+    /// Young's modulus [MPa].
+    pub youngs_modulus: f64,
+    /// Stress-free length [mm].
+    pub natural_length: f64,
+    /// Bar or cable.
+    pub behaviour: Behaviour,
+}
+
+impl Member {
+    /// Axial stiffness `E·A/L₀` in tension [N/mm].
+    pub fn axial_stiffness(&self) -> f64 {
+        self.youngs_modulus * self.area / self.natural_length
+    }
+}
+
+/// The surface whose tilt is measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopSurface {
+    /// Indices of its three nodes, in the paper's Fig. 5 order (1, 2, 3).
+    pub nodes: [usize; 3],
+    /// The unit normal θ_P is measured against.
+    pub reference_normal: [f64; 3],
+}
+
+/// A validated truss model (see the module doc for its invariants).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    nodes: Vec<Node>,
+    members: Vec<Member>,
+    fixed: Vec<[bool; 3]>,
+    loads: Vec<[f64; 3]>,
+    top_surface: Option<TopSurface>,
+    node_index: HashMap<String, usize>,
+}
+
+impl Model {
+    /// Reads and validates a model file.
+    pub fn read(path: &Path) -> Result<Self, ModelError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_json(&text, &path.display().to_string())
+    }
+
+    /// Parses and validates a model file's text; `origin` names it in errors.
+    pub fn from_json(text: &str, origin: &str) -> Result<Self, ModelError> {
+        Self::new(ModelFile::from_json(text, origin)?)
+    }
+
+    /// Validates a model file.
+    pub fn new(file: ModelFile) -> Result<Self, ModelError> {
+        let model = Self::check(file)?;
+        crate::Structure::new(&model)?;
+        Ok(model)
+    }
+
+    /// Validates everything but the mechanism check (which needs the solver's structure).
+    fn check(file: ModelFile) -> Result<Self, ModelError> {
+        if file.nodes.is_empty() {
+            return Err(ModelError::Empty { what: "nodes" });
+        }
+        if file.members.is_empty() {
+            return Err(ModelError::Empty { what: "members" });
+        }
+        let node_index = unique_ids("node", file.nodes.iter().map(|n| n.id.as_str()))?;
+        unique_ids("member", file.members.iter().map(|m| m.id.as_str()))?;
+        let nodes = file
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(i, n)| check_node(i, n))
+            .collect::<Result<Vec<_>, _>>()?;
+        let lookup = |item: &dyn Fn() -> String, id: &str| {
+            node_index
+                .get(id)
+                .copied()
+                .ok_or_else(|| ModelError::UnknownNode {
+                    item: item(),
+                    node: id.to_string(),
+                })
+        };
+        let members = file
+            .members
+            .iter()
+            .enumerate()
+            .map(|(i, m)| check_member(i, m, &nodes, &lookup))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut fixed = vec![[false; 3]; nodes.len()];
+        for (i, s) in file.supports.iter().enumerate() {
+            let item = || format!("supports[{i}]");
+            let node = lookup(&item, &s.node)?;
+            for dof in parse_fixed(&item(), s)? {
+                fixed[node][dof] = true;
+            }
+        }
+        let mut loads = vec![[0.0; 3]; nodes.len()];
+        for (i, l) in file.loads.iter().enumerate() {
+            let item = || format!("loads[{i}]");
+            let node = lookup(&item, &l.node)?;
+            finite(&item(), "force", &l.force)?;
+            for (acc, f) in loads[node].iter_mut().zip(l.force) {
+                *acc += f;
+            }
+        }
+        let top_surface = file
+            .top_surface
+            .as_ref()
+            .map(|t| check_top_surface(t, &nodes, &lookup))
+            .transpose()?;
+        Ok(Self {
+            nodes,
+            members,
+            fixed,
+            loads,
+            top_surface,
+            node_index,
+        })
+    }
+
+    /// The nodes.
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The members.
+    pub fn members(&self) -> &[Member] {
+        &self.members
+    }
+
+    /// Which directions (x, y, z) of node `node` are fixed.
+    pub fn fixed(&self, node: usize) -> [bool; 3] {
+        self.fixed[node]
+    }
+
+    /// The total nodal load on node `node` [N].
+    pub fn load(&self, node: usize) -> [f64; 3] {
+        self.loads[node]
+    }
+
+    /// The measured surface, if the model has one.
+    pub fn top_surface(&self) -> Option<&TopSurface> {
+        self.top_surface.as_ref()
+    }
+
+    /// Index of the node with id `id`.
+    pub fn node_index(&self, id: &str) -> Option<usize> {
+        self.node_index.get(id).copied()
+    }
+
+    /// Index of the member with id `id`.
+    pub fn member_index(&self, id: &str) -> Option<usize> {
+        self.members.iter().position(|m| m.id == id)
+    }
+
+    /// The distinct group names, in order of first appearance.
+    pub fn groups(&self) -> Vec<&str> {
+        let mut groups: Vec<&str> = Vec::new();
+        for m in &self.members {
+            if !groups.contains(&m.group.as_str()) {
+                groups.push(&m.group);
+            }
+        }
+        groups
+    }
+
+    /// Nominal length of member `m` (distance between its nodes' nominal positions) [mm].
+    pub fn nominal_length(&self, m: usize) -> f64 {
+        let [a, b] = self.members[m].nodes;
+        distance(self.nodes[a].xyz, self.nodes[b].xyz)
+    }
+
+    /// The model as a file, with every default written out.
+    pub fn to_file(&self) -> ModelFile {
+        let axes = |f: [bool; 3]| -> String {
+            "xyz"
+                .chars()
+                .zip(f)
+                .filter(|(_, fixed)| *fixed)
+                .map(|(c, _)| c)
+                .collect()
+        };
+        ModelFile {
+            nodes: self
+                .nodes
+                .iter()
+                .map(|n| NodeSpec {
+                    id: n.id.clone(),
+                    xyz: n.xyz,
+                })
+                .collect(),
+            members: self
+                .members
+                .iter()
+                .map(|m| MemberSpec {
+                    id: m.id.clone(),
+                    nodes: m.nodes.map(|n| self.nodes[n].id.clone()),
+                    group: m.group.clone(),
+                    area: m.area,
+                    youngs_modulus: m.youngs_modulus,
+                    natural_length: Some(m.natural_length),
+                    behaviour: match m.behaviour {
+                        Behaviour::Bar => BehaviourSpec::Bar,
+                        Behaviour::Cable { .. } => BehaviourSpec::Cable,
+                    },
+                    compression_ratio: match m.behaviour {
+                        Behaviour::Bar => None,
+                        Behaviour::Cable { compression_ratio } => Some(compression_ratio),
+                    },
+                })
+                .collect(),
+            supports: self
+                .fixed
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| f.iter().any(|&x| x))
+                .map(|(i, &f)| SupportSpec {
+                    node: self.nodes[i].id.clone(),
+                    fixed: axes(f),
+                })
+                .collect(),
+            loads: self
+                .loads
+                .iter()
+                .enumerate()
+                .filter(|(_, f)| f.iter().any(|&x| x != 0.0))
+                .map(|(i, &force)| LoadSpec {
+                    node: self.nodes[i].id.clone(),
+                    force,
+                })
+                .collect(),
+            top_surface: self.top_surface.as_ref().map(|t| TopSurfaceSpec {
+                nodes: t.nodes.map(|n| self.nodes[n].id.clone()),
+                reference_normal: t.reference_normal,
+            }),
+        }
+    }
+}
+
+/// Euclidean distance [mm].
+pub(crate) fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+}
+
+/// Resolves a node id for an item (described lazily, for the error message).
+type NodeLookup<'a> = dyn Fn(&dyn Fn() -> String, &str) -> Result<usize, ModelError> + 'a;
+
+fn unique_ids<'a>(
+    kind: &'static str,
+    ids: impl Iterator<Item = &'a str>,
+) -> Result<HashMap<String, usize>, ModelError> {
+    let mut seen = HashMap::new();
+    for (i, id) in ids.enumerate() {
+        if let Some(&first) = seen.get(id) {
+            return Err(ModelError::DuplicateId {
+                kind,
+                id: id.to_string(),
+                first,
+                second: i,
+            });
+        }
+        seen.insert(id.to_string(), i);
+    }
+    Ok(seen)
+}
+
+fn finite(item: &str, field: &'static str, values: &[f64]) -> Result<(), ModelError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(ModelError::NotFinite {
+            item: item.to_string(),
+            field,
+        })
+    }
+}
+
+fn positive(item: &str, field: &'static str, value: f64) -> Result<f64, ModelError> {
+    finite(item, field, &[value])?;
+    if value > 0.0 {
+        Ok(value)
+    } else {
+        Err(ModelError::NotPositive {
+            item: item.to_string(),
+            field,
+            value,
+        })
+    }
+}
+
+fn check_node(i: usize, n: &NodeSpec) -> Result<Node, ModelError> {
+    finite(&format!("nodes[{i}] (id {:?})", n.id), "xyz", &n.xyz)?;
+    Ok(Node {
+        id: n.id.clone(),
+        xyz: n.xyz,
+    })
+}
+
+fn check_member(
+    i: usize,
+    m: &MemberSpec,
+    nodes: &[Node],
+    lookup: &NodeLookup<'_>,
+) -> Result<Member, ModelError> {
+    let item = || format!("members[{i}] (id {:?})", m.id);
+    let a = lookup(&item, &m.nodes[0])?;
+    let b = lookup(&item, &m.nodes[1])?;
+    let length = distance(nodes[a].xyz, nodes[b].xyz);
+    if a == b || length == 0.0 {
+        return Err(ModelError::ZeroLength {
+            item: item(),
+            a: m.nodes[0].clone(),
+            b: m.nodes[1].clone(),
+        });
+    }
+    let area = positive(&item(), "area", m.area)?;
+    let youngs_modulus = positive(&item(), "youngs_modulus", m.youngs_modulus)?;
+    let natural_length = positive(
+        &item(),
+        "natural_length",
+        m.natural_length.unwrap_or(length),
+    )?;
+    let behaviour = match (m.behaviour, m.compression_ratio) {
+        (BehaviourSpec::Bar, None) => Behaviour::Bar,
+        (BehaviourSpec::Bar, Some(_)) => {
+            return Err(ModelError::Invalid {
+                item: item(),
+                message: "compression_ratio applies to cables only".into(),
+            });
+        }
+        (BehaviourSpec::Cable, ratio) => {
+            let r = ratio.unwrap_or(DEFAULT_COMPRESSION_RATIO);
+            finite(&item(), "compression_ratio", &[r])?;
+            if !(0.0..1.0).contains(&r) {
+                return Err(ModelError::Invalid {
+                    item: item(),
+                    message: format!("compression_ratio must be in [0, 1), got {r}"),
+                });
+            }
+            Behaviour::Cable {
+                compression_ratio: r,
+            }
+        }
+    };
+    if m.group.is_empty() {
+        return Err(ModelError::Invalid {
+            item: item(),
+            message: "group must not be empty".into(),
+        });
+    }
+    Ok(Member {
+        id: m.id.clone(),
+        nodes: [a, b],
+        group: m.group.clone(),
+        area,
+        youngs_modulus,
+        natural_length,
+        behaviour,
+    })
+}
+
+fn parse_fixed(item: &str, s: &SupportSpec) -> Result<Vec<usize>, ModelError> {
+    let mut dofs = Vec::new();
+    for c in s.fixed.chars() {
+        let dof = match c {
+            'x' => 0,
+            'y' => 1,
+            'z' => 2,
+            _ => {
+                return Err(ModelError::Invalid {
+                    item: item.to_string(),
+                    message: format!(
+                        "fixed must be made of the letters x, y, z; got {:?}",
+                        s.fixed
+                    ),
+                });
+            }
+        };
+        dofs.push(dof);
+    }
+    Ok(dofs)
+}
+
+fn check_top_surface(
+    t: &TopSurfaceSpec,
+    nodes: &[Node],
+    lookup: &NodeLookup<'_>,
+) -> Result<TopSurface, ModelError> {
+    let item = || "top_surface".to_string();
+    let mut idx = [0; 3];
+    for (k, id) in t.nodes.iter().enumerate() {
+        idx[k] = lookup(&item, id)?;
+    }
+    finite(&item(), "reference_normal", &t.reference_normal)?;
+    let r = t.reference_normal;
+    let norm = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    if norm == 0.0 {
+        return Err(ModelError::Invalid {
+            item: item(),
+            message: "reference_normal must not be zero".into(),
+        });
+    }
+    let p = idx.map(|i| nodes[i].xyz);
+    let n = crate::measure::cross(
+        [p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]],
+        [p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]],
+    );
+    if n == [0.0; 3] {
+        return Err(ModelError::Invalid {
+            item: item(),
+            message: "its three nodes are on one line and define no plane".into(),
+        });
+    }
+    Ok(TopSurface {
+        nodes: idx,
+        reference_normal: r.map(|x| x / norm),
+    })
+}

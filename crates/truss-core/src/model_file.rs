@@ -1,0 +1,157 @@
+//! The JSON model file: the raw, unvalidated form of a [`Model`](crate::Model).
+//!
+//! ## Format
+//!
+//! ```json
+//! {
+//!   "nodes":   [{"id": "n0.0", "xyz": [0.0, 0.0, 0.0]}, …],
+//!   "members": [{"id": "batten.0.0", "nodes": ["n0.0", "n0.1"], "group": "batten",
+//!                "area": 14.9, "youngs_modulus": 70000.0, "natural_length": 380.0,
+//!                "behaviour": "bar"},
+//!               {"id": "diagonal.1.0.a", "nodes": ["n0.0", "n1.1"], "group": "diagonal",
+//!                "area": 3.1, "youngs_modulus": 70000.0, "natural_length": 537.4,
+//!                "behaviour": "cable", "compression_ratio": 1e-4}, …],
+//!   "supports": [{"node": "n0.0", "fixed": "xyz"}, …],
+//!   "loads":    [{"node": "n5.0", "force": [0.0, 0.0, -1.0]}],
+//!   "top_surface": {"nodes": ["n5.0", "n5.1", "n5.2"], "reference_normal": [0.0, 0.0, 1.0]}
+//! }
+//! ```
+//!
+//! | field | meaning | unit |
+//! |---|---|---|
+//! | `nodes[].id` | unique node name | |
+//! | `nodes[].xyz` | nominal position | mm |
+//! | `members[].id` | unique member name | |
+//! | `members[].nodes` | the two node ids it joins | |
+//! | `members[].group` | group name (`batten`, `longeron`, `diagonal`, …); length-error distributions are given per group | |
+//! | `members[].area` | cross-sectional area, > 0 | mm² |
+//! | `members[].youngs_modulus` | Young's modulus, > 0 | MPa |
+//! | `members[].natural_length` | stress-free length, > 0; optional, defaults to the distance between its nodes | mm |
+//! | `members[].behaviour` | `"bar"` (tension and compression) or `"cable"` (tension only) | |
+//! | `members[].compression_ratio` | cables only: compression stiffness / tension stiffness, in [0, 1); default 1e-4 | |
+//! | `supports[].node`, `supports[].fixed` | a node and the directions held fixed, any of `"x"`, `"y"`, `"z"` (`"xyz"` = pinned) | |
+//! | `loads[].node`, `loads[].force` | a nodal force | N |
+//! | `top_surface.nodes` | three nodes whose plane is measured (paper Fig. 5 order 1, 2, 3); optional | |
+//! | `top_surface.reference_normal` | the normal θ_P is measured against, default `[0, 0, 1]` | |
+//!
+//! Unknown fields are refused, so a misspelt field name is an error rather than a silently
+//! ignored value.
+
+use serde::{Deserialize, Serialize};
+
+/// A model file as written: ids are strings, nothing is checked yet.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelFile {
+    /// The nodes.
+    pub nodes: Vec<NodeSpec>,
+    /// The members.
+    pub members: Vec<MemberSpec>,
+    /// Fixed degrees of freedom.
+    #[serde(default)]
+    pub supports: Vec<SupportSpec>,
+    /// Nodal forces [N].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub loads: Vec<LoadSpec>,
+    /// The surface whose tilt is measured.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub top_surface: Option<TopSurfaceSpec>,
+}
+
+/// A node as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NodeSpec {
+    /// Unique id.
+    pub id: String,
+    /// Nominal position [mm].
+    pub xyz: [f64; 3],
+}
+
+/// How a member carries load, as written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BehaviourSpec {
+    /// Tension and compression.
+    Bar,
+    /// Tension only (with a small compression stiffness ratio).
+    Cable,
+}
+
+/// A member as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MemberSpec {
+    /// Unique id.
+    pub id: String,
+    /// The two node ids.
+    pub nodes: [String; 2],
+    /// Group name.
+    pub group: String,
+    /// Cross-sectional area [mm²].
+    pub area: f64,
+    /// Young's modulus [MPa].
+    pub youngs_modulus: f64,
+    /// Stress-free length [mm]; defaults to the distance between the nodes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub natural_length: Option<f64>,
+    /// Bar or cable.
+    pub behaviour: BehaviourSpec,
+    /// Cables only: compression stiffness / tension stiffness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression_ratio: Option<f64>,
+}
+
+/// A support as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SupportSpec {
+    /// The node id.
+    pub node: String,
+    /// Fixed directions: a string of the letters `x`, `y`, `z`.
+    pub fixed: String,
+}
+
+/// A nodal load as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSpec {
+    /// The node id.
+    pub node: String,
+    /// Force [N].
+    pub force: [f64; 3],
+}
+
+/// The measured surface as written.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TopSurfaceSpec {
+    /// Three node ids, in the paper's Fig. 5 order.
+    pub nodes: [String; 3],
+    /// Reference normal; default +z.
+    #[serde(default = "default_normal")]
+    pub reference_normal: [f64; 3],
+}
+
+fn default_normal() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+impl ModelFile {
+    /// Parses a model file's text; `origin` names it in errors (a path, or `<string>`).
+    pub fn from_json(text: &str, origin: &str) -> Result<Self, crate::ModelError> {
+        serde_json::from_str(text).map_err(|e| crate::ModelError::Syntax {
+            origin: origin.to_string(),
+            line: e.line(),
+            column: e.column(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Pretty JSON text of the file, ending with a newline.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).expect("model files always serialise");
+        s.push('\n');
+        s
+    }
+}

@@ -1,0 +1,181 @@
+//! The line search: a bracket on the directional derivative of the energy, seeded by an
+//! exact minimiser of the piecewise quadratic model along the line.
+
+use super::evaluate::{dot_n, evaluate, max_abs};
+use super::{Evaluation, Solver};
+use crate::SolveError;
+
+impl Solver {
+    /// Line search along `self.d` from `self.u` (see the module doc); moves `self.u`,
+    /// `self.r` and `self.states` to the accepted point and returns α and its evaluation.
+    ///
+    /// Keeps a bracket: `a`, the largest α seen with `φ' < 0`, and `b`, the smallest with
+    /// `φ' > 0` (or a non-finite force, where a member would collapse). The trials are: the
+    /// full step (unless `expand`), then the minimiser predicted by [`Solver::predict_alpha`],
+    /// then false position or bisection inside the bracket, or fourfold growth while there
+    /// is no upper end. A trial is accepted when `|φ'(α)| ≤ η·|φ'_min|`, `φ'_min` the
+    /// steepest descent rate seen (φ'(0) for a Newton step; larger along a direction of
+    /// negative curvature, whose `φ'(0)` may be near zero).
+    pub(super) fn line_search(
+        &mut self,
+        iteration: u32,
+        current: Evaluation,
+        expand: bool,
+    ) -> Result<(f64, Evaluation), SolveError> {
+        const ETA: f64 = 0.5;
+        let n = self.structure.free;
+        let phi0 = dot_n(&self.r[..n], &self.d[..n]);
+        // Never let one step move a node by more than a fifth of the shortest member.
+        let cap = 0.2 * self.shortest_member() / max_abs(&self.d[..n]).max(f64::MIN_POSITIVE);
+        let (mut a, mut phi_a) = (0.0, phi0);
+        let (mut b, mut phi_b) = (f64::INFINITY, f64::INFINITY);
+        let mut steepest = phi0.min(0.0);
+        let mut side = 0i8;
+        for trial in 0..100 {
+            let alpha = if trial == 0 && !expand {
+                1.0f64.min(cap)
+            } else if trial <= 1 {
+                let predicted = self.predict_alpha(phi0, cap);
+                if predicted > a && predicted < b {
+                    predicted
+                } else if b.is_finite() {
+                    0.5 * (a + b)
+                } else {
+                    (4.0 * a).max(f64::MIN_POSITIVE).min(cap)
+                }
+            } else if !b.is_finite() {
+                (4.0 * a).min(cap)
+            } else if phi_b.is_finite() && phi_b > phi_a && side != 0 {
+                (b - phi_b * (b - a) / (phi_b - phi_a))
+                    .clamp(a + 1e-3 * (b - a), b - 1e-3 * (b - a))
+            } else {
+                0.5 * (a + b)
+            };
+            let eval = self.try_step(alpha);
+            let phi = dot_n(&self.trial_r[..n], &self.d[..n]);
+            if phi.is_finite() {
+                steepest = steepest.min(phi);
+            }
+            let descending = phi.is_finite() && phi < 0.0;
+            // Accept: close enough to a root; or a Newton step still descending (the next
+            // iteration goes on from there); or the cap reached while still descending; or
+            // not a descent direction at all (rounding at the floor).
+            let accept = phi.is_finite()
+                && (phi.abs() <= ETA * steepest.abs()
+                    || (trial == 0 && !expand && phi <= 0.0)
+                    || (descending && alpha >= cap)
+                    || phi0 >= 0.0 && !expand);
+            if accept {
+                self.accept();
+                return Ok((alpha, eval));
+            }
+            if descending {
+                (a, phi_a) = (alpha, phi);
+                if side == -1 {
+                    phi_b *= 0.5;
+                }
+                side = -1;
+            } else {
+                (b, phi_b) = (alpha, phi);
+                if side == 1 {
+                    phi_a *= 0.5;
+                }
+                side = 1;
+            }
+            if b.is_finite() && b - a <= f64::EPSILON * b {
+                break;
+            }
+        }
+        Err(SolveError::NotConverged {
+            iterations: iteration,
+            residual: current.residual,
+            step: a * max_abs(&self.d[..n]),
+        })
+    }
+
+    /// Predicts the minimiser of `φ(α) = Π(u + α·d)` in `(0, cap]` from a piecewise
+    /// quadratic model: `φ''` starts at `dᵀK(u)d` (with the geometric stiffness) and jumps
+    /// by `±(1 − r)·k·(n·Δd)²` where a cable's linearised elongation `e + α·(n·Δd)` changes
+    /// sign. The breakpoints are walked in order from `φ'(0)` to the first root of `φ'`.
+    pub(super) fn predict_alpha(&mut self, phi0: f64, cap: f64) -> f64 {
+        let d = &self.d;
+        let mut curvature = 0.0;
+        self.breakpoints.clear();
+        for ((c, st), m) in self
+            .structure
+            .members
+            .iter()
+            .zip(&self.states)
+            .zip(&self.members)
+        {
+            let dv = [
+                d[c.dofs[3]] - d[c.dofs[0]],
+                d[c.dofs[4]] - d[c.dofs[1]],
+                d[c.dofs[5]] - d[c.dofs[2]],
+            ];
+            let along = st.direction[0] * dv[0] + st.direction[1] * dv[1] + st.direction[2] * dv[2];
+            let total = dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2];
+            curvature +=
+                st.stiffness * along * along + st.force / st.length * (total - along * along);
+            if c.is_cable && along != 0.0 {
+                let at = -st.elongation / along;
+                if at > 0.0 && at < cap {
+                    let k = m.rigidity / m.natural_length;
+                    let jump = (1.0 - m.compression_ratio) * k * along * along;
+                    // Slack → taut stiffens; taut → slack softens.
+                    self.breakpoints
+                        .push((at, if st.slack { jump } else { -jump }));
+                }
+            }
+        }
+        self.breakpoints
+            .sort_unstable_by(|x, y| x.0.partial_cmp(&y.0).unwrap_or(std::cmp::Ordering::Equal));
+        let (mut alpha, mut slope, mut phi) = (0.0, curvature, phi0);
+        for &(at, jump) in &self.breakpoints {
+            if slope > 0.0 {
+                let root = alpha - phi / slope;
+                if root <= at {
+                    return root.max(0.0);
+                }
+            }
+            phi += slope * (at - alpha);
+            alpha = at;
+            slope += jump;
+        }
+        if slope > 0.0 {
+            (alpha - phi / slope).clamp(0.0, cap)
+        } else {
+            cap
+        }
+    }
+
+    /// Evaluates the trial point `u + α·d` into the trial buffers.
+    pub(super) fn try_step(&mut self, alpha: f64) -> Evaluation {
+        self.evaluations += 1;
+        for ((t, u), d) in self.trial_u.iter_mut().zip(&self.u).zip(&self.d) {
+            *t = u + alpha * d;
+        }
+        evaluate(
+            &self.structure,
+            &self.members,
+            &self.loads,
+            &self.trial_u,
+            &mut self.trial_r,
+            &mut self.trial_states,
+        )
+    }
+
+    /// Makes the trial point current.
+    pub(super) fn accept(&mut self) {
+        std::mem::swap(&mut self.u, &mut self.trial_u);
+        std::mem::swap(&mut self.r, &mut self.trial_r);
+        std::mem::swap(&mut self.states, &mut self.trial_states);
+    }
+
+    pub(super) fn shortest_member(&self) -> f64 {
+        self.members
+            .iter()
+            .map(|m| m.reference_length)
+            .fold(f64::INFINITY, f64::min)
+    }
+}

@@ -1,0 +1,269 @@
+//! The iteration of the module doc: the linearised problem, then chord steps or model
+//! steps, each followed by a line search, until converged.
+
+use super::evaluate::{evaluate, max_abs};
+use super::step::Step;
+use super::{IterationRecord, Mode, SolveReport, Solver};
+use crate::SolveError;
+use crate::linearised::{ActiveSetFailure, gather_b, scatter_b};
+use crate::structure::Structure;
+use std::sync::Arc;
+
+impl Solver {
+    /// Steps 1–5 of the module doc.
+    pub(super) fn newton(&mut self) -> Result<SolveReport, SolveError> {
+        let n = self.structure.free;
+        let opts = self.options.clone();
+        let structure = Arc::clone(&self.structure);
+        let mut iterations = 0u32;
+        let mut factorisations = 0u32;
+
+        // Step 1: the linearised problem.
+        let mut mode = match self.linearised(&structure, &mut factorisations) {
+            Ok(mode) => {
+                iterations += 1;
+                mode
+            }
+            Err(_) => {
+                self.u.fill(0.0);
+                Mode::Tangent
+            }
+        };
+        let mut eval = evaluate(
+            &structure,
+            &self.members,
+            &self.loads,
+            &self.u,
+            &mut self.r,
+            &mut self.states,
+        );
+        self.update_slack();
+        // Whether `self.k` holds the factorised model stiffness of `self.factor_slack`.
+        let mut k_valid = false;
+        let mut prev_step = f64::INFINITY;
+        let mut step = 0.0;
+        let mut poor = false;
+        // Iterations since the out-of-balance force last halved, and its lowest value.
+        let (mut stalled, mut lowest) = (0u32, f64::INFINITY);
+        loop {
+            if !eval.residual.is_finite() {
+                return Err(SolveError::NonFinite {
+                    iteration: iterations,
+                    what: "out-of-balance force (a member may have collapsed to zero length)"
+                        .into(),
+                });
+            }
+            if eval.residual == 0.0 || eval.residual <= opts.residual_floor * eval.force_scale {
+                break;
+            }
+            // At the rounding floor of an ill-conditioned structure (a tall tower, whose
+            // bending is far softer than its members) the steps stop shrinking before the
+            // step test is met: accept when the force has not halved in three iterations and
+            // is within a thousand times the floor (1e-10 of the largest member force).
+            if eval.residual <= 0.5 * lowest {
+                (stalled, lowest) = (0, eval.residual);
+            } else {
+                stalled += 1;
+            }
+            if stalled >= 3 && eval.residual <= 1e3 * opts.residual_floor * eval.force_scale {
+                break;
+            }
+            if iterations >= opts.max_iterations {
+                return Err(SolveError::NotConverged {
+                    iterations,
+                    residual: eval.residual,
+                    step,
+                });
+            }
+            iterations += 1;
+
+            // Choose the step.
+            let mut fresh = false;
+            let mut shift = 0.0;
+            let mut curved = false;
+            if mode == Mode::Chord && poor {
+                mode = Mode::Tangent;
+                poor = false;
+            }
+            if mode == Mode::Chord {
+                let basis = structure.basis.as_ref().expect("chord mode needs a basis");
+                let states = &self.states;
+                let nc = basis.cables.len();
+                if self
+                    .active
+                    .set_slack_from(|c| states[basis.cables[c]].slack, nc)
+                    && self.active.factor(basis).is_err()
+                {
+                    mode = Mode::Tangent;
+                }
+            }
+            match mode {
+                Mode::Chord => {
+                    let basis = structure.basis.as_ref().expect("chord mode needs a basis");
+                    self.negate_residual_into_step();
+                    self.active.apply_inverse(&structure, basis, &mut self.d);
+                }
+                Mode::Tangent => {
+                    let reuse = k_valid
+                        && opts.reuse_factorisation
+                        && !poor
+                        && self.slack == self.factor_slack;
+                    if reuse {
+                        self.negate_residual_into_step();
+                        self.k.solve_in_place(&mut self.d[..n]);
+                    } else {
+                        match self.model_step(iterations, &mut factorisations)? {
+                            Step::Newton { shift: mu } => {
+                                shift = mu;
+                                fresh = true;
+                                k_valid = true;
+                                prev_step = f64::INFINITY;
+                            }
+                            Step::Curvature => {
+                                curved = true;
+                                k_valid = false;
+                            }
+                        }
+                    }
+                }
+            }
+
+            let residual_before = eval.residual;
+            let (alpha, new_eval) = self.line_search(iterations, eval, curved)?;
+            eval = new_eval;
+            step = alpha * max_abs(&self.d[..n]);
+            if opts.record_iterations {
+                let slack = self.slack_indices();
+                self.log.push(IterationRecord {
+                    iteration: iterations,
+                    residual: residual_before,
+                    step,
+                    alpha,
+                    refactorised: fresh,
+                    shift,
+                    slack,
+                    evaluations: self.evaluations,
+                });
+            }
+            self.update_slack();
+
+            // Convergence on the step.
+            let contraction = step / prev_step;
+            let small = step <= opts.step_tolerance * max_abs(&self.u[..n]);
+            if small && !curved && (fresh || contraction <= 0.5) {
+                break;
+            }
+            poor = !fresh && !curved && contraction > opts.reuse_contraction;
+            prev_step = if curved { f64::INFINITY } else { step };
+        }
+        Ok(SolveReport {
+            iterations,
+            factorisations,
+            residual: eval.residual,
+            step,
+            slack_cables: self.slack.iter().filter(|&&s| s).count() as u32,
+            evaluations: self.evaluations,
+        })
+    }
+
+    /// `d = −r` (the zero slot kept zero).
+    fn negate_residual_into_step(&mut self) {
+        let n = self.structure.free;
+        for (d, r) in self.d[..n].iter_mut().zip(&self.r[..n]) {
+            *d = -r;
+        }
+        self.d[n] = 0.0;
+    }
+
+    /// Step 1: solves the linearised problem into `self.u`, and says how to go on: chord
+    /// steps with the active set's Woodbury inverse when the model has a cable basis and
+    /// the final slack set leaves no soft direction, model steps otherwise.
+    fn linearised(
+        &mut self,
+        structure: &Structure,
+        factorisations: &mut u32,
+    ) -> Result<Mode, ActiveSetFailure> {
+        for (st, m) in self.stretch.iter_mut().zip(&self.members) {
+            *st = m.initial_stretch;
+        }
+        match &structure.basis {
+            Some(basis) => {
+                self.active.solve_linearised(
+                    structure,
+                    basis,
+                    &self.stretch,
+                    &self.loads,
+                    &mut self.u,
+                )?;
+                Ok(if self.active.is_soft() {
+                    Mode::Tangent
+                } else {
+                    Mode::Chord
+                })
+            }
+            None => {
+                self.linearised_banded(structure, factorisations)?;
+                Ok(Mode::Tangent)
+            }
+        }
+    }
+
+    /// Step 1 without a cable basis: the active-set iteration with a block-banded
+    /// factorisation of the linearised stiffness of each slack set tried.
+    fn linearised_banded(
+        &mut self,
+        s: &Structure,
+        factorisations: &mut u32,
+    ) -> Result<(), ActiveSetFailure> {
+        let n = s.free;
+        // Start from the all-taut solution's slack set.
+        self.u.copy_from_slice(&self.loads);
+        for (m, c) in s.members.iter().enumerate() {
+            scatter_b(
+                s,
+                m,
+                -c.rigidity / c.natural_length * self.stretch[m],
+                &mut self.u,
+            );
+        }
+        s.nominal.solve_in_place(&mut self.u[..n]);
+        for (m, c) in s.members.iter().enumerate() {
+            self.factor_slack[m] = c.is_cable && gather_b(s, m, &self.u) + self.stretch[m] < 0.0;
+        }
+        for _ in 0..50 {
+            let slack = &self.factor_slack;
+            s.assemble_material(&mut self.k, |m| {
+                if slack[m] {
+                    s.members[m].compression_ratio
+                } else {
+                    1.0
+                }
+            });
+            self.u.copy_from_slice(&self.loads);
+            for (m, c) in s.members.iter().enumerate() {
+                let mut k = c.rigidity / c.natural_length;
+                if self.factor_slack[m] {
+                    k *= c.compression_ratio;
+                }
+                scatter_b(s, m, -k * self.stretch[m], &mut self.u);
+            }
+            *factorisations += 1;
+            self.k
+                .factor()
+                .map_err(|_| ActiveSetFailure::NotPositiveDefinite)?;
+            self.k.solve_in_place(&mut self.u[..n]);
+            let mut settled = true;
+            for (m, c) in s.members.iter().enumerate() {
+                let slack = c.is_cable && gather_b(s, m, &self.u) + self.stretch[m] < 0.0;
+                if slack != self.factor_slack[m] {
+                    settled = false;
+                    self.factor_slack[m] = slack;
+                }
+            }
+            if settled {
+                return Ok(());
+            }
+        }
+        Err(ActiveSetFailure::NoFixedPoint)
+    }
+}

@@ -1,0 +1,278 @@
+//! One Newton step with the true tangent: the piecewise model of the energy at the current
+//! point, minimised exactly over slack sets, or a direction of negative curvature.
+//!
+//! At the current point `u`, each member's elongation is linearised, `e(δ) = e + nᵀΔδ`,
+//! keeping its exact piecewise axial energy `½·k_e(e)·e²`, and the geometric stiffness of
+//! the current forces `(N/L)(I − n nᵀ)` is added. For a slack set `S` the model's minimiser
+//! solves
+//!
+//! ```text
+//! K(S)·δ = −r(u) − Σ_{m switched} (k_e,S − k_e,now)·e_m·b_m
+//! K(S)   = Σ_m k_e,S·n nᵀ + (N_m/L_m)(I − n nᵀ)        (blocks of each member)
+//! ```
+//!
+//! where "switched" are the cables whose state in `S` differs from now. The set is found by
+//! the active-set iteration (take as the next `S` the cables with `e + nᵀΔδ < 0` until it
+//! repeats), so a step changes the state of any number of cables at once, instead of one
+//! line search per change.
+
+use super::Solver;
+use super::evaluate::{dot_n, max_abs};
+use crate::SolveError;
+
+/// Most slack sets tried for one model step; the last step is used if none settles.
+const MAX_MODEL_PIECES: u32 = 8;
+
+/// What a model step produced.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Step {
+    /// `self.d` is the model's step, and `self.k` the factorised `K(S)` of the slack set in
+    /// `self.factor_slack` (plus a Levenberg shift `μ`, usually 0).
+    Newton {
+        /// The shift μ.
+        shift: f64,
+    },
+    /// `self.d` is a direction of negative curvature of `K(S)`; `self.k` is not usable.
+    Curvature,
+}
+
+impl Solver {
+    /// Records which cables are slack at the current point.
+    pub(super) fn update_slack(&mut self) {
+        for (s, st) in self.slack.iter_mut().zip(&self.states) {
+            *s = st.slack;
+        }
+    }
+
+    /// Indices of the currently slack cables.
+    pub(super) fn slack_indices(&self) -> Vec<usize> {
+        (0..self.slack.len()).filter(|&m| self.slack[m]).collect()
+    }
+
+    /// The model step of the module doc, starting from the current slack set. Counts
+    /// factorisations.
+    ///
+    /// Where `K(S)` is indefinite (a panel whose bracing is slack, compressed past the
+    /// stiffness of its slack cables), the piece's minimum along the direction of negative
+    /// curvature that the failed pivot gives is where the first slack cable engages: that
+    /// cable is made taut (and kept so for this step) and `K(S)` factorised again. Only when
+    /// no cable bounds the direction does the step become a search along it.
+    pub(super) fn model_step(
+        &mut self,
+        iteration: u32,
+        factorisations: &mut u32,
+    ) -> Result<Step, SolveError> {
+        let n = self.structure.free;
+        self.factor_slack.copy_from_slice(&self.slack);
+        self.locked.fill(false);
+        let mut pieces = 0;
+        let mut engagements = 0;
+        while pieces < MAX_MODEL_PIECES {
+            self.assemble_model();
+            *factorisations += 1;
+            self.k.factor_collecting(&mut self.failures, 1);
+            let mut shift = 0.0;
+            if let Some(&first) = self.failures.first() {
+                if first.pivot < 0.0 && engagements < self.structure.members.len() {
+                    self.k
+                        .failed_pivot_direction(first.index, &mut self.scratch);
+                    if self.engage_first_cable() {
+                        engagements += 1;
+                        continue;
+                    }
+                    self.d.copy_from_slice(&self.scratch);
+                    self.d[n] = 0.0;
+                    if self.negative_curvature() {
+                        return Ok(Step::Curvature);
+                    }
+                }
+                shift = self
+                    .factor_model(iteration, factorisations, false)?
+                    .expect("a shifted factorisation never stops at a curvature");
+            }
+            pieces += 1;
+            // Right-hand side: −r, corrected for the cables switched in the model.
+            for i in 0..n {
+                self.d[i] = -self.r[i];
+            }
+            self.d[n] = 0.0;
+            let s = &*self.structure;
+            for (m, c) in s.members.iter().enumerate() {
+                if c.is_cable && self.factor_slack[m] != self.slack[m] {
+                    let k = self.members[m].rigidity / self.members[m].natural_length;
+                    let k_model = if self.factor_slack[m] {
+                        c.compression_ratio * k
+                    } else {
+                        k
+                    };
+                    let st = &self.states[m];
+                    let extra = (k_model - st.stiffness) * st.elongation;
+                    for d in 0..3 {
+                        let f = extra * st.direction[d];
+                        self.d[c.dofs[d]] += f;
+                        self.d[c.dofs[3 + d]] -= f;
+                    }
+                }
+            }
+            self.d[n] = 0.0;
+            self.k.solve_in_place(&mut self.d[..n]);
+            // The slack set the model predicts at the step.
+            let mut settled = true;
+            for (m, c) in s.members.iter().enumerate() {
+                if !c.is_cable {
+                    continue;
+                }
+                let st = &self.states[m];
+                let dv = [
+                    self.d[c.dofs[3]] - self.d[c.dofs[0]],
+                    self.d[c.dofs[4]] - self.d[c.dofs[1]],
+                    self.d[c.dofs[5]] - self.d[c.dofs[2]],
+                ];
+                let e = st.elongation
+                    + st.direction[0] * dv[0]
+                    + st.direction[1] * dv[1]
+                    + st.direction[2] * dv[2];
+                let slack = e < 0.0 && c.compression_ratio < 1.0 && !self.locked[m];
+                if slack != self.factor_slack[m] {
+                    settled = false;
+                    self.factor_slack[m] = slack;
+                }
+            }
+            if settled {
+                return Ok(Step::Newton { shift });
+            }
+        }
+        // No settled set: refactorise for the last set so that `self.k` matches
+        // `self.factor_slack`, and keep the step computed before (the line search copes).
+        self.scratch.copy_from_slice(&self.d);
+        let shift = self
+            .factor_model(iteration, factorisations, false)?
+            .expect("a shifted factorisation never stops at a curvature");
+        self.d.copy_from_slice(&self.scratch);
+        Ok(Step::Newton { shift })
+    }
+
+    /// Assembles the model's `K(S)` for `S = self.factor_slack` and factorises it; where it
+    /// is not positive definite, retries with a Levenberg shift `K + μ·diag(K)`, μ = 1e-9,
+    /// 1e-7, …, 1. Returns `Some(μ)` (the `Option` is for callers that stop at a curvature;
+    /// this one never does unless `allow_curvature`, which leaves the direction of the first
+    /// negative pivot in `self.d` and returns `None`).
+    pub(super) fn factor_model(
+        &mut self,
+        iteration: u32,
+        factorisations: &mut u32,
+        allow_curvature: bool,
+    ) -> Result<Option<f64>, SolveError> {
+        let mut shift = 0.0;
+        loop {
+            self.assemble_model();
+            let s = &*self.structure;
+            if shift > 0.0 {
+                self.k.scale_diagonal(1.0 + shift);
+            }
+            *factorisations += 1;
+            match self.k.factor() {
+                Ok(()) => return Ok(Some(shift)),
+                Err(e) => {
+                    if allow_curvature && shift == 0.0 && e.pivot < 0.0 {
+                        self.k.failed_pivot_direction(e.index, &mut self.d);
+                        self.d[s.free] = 0.0;
+                        return Ok(None);
+                    }
+                    shift = if shift == 0.0 { 1e-9 } else { shift * 100.0 };
+                    if shift > 1.0 {
+                        let (node, dof) = s.describe_dof(e.index);
+                        return Err(SolveError::Mechanism {
+                            iteration,
+                            node,
+                            dof,
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    /// With `self.scratch` a direction of negative curvature `v` of `K(S)`, finds the slack
+    /// cable of `S` that engages first along `±v` (the sign that lowers the energy first,
+    /// else the other), makes it taut and locked in `S`, and returns true; false if no slack
+    /// cable engages.
+    fn engage_first_cable(&mut self) -> bool {
+        let n = self.structure.free;
+        let v = &self.scratch;
+        let descent = if dot_n(&self.r[..n], &v[..n]) > 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        for sign in [descent, -descent] {
+            let mut first: Option<(f64, usize)> = None;
+            for (m, c) in self.structure.members.iter().enumerate() {
+                if !(c.is_cable && self.factor_slack[m]) {
+                    continue;
+                }
+                let st = &self.states[m];
+                let dv = [
+                    v[c.dofs[3]] - v[c.dofs[0]],
+                    v[c.dofs[4]] - v[c.dofs[1]],
+                    v[c.dofs[5]] - v[c.dofs[2]],
+                ];
+                let rate = sign
+                    * (st.direction[0] * dv[0] + st.direction[1] * dv[1] + st.direction[2] * dv[2]);
+                if rate > 0.0 {
+                    let at = (-st.elongation).max(0.0) / rate;
+                    if first.is_none_or(|(best, _)| at < best) {
+                        first = Some((at, m));
+                    }
+                }
+            }
+            if let Some((_, m)) = first {
+                self.factor_slack[m] = false;
+                self.locked[m] = true;
+                return true;
+            }
+        }
+        false
+    }
+
+    /// Assembles into `self.k` the model stiffness `K(S)` of the module doc at the current
+    /// point, for `S = self.factor_slack`: the true tangent when `S` is the current slack set.
+    pub(super) fn assemble_model(&mut self) {
+        self.k.clear();
+        let s = &*self.structure;
+        for (m, (c, st)) in s.members.iter().zip(&self.states).enumerate() {
+            let stiffness = if c.is_cable && self.factor_slack[m] != st.slack {
+                let k = self.members[m].rigidity / self.members[m].natural_length;
+                if self.factor_slack[m] {
+                    c.compression_ratio * k
+                } else {
+                    k
+                }
+            } else {
+                st.stiffness
+            };
+            s.add_member(&mut self.k, c, &st.tangent_block_with(stiffness));
+        }
+        s.set_identity_rows(&mut self.k);
+    }
+
+    /// Turns the direction left in `self.d` by a failed factorisation (whose curvature
+    /// `dᵀK d` is the negative pivot) into a step direction: scaled to max |d| = 1 mm and
+    /// signed so that the energy decreases along it. Returns false if it is unusable.
+    pub(super) fn negative_curvature(&mut self) -> bool {
+        let n = self.structure.free;
+        let scale = max_abs(&self.d[..n]);
+        if !(scale.is_finite() && scale > 0.0) {
+            return false;
+        }
+        let sign = if dot_n(&self.r[..n], &self.d[..n]) > 0.0 {
+            -1.0
+        } else {
+            1.0
+        };
+        for x in &mut self.d[..n] {
+            *x *= sign / scale;
+        }
+        true
+    }
+}

@@ -1,0 +1,116 @@
+//! Unit tests of the assembled system against finite differences: the out-of-balance force
+//! is the gradient of the total potential energy, and the tangent is its Jacobian.
+
+use super::evaluate::evaluate;
+use super::*;
+use crate::prism::PrismOptions;
+
+/// A solver for the 3-stage prism (exact diagonals, so some cables go slack and some stay
+/// taut under the errors below) with its state set at a displacement `u` of a few µm.
+fn solver_at(seed: u64) -> (Solver, Vec<f64>) {
+    let model = PrismOptions {
+        diagonal_length: None,
+        ..PrismOptions::with_stages(3)
+    }
+    .model()
+    .unwrap();
+    let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
+    let mut x = seed;
+    let mut next = move || {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((x >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
+    };
+    let errors: Vec<f64> = (0..model.members().len()).map(|_| 0.01 * next()).collect();
+    solver
+        .set_sample(Perturbation {
+            length_errors: &errors,
+            extra_loads: &[],
+        })
+        .unwrap();
+    let n = solver.structure.free;
+    let mut u = vec![0.0; n + 1];
+    for (i, v) in u[..n].iter_mut().enumerate() {
+        // Only free directions move (the fixed ones of a partly fixed node have no rows).
+        if solver.structure.node_dofs[solver.structure.dof_owner[i].0]
+            [solver.structure.dof_owner[i].1 as usize]
+            != crate::structure::FIXED
+        {
+            *v = 0.005 * next();
+        }
+    }
+    (solver, u)
+}
+
+fn residual_and_energy(solver: &mut Solver, u: &[f64]) -> (Vec<f64>, f64) {
+    let mut r = vec![0.0; u.len()];
+    evaluate(
+        &solver.structure,
+        &solver.members,
+        &solver.loads,
+        u,
+        &mut r,
+        &mut solver.states,
+    );
+    solver.u.copy_from_slice(u);
+    (r, solver.potential_energy())
+}
+
+#[test]
+fn residual_is_the_energy_gradient() {
+    for seed in 1..4 {
+        let (mut solver, u) = solver_at(seed);
+        let (r, _) = residual_and_energy(&mut solver, &u);
+        let h = 1e-6;
+        for i in 0..solver.structure.free {
+            let (mut up, mut um) = (u.clone(), u.clone());
+            up[i] += h;
+            um[i] -= h;
+            let (_, ep) = residual_and_energy(&mut solver, &up);
+            let (_, em) = residual_and_energy(&mut solver, &um);
+            let fd = (ep - em) / (2.0 * h);
+            assert!(
+                (fd - r[i]).abs() <= 1e-5 * r[i].abs().max(1e-2),
+                "seed {seed} row {i}: {fd} vs {}",
+                r[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn tangent_is_the_residual_jacobian() {
+    for seed in 1..4 {
+        let (mut solver, u) = solver_at(seed);
+        let (_, _) = residual_and_energy(&mut solver, &u);
+        solver.update_slack();
+        solver.factor_slack.copy_from_slice(&solver.slack);
+        solver.assemble_model();
+        let n = solver.structure.free;
+        let h = 1e-7;
+        for j in 0..n {
+            let (mut up, mut um) = (u.clone(), u.clone());
+            up[j] += h;
+            um[j] -= h;
+            let (rp, _) = residual_and_energy(&mut solver, &up);
+            let (rm, _) = residual_and_energy(&mut solver, &um);
+            for i in 0..n {
+                let fd = (rp[i] - rm[i]) / (2.0 * h);
+                let k = if solver.structure.node_dofs[solver.structure.dof_owner[i].0]
+                    [solver.structure.dof_owner[i].1 as usize]
+                    == crate::structure::FIXED
+                {
+                    0.0 // identity rows of fixed directions are not part of the Jacobian
+                } else {
+                    solver.k.get(i, j)
+                };
+                let scale = solver.k.get(i, i).abs().max(1.0);
+                assert!(
+                    (fd - k).abs() <= 1e-6 * scale,
+                    "seed {seed} K[{i}][{j}]: fd {fd} vs {k}"
+                );
+            }
+        }
+    }
+}

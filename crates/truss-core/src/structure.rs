@@ -1,0 +1,274 @@
+//! The compiled, immutable form of a model that solvers share: node numbering, per-member
+//! constants, assembly targets, and the factorised all-taut material stiffness `K₀`.
+//!
+//! A [`Structure`] is built once per model and shared (behind an `Arc`) by every thread's
+//! [`Solver`](crate::Solver). `K₀ = Σ k_m b_m b_mᵀ` (every cable taut, nominal geometry, no
+//! geometric stiffness) is factorised here once: it proves the model is not a mechanism,
+//! and with the Woodbury data over the cables it solves the linearised problem of every
+//! sample (see the `linearised` module).
+
+use crate::block::{Block, BlockBandMatrix};
+use crate::element::{AxialMember, norm, sub};
+use crate::linearised::{CableBasis, MAX_WOODBURY_CABLES};
+use crate::model::{Behaviour, Model};
+use crate::ordering::number_nodes;
+use crate::{ModelError, TopSurface};
+
+/// Marks a fixed direction in a node's DOF numbers.
+pub(crate) const FIXED: u32 = u32::MAX;
+
+/// Marks an assembly target that does not exist (a fully fixed node).
+pub(crate) const NONE: usize = usize::MAX;
+
+/// One member, compiled.
+#[derive(Debug, Clone)]
+pub(crate) struct CompiledMember {
+    /// Row numbers of (`i`x, `i`y, `i`z, `j`x, `j`y, `j`z); a fixed direction points at the
+    /// zero slot (index `free`), whose value is always zero.
+    pub dofs: [usize; 6],
+    /// Nominal vector `X_j − X_i` [mm].
+    pub reference: [f64; 3],
+    /// Nominal unit direction `(X_j − X_i)/L_r`.
+    pub unit: [f64; 3],
+    /// Nominal natural length [mm].
+    pub natural_length: f64,
+    /// Nominal `L_r − L₀` [mm].
+    pub nominal_stretch: f64,
+    /// `E·A` [N].
+    pub rigidity: f64,
+    /// 1 for bars; the compression ratio for cables.
+    pub compression_ratio: f64,
+    /// Whether the member is a cable.
+    pub is_cable: bool,
+    /// Block slots of (`i`,`i`), (`j`,`j`) and the coupling block, or [`NONE`].
+    pub slots: [usize; 3],
+    /// Whether the coupling block's rows belong to node `i` (else to node `j`).
+    pub coupling_rows_i: bool,
+    /// 1 for a free direction, 0 for a fixed one, of node `i` then node `j`.
+    pub masks: [[f64; 3]; 2],
+}
+
+/// A model compiled for solving (see the module doc).
+#[derive(Debug, Clone)]
+pub struct Structure {
+    pub(crate) node_ids: Vec<String>,
+    pub(crate) node_xyz: Vec<[f64; 3]>,
+    /// Row numbers of each node's directions, [`FIXED`] where held.
+    pub(crate) node_dofs: Vec<[u32; 3]>,
+    /// Node and direction of each row.
+    pub(crate) dof_owner: Vec<(usize, u8)>,
+    /// Number of rows (3 per active node); vectors have one more entry, the zero slot.
+    pub(crate) free: usize,
+    pub(crate) members: Vec<CompiledMember>,
+    /// Block slots and directions of fixed directions of active nodes (identity rows).
+    pub(crate) identity_rows: Vec<(usize, usize)>,
+    /// External load per row (plus the zero slot) [N].
+    pub(crate) loads: Vec<f64>,
+    /// `K₀`, factorised.
+    pub(crate) nominal: BlockBandMatrix,
+    /// Woodbury data over the cables, for models with few enough cables.
+    pub(crate) basis: Option<CableBasis>,
+    pub(crate) top_surface: Option<TopSurface>,
+}
+
+impl Structure {
+    /// Compiles `model` and factorises `K₀`; fails if the model is a mechanism.
+    pub fn new(model: &Model) -> Result<Self, ModelError> {
+        let nodes = model.nodes();
+        let fixed: Vec<[bool; 3]> = (0..nodes.len()).map(|i| model.fixed(i)).collect();
+        let edges: Vec<[usize; 2]> = model.members().iter().map(|m| m.nodes).collect();
+        let numbering = number_nodes(&fixed, &edges);
+        let free = 3 * numbering.blocks;
+        let mut k = BlockBandMatrix::new(numbering.blocks, numbering.bandwidth);
+        let mut node_dofs = vec![[FIXED; 3]; nodes.len()];
+        let mut dof_owner = vec![(0, 0); free];
+        let mut identity_rows = Vec::new();
+        for (node, block) in numbering.block.iter().enumerate() {
+            if let Some(b) = *block {
+                for d in 0..3 {
+                    dof_owner[3 * b + d] = (node, d as u8);
+                    if fixed[node][d] {
+                        identity_rows.push((k.slot(b, b), d));
+                    } else {
+                        node_dofs[node][d] = (3 * b + d) as u32;
+                    }
+                }
+            }
+        }
+        let members = model
+            .members()
+            .iter()
+            .enumerate()
+            .map(|(m, member)| {
+                let [i, j] = member.nodes;
+                let mut dofs = [free; 6];
+                for d in 0..3 {
+                    for (side, node) in [i, j].into_iter().enumerate() {
+                        if node_dofs[node][d] != FIXED {
+                            dofs[3 * side + d] = node_dofs[node][d] as usize;
+                        }
+                    }
+                }
+                let (bi, bj) = (numbering.block[i], numbering.block[j]);
+                let slot = |a: Option<usize>, b: Option<usize>| match (a, b) {
+                    (Some(a), Some(b)) => k.slot(a.max(b), a.min(b)),
+                    _ => NONE,
+                };
+                let mask = |node: usize| fixed[node].map(|f| if f { 0.0 } else { 1.0 });
+                let reference = sub(nodes[j].xyz, nodes[i].xyz);
+                let length = norm(reference);
+                let (is_cable, compression_ratio) = match member.behaviour {
+                    Behaviour::Bar => (false, 1.0),
+                    Behaviour::Cable { compression_ratio } => (true, compression_ratio),
+                };
+                CompiledMember {
+                    dofs,
+                    reference,
+                    unit: reference.map(|x| x / length),
+                    natural_length: member.natural_length,
+                    nominal_stretch: model.nominal_length(m) - member.natural_length,
+                    rigidity: member.youngs_modulus * member.area,
+                    compression_ratio,
+                    is_cable,
+                    slots: [slot(bi, bi), slot(bj, bj), slot(bi, bj)],
+                    coupling_rows_i: bi > bj,
+                    masks: [mask(i), mask(j)],
+                }
+            })
+            .collect();
+        let mut loads = vec![0.0; free + 1];
+        for (node, dofs) in node_dofs.iter().enumerate() {
+            let f = model.load(node);
+            for d in 0..3 {
+                if dofs[d] != FIXED {
+                    loads[dofs[d] as usize] = f[d];
+                }
+            }
+        }
+        let mut structure = Self {
+            node_ids: nodes.iter().map(|n| n.id.clone()).collect(),
+            node_xyz: nodes.iter().map(|n| n.xyz).collect(),
+            node_dofs,
+            dof_owner,
+            free,
+            members,
+            identity_rows,
+            loads,
+            nominal: BlockBandMatrix::new(0, 0),
+            basis: None,
+            top_surface: model.top_surface().cloned(),
+        };
+        structure.assemble_material(&mut k, |_| 1.0);
+        k.factor().map_err(|e| {
+            let (node, dof) = structure.describe_dof(e.index);
+            ModelError::Mechanism { node, dof }
+        })?;
+        structure.nominal = k;
+        let cables = structure.members.iter().filter(|m| m.is_cable).count();
+        if cables > 0 && cables <= MAX_WOODBURY_CABLES {
+            structure.basis = Some(CableBasis::new(&structure));
+        }
+        Ok(structure)
+    }
+
+    /// Assembles the linearised material stiffness `Σ f(m)·k_m·b_m b_mᵀ` (nominal `k_m`
+    /// and directions, `f(m)` a per-member factor such as a slack cable's compression
+    /// ratio) into `k`, identity rows included.
+    pub(crate) fn assemble_material(&self, k: &mut BlockBandMatrix, factor: impl Fn(usize) -> f64) {
+        k.clear();
+        for (m, c) in self.members.iter().enumerate() {
+            let kk = factor(m) * c.rigidity / c.natural_length;
+            let n = c.unit;
+            let block = [
+                kk * n[0] * n[0],
+                kk * n[1] * n[0],
+                kk * n[1] * n[1],
+                kk * n[2] * n[0],
+                kk * n[2] * n[1],
+                kk * n[2] * n[2],
+            ];
+            self.add_member(k, c, &block);
+        }
+        self.set_identity_rows(k);
+    }
+
+    /// Adds a member's contribution `[[K, −K], [−K, K]]` (from the six distinct entries of
+    /// the symmetric 3×3 `K`, order `[xx, yx, yy, zx, zy, zz]`), fixed directions masked.
+    #[inline]
+    pub(crate) fn add_member(&self, k: &mut BlockBandMatrix, c: &CompiledMember, e: &[f64; 6]) {
+        let full: Block = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
+        let [mi, mj] = c.masks;
+        let [sii, sjj, sij] = c.slots;
+        let storage = k.storage_mut();
+        if sii != NONE {
+            add_masked(&mut storage[sii], &full, &mi, &mi, 1.0);
+        }
+        if sjj != NONE {
+            add_masked(&mut storage[sjj], &full, &mj, &mj, 1.0);
+        }
+        if sij != NONE {
+            if c.coupling_rows_i {
+                add_masked(&mut storage[sij], &full, &mi, &mj, -1.0);
+            } else {
+                add_masked(&mut storage[sij], &full, &mj, &mi, -1.0);
+            }
+        }
+    }
+
+    /// Puts 1 on the diagonal of every fixed direction of an active node.
+    #[inline]
+    pub(crate) fn set_identity_rows(&self, k: &mut BlockBandMatrix) {
+        let storage = k.storage_mut();
+        for &(slot, d) in &self.identity_rows {
+            storage[slot][d][d] = 1.0;
+        }
+    }
+
+    /// The member's constants for a sample with length error `error` [mm].
+    #[inline]
+    pub(crate) fn nominal_member(&self, m: &CompiledMember, error: f64) -> AxialMember {
+        AxialMember::new(
+            m.reference,
+            m.natural_length + error,
+            m.nominal_stretch - error,
+            m.rigidity,
+            m.compression_ratio,
+        )
+    }
+
+    /// Number of rows of the stiffness matrix (3 per node with a free direction).
+    pub fn free_dofs(&self) -> usize {
+        self.free
+    }
+
+    /// Block (node) half-bandwidth of the stiffness matrix in the chosen numbering.
+    pub fn bandwidth(&self) -> usize {
+        self.nominal.bandwidth()
+    }
+
+    /// Number of members.
+    pub fn member_count(&self) -> usize {
+        self.members.len()
+    }
+
+    /// Number of nodes.
+    pub fn node_count(&self) -> usize {
+        self.node_ids.len()
+    }
+
+    /// Node id and direction (`x`, `y`, `z`) of row `dof`, for messages.
+    pub(crate) fn describe_dof(&self, dof: usize) -> (String, char) {
+        let (node, dir) = self.dof_owner[dof];
+        (self.node_ids[node].clone(), ['x', 'y', 'z'][dir as usize])
+    }
+}
+
+/// `target += sign · (row mask) ∘ block ∘ (column mask)`.
+#[inline(always)]
+fn add_masked(target: &mut Block, block: &Block, rows: &[f64; 3], cols: &[f64; 3], sign: f64) {
+    for r in 0..3 {
+        for c in 0..3 {
+            target[r][c] += sign * rows[r] * cols[c] * block[r][c];
+        }
+    }
+}

@@ -1,0 +1,127 @@
+//! Bad model files are refused with an error naming the item.
+
+mod common;
+use common::*;
+use truss_core::{Model, ModelError};
+
+fn triangle() -> truss_core::ModelFile {
+    file(
+        vec![
+            node("a", [0.0, 0.0, 0.0]),
+            node("b", [100.0, 0.0, 0.0]),
+            node("c", [0.0, 100.0, 0.0]),
+        ],
+        vec![
+            member("ab", "a", "b", 1.0, None, None),
+            member("bc", "b", "c", 1.0, None, None),
+            member("ca", "c", "a", 1.0, None, None),
+        ],
+        vec![support("a", "xyz"), support("b", "yz"), support("c", "z")],
+    )
+}
+
+fn message(f: truss_core::ModelFile) -> String {
+    Model::new(f).unwrap_err().to_string()
+}
+
+#[test]
+fn the_valid_triangle_is_accepted() {
+    Model::new(triangle()).unwrap();
+}
+
+#[test]
+fn unknown_node_is_named() {
+    let mut f = triangle();
+    f.members[1].nodes[1] = "q".into();
+    let m = message(f);
+    assert!(
+        m.contains("members[1]") && m.contains("\"bc\"") && m.contains("\"q\""),
+        "{m}"
+    );
+}
+
+#[test]
+fn duplicate_ids_are_named() {
+    let mut f = triangle();
+    f.members[2].id = "ab".into();
+    assert!(message(f).contains("member id \"ab\" is used twice"));
+    let mut f = triangle();
+    f.nodes[2].id = "a".into();
+    assert!(message(f).contains("node id \"a\""));
+}
+
+#[test]
+fn zero_length_member_is_named() {
+    let mut f = triangle();
+    f.nodes[1].xyz = [0.0, 0.0, 0.0];
+    let m = message(f);
+    assert!(m.contains("zero-length") && m.contains("\"ab\""), "{m}");
+}
+
+#[test]
+fn non_positive_area_and_modulus_are_named() {
+    let mut f = triangle();
+    f.members[0].area = 0.0;
+    assert!(message(f).contains("area must be positive"));
+    let mut f = triangle();
+    f.members[2].youngs_modulus = -70_000.0;
+    let m = message(f);
+    assert!(
+        m.contains("members[2]") && m.contains("youngs_modulus"),
+        "{m}"
+    );
+    let mut f = triangle();
+    f.members[0].natural_length = Some(0.0);
+    assert!(message(f).contains("natural_length"));
+}
+
+#[test]
+fn non_finite_numbers_are_named() {
+    let mut f = triangle();
+    f.nodes[2].xyz[1] = f64::NAN;
+    let m = message(f);
+    assert!(
+        m.contains("nodes[2]") && m.contains("xyz") && m.contains("not a finite"),
+        "{m}"
+    );
+    let mut f = triangle();
+    f.members[1].area = f64::INFINITY;
+    assert!(message(f).contains("not a finite"));
+}
+
+#[test]
+fn a_mechanism_is_refused_naming_the_free_node() {
+    let mut f = triangle();
+    f.supports[2].fixed = "".into();
+    let m = message(f);
+    assert!(
+        m.contains("mechanism") && m.contains("\"c\"") && m.contains("z"),
+        "{m}"
+    );
+}
+
+#[test]
+fn bad_json_and_misspelt_fields_name_the_line() {
+    let text = triangle_json().replace("\"youngs_modulus\"", "\"youngs_modulous\"");
+    let err = Model::from_json(&text, "m.json").unwrap_err();
+    assert!(matches!(err, ModelError::Syntax { .. }), "{err}");
+    let m = err.to_string();
+    assert!(
+        m.starts_with("m.json: line ") && m.contains("youngs_modulous"),
+        "{m}"
+    );
+}
+
+#[test]
+fn cable_fields_are_checked() {
+    let mut f = triangle();
+    f.members[0].compression_ratio = Some(0.5);
+    assert!(message(f).contains("cables only"));
+    let mut f = triangle();
+    f.members[0] = member("ab", "a", "b", 1.0, None, Some(1.5));
+    assert!(message(f).contains("compression_ratio must be in [0, 1)"));
+}
+
+fn triangle_json() -> String {
+    triangle().to_json()
+}
