@@ -1,0 +1,514 @@
+//! The statistics of one case: percentiles with three kinds of interval, the Rayleigh law and
+//! its goodness of fit, loose joints. Turns verified samples into a [`CaseReport`].
+
+use crate::bootstrap::{
+    self, BootstrapConfig, QuantileReplicates, SortedSample, bootstrap_quantiles,
+};
+use crate::cli::Settings;
+use crate::gof::{self, CalibrationCache, GofConfig};
+use crate::load::CaseData;
+use crate::quantile::{order_statistic_interval, quantile_sorted};
+use crate::rayleigh::{self, ComponentStats};
+use crate::report::*;
+use statrs::distribution::{Beta, ContinuousCDF};
+
+/// A case's report plus what the sweeps need: the target percentile, its interval and its
+/// bootstrap replicates.
+#[derive(Debug, Clone)]
+pub struct CaseAnalysis {
+    /// The case's section of the report.
+    pub report: CaseReport,
+    /// The target percentile (rad) with its BCa (else percentile) interval.
+    pub target: Figure,
+    /// The target percentile of each bootstrap replicate (`None`: empty replicate, or no bootstrap).
+    pub target_replicates: Vec<Option<f64>>,
+}
+
+/// The caveats every figure of a case carries.
+pub fn caveats(case: &CaseData) -> Vec<String> {
+    let mut out = vec![];
+    if case.present < case.info.samples {
+        out.push(format!(
+            "partial: {} of {} samples of this case present ({:.1} %)",
+            case.present,
+            case.info.samples,
+            100.0 * case.present as f64 / case.info.samples.max(1) as f64
+        ));
+    }
+    if case.failed > 0 {
+        out.push(format!(
+            "{} failed samples excluded: computed on the {} converged samples; if failures are more likely for large distortions the upper percentiles are biased low",
+            case.failed,
+            case.converged()
+        ));
+    }
+    out
+}
+
+/// Formats a p-value, showing the Monte Carlo floor `1/(M+1)` as a bound.
+pub fn format_p(p: f64, replicates: usize) -> String {
+    let floor = 1.0 / (replicates as f64 + 1.0);
+    if p <= floor * (1.0 + 1e-9) {
+        format!("p ≤ {floor:.1e}")
+    } else if p < 0.01 {
+        format!("p = {p:.4}")
+    } else {
+        format!("p = {p:.2}")
+    }
+}
+
+fn component_report(stats: Option<ComponentStats>) -> ComponentReport {
+    let Some(s) = stats else {
+        let none = || Figure::null("no converged sample");
+        return ComponentReport {
+            mean: none(),
+            std: none(),
+            rms: none(),
+        };
+    };
+    let with = |v: f64, b: Option<rayleigh::Bounds>, why: &str| match b {
+        Some(b) => Figure::new(v, b.lower, b.upper),
+        None => Figure::without_interval(v, why),
+    };
+    ComponentReport {
+        mean: with(s.mean, s.mean_interval, "n = 1: no interval"),
+        std: match s.std {
+            Some(sd) => with(sd, s.std_interval, "no interval"),
+            None => Figure::null("n = 1: no standard deviation"),
+        },
+        rms: with(s.rms, s.rms_interval, "no interval"),
+    }
+}
+
+/// The Clopper–Pearson interval of a binomial fraction k/n (Clopper & Pearson 1934).
+pub fn clopper_pearson(k: u64, n: u64, confidence: f64) -> Figure {
+    if n == 0 {
+        return Figure::null("no sample records loose_joints");
+    }
+    let tail = (1.0 - confidence) / 2.0;
+    let (kf, nf) = (k as f64, n as f64);
+    let lower = if k == 0 {
+        0.0
+    } else {
+        Beta::new(kf, nf - kf + 1.0).map_or(f64::NAN, |b| b.inverse_cdf(tail))
+    };
+    let upper = if k == n {
+        1.0
+    } else {
+        Beta::new(kf + 1.0, nf - kf).map_or(f64::NAN, |b| b.inverse_cdf(1.0 - tail))
+    };
+    Figure::new(kf / nf, lower, upper)
+}
+
+/// The percentile-method interval of replicate values (unsorted, `None`s skipped).
+pub fn replicate_interval(
+    values: impl Iterator<Item = f64>,
+    confidence: f64,
+) -> Option<(f64, f64)> {
+    let mut v: Vec<f64> = values.filter(|x| x.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    bootstrap::percentile_interval(&v, confidence)
+}
+
+struct Percentiles {
+    reports: Vec<PercentileReport>,
+    /// Per level: point estimate and primary (BCa, else percentile) interval.
+    primary: Vec<Figure>,
+}
+
+fn percentiles(
+    sample: &SortedSample,
+    boot: Option<&QuantileReplicates>,
+    settings: &Settings,
+    caveats: &[String],
+) -> Percentiles {
+    let conf = settings.confidence;
+    let n = sample.len();
+    let mut reports = vec![];
+    let mut primary = vec![];
+    for (j, &pct) in settings.percentiles.iter().enumerate() {
+        let p = pct / 100.0;
+        let value = quantile_sorted(&sample.values, p);
+        let no_boot = if n == 0 {
+            "no converged sample".to_string()
+        } else {
+            format!("n = {n}: the bootstrap needs at least 2 samples")
+        };
+        let (pb, bca) = match (value, boot) {
+            (Some(q), Some(b)) => {
+                let reps = b.sorted_level(j);
+                let pb = match bootstrap::percentile_interval(&reps, conf) {
+                    Some((lo, hi)) => Interval::new(lo, hi),
+                    None => Interval::null("no non-empty bootstrap replicate"),
+                };
+                let bca = match bootstrap::quantile_acceleration(&sample.values, p, q)
+                    .ok_or_else(|| "acceleration undefined".to_string())
+                    .and_then(|a| bootstrap::bca_interval(&reps, q, a, conf))
+                {
+                    Ok(i) => BcaReport {
+                        lower: real(i.lower),
+                        upper: real(i.upper),
+                        z0: real(i.z0),
+                        acceleration: real(i.acceleration),
+                        reason: None,
+                    },
+                    Err(reason) => BcaReport {
+                        reason: Some(reason),
+                        ..Default::default()
+                    },
+                };
+                (pb, bca)
+            }
+            _ => (
+                Interval::null(no_boot.clone()),
+                BcaReport {
+                    reason: Some(no_boot.clone()),
+                    ..Default::default()
+                },
+            ),
+        };
+        let os = match order_statistic_interval(&sample.values, p, conf) {
+            Ok(i) => OrderStatisticReport {
+                lower: real(i.lower),
+                upper: real(i.upper),
+                lower_rank: Some(i.lower_rank),
+                upper_rank: Some(i.upper_rank),
+                coverage: real(i.coverage),
+                reason: None,
+            },
+            Err(reason) => OrderStatisticReport {
+                reason: Some(reason),
+                ..Default::default()
+            },
+        };
+        primary.push(match value {
+            None => Figure::null("no converged sample"),
+            Some(q) => match (bca.lower, bca.upper, pb.get()) {
+                (Some(lo), Some(hi), _) => Figure::new(q, lo.0, hi.0),
+                (_, _, Some((lo, hi))) => Figure {
+                    reason: Some("percentile-bootstrap interval (BCa undefined)".into()),
+                    ..Figure::new(q, lo, hi)
+                },
+                _ => Figure::without_interval(q, no_boot),
+            },
+        });
+        reports.push(PercentileReport {
+            percentile: Real(pct),
+            value: value.and_then(real),
+            reason: value.is_none().then(|| "no converged sample".into()),
+            percentile_bootstrap: pb,
+            bca,
+            order_statistic: os,
+            caveats: caveats.to_vec(),
+        });
+    }
+    Percentiles { reports, primary }
+}
+
+/// Relative difference (Rayleigh − empirical)/empirical at level `p`, with its bootstrap interval.
+fn relative_difference(
+    sigma: f64,
+    empirical: Option<f64>,
+    p: f64,
+    j: usize,
+    boot: Option<&QuantileReplicates>,
+    confidence: f64,
+) -> Figure {
+    let Some(q) = empirical.filter(|q| *q > 0.0) else {
+        return Figure::null("empirical percentile is zero or undefined");
+    };
+    let value = (rayleigh::percentile(sigma, p) - q) / q;
+    let Some(b) = boot else {
+        return Figure::without_interval(value, "no bootstrap");
+    };
+    let reps = b
+        .replicates
+        .iter()
+        .zip(&b.quantiles[j])
+        .filter_map(|(r, qs)| {
+            let qs = (*qs)?;
+            (r.total_weight > 0 && qs > 0.0).then(|| {
+                let s = (r.weighted_sum_sq / (2.0 * r.total_weight as f64)).sqrt();
+                (rayleigh::percentile(s, p) - qs) / qs
+            })
+        });
+    match replicate_interval(reps, confidence) {
+        Some((lo, hi)) => Figure::new(value, lo, hi),
+        None => Figure::without_interval(value, "no usable bootstrap replicate"),
+    }
+}
+
+fn gof_report(
+    sample: &SortedSample,
+    rayleigh_sigma: Option<f64>,
+    empirical_target: Option<f64>,
+    target_rel: &Figure,
+    settings: &Settings,
+    cache: &mut CalibrationCache,
+    caveats: &[String],
+) -> GofReport {
+    let config = GofConfig {
+        replicates: settings.gof_replicates,
+        seed: settings.bootstrap_seed,
+        threads: settings.threads,
+    };
+    let level = settings.gof_level;
+    let pct = settings.target_percentile;
+    let result = gof::rayleigh_gof(&sample.values, cache, &config);
+    let g = match result {
+        Ok(g) => g,
+        Err(reason) => {
+            return GofReport {
+                verdict: None,
+                summary: format!("Rayleigh law not tested: {reason}"),
+                level: Real(level),
+                ks: None,
+                ad: None,
+                null_calibration: None,
+                effect: None,
+                reason: Some(reason),
+                caveats: caveats.to_vec(),
+            };
+        }
+    };
+    let holds = g.ks_p >= level && g.ad_p >= level;
+    let m = g.calibration_replicates;
+    let effect = match (rayleigh_sigma, empirical_target) {
+        (Some(s), Some(q)) => Some(EffectReport {
+            percentile: Real(pct),
+            rayleigh: Real(rayleigh::percentile(s, pct / 100.0)),
+            empirical: Real(q),
+            relative_difference: target_rel.clone(),
+            max_cdf_gap: Real(g.statistics.ks),
+        }),
+        _ => None,
+    };
+    let mut summary = format!(
+        "Rayleigh law {} (KS {}, AD {})",
+        if holds { "holds" } else { "rejected" },
+        format_p(g.ks_p, m),
+        format_p(g.ad_p, m)
+    );
+    if let Some(rel) = target_rel.get() {
+        let pct_txt = format!("{pct}th percentile");
+        if holds {
+            summary.push_str(&format!(
+                "; Rayleigh {pct_txt} within {:.1} % of the empirical one",
+                rel.abs() * 100.0
+            ));
+        } else {
+            summary.push_str(&format!(
+                "; Rayleigh {pct_txt} {:.1} % {} the empirical one",
+                rel.abs() * 100.0,
+                if rel >= 0.0 { "above" } else { "below" }
+            ));
+        }
+    }
+    summary.push_str(&format!(", max CDF gap {:.4}", g.statistics.ks));
+    GofReport {
+        verdict: Some(if holds { "holds" } else { "rejected" }),
+        summary,
+        level: Real(level),
+        ks: Some(TestReport {
+            statistic: Real(g.statistics.ks),
+            modified: Real(g.statistics.ks_modified),
+            p_value: Real(g.ks_p),
+            p_value_se: Real(g.ks_p_se),
+        }),
+        ad: Some(TestReport {
+            statistic: Real(g.statistics.ad),
+            modified: Real(g.statistics.ad_modified),
+            p_value: Real(g.ad_p),
+            p_value_se: Real(g.ad_p_se),
+        }),
+        null_calibration: Some(NullCalibrationReport {
+            sample_size: g.calibration_n,
+            replicates: m,
+        }),
+        effect,
+        reason: None,
+        caveats: caveats.to_vec(),
+    }
+}
+
+/// Computes every statistic of one case.
+pub fn analyse_case(
+    case: &CaseData,
+    settings: &Settings,
+    cache: &mut CalibrationCache,
+) -> CaseAnalysis {
+    let caveats = caveats(case);
+    let conf = settings.confidence;
+    let sample = SortedSample::new(case.points().map(|p| (p.theta, p.index)).collect());
+    let n = sample.len();
+    let levels: Vec<f64> = settings.percentiles.iter().map(|p| p / 100.0).collect();
+    let boot = (n >= 2).then(|| {
+        bootstrap_quantiles(
+            &sample,
+            &levels,
+            &BootstrapConfig {
+                replicates: settings.replicates,
+                seed: settings.bootstrap_seed,
+                threads: settings.threads,
+            },
+        )
+    });
+    let pcts = percentiles(&sample, boot.as_ref(), settings, &caveats);
+    // `Settings::validate` adds the target percentile; without it, the sweeps use the last one.
+    let target_j = settings
+        .percentiles
+        .iter()
+        .position(|&p| p == settings.target_percentile)
+        .unwrap_or(settings.percentiles.len().saturating_sub(1));
+
+    // Rayleigh law, sums in global index order.
+    let points = case.points();
+    let sum_sq_theta: f64 = points.clone().map(|p| p.theta * p.theta).sum();
+    let tx = rayleigh::component_stats(points.clone().map(|p| p.tan_x), conf);
+    let ty = rayleigh::component_stats(points.clone().map(|p| p.tan_y), conf);
+    let fit = (n > 0).then(|| rayleigh::fit_from_sum_sq(n, sum_sq_theta, conf));
+    let sigma_t = match (tx, ty) {
+        (Some(x), Some(y)) => {
+            let s = x.sum_sq + y.sum_sq;
+            let v = (s / (2.0 * n as f64)).sqrt();
+            match rayleigh::chi2_scale_interval(s, 2.0 * n as f64, conf) {
+                Ok(b) => Figure::new(v, b.lower, b.upper),
+                Err(e) => Figure::without_interval(v, e),
+            }
+        }
+        _ => Figure::null("no converged sample"),
+    };
+    let mut rel_target = Figure::null("no converged sample");
+    let rayleigh_pcts: Vec<RayleighPercentile> = settings
+        .percentiles
+        .iter()
+        .enumerate()
+        .map(|(j, &pct)| {
+            let p = pct / 100.0;
+            let empirical = quantile_sorted(&sample.values, p);
+            let (value, rel) = match fit {
+                Some(f) => (
+                    Figure::new(
+                        rayleigh::percentile(f.sigma, p),
+                        rayleigh::percentile(f.sigma_interval.lower, p),
+                        rayleigh::percentile(f.sigma_interval.upper, p),
+                    ),
+                    relative_difference(f.sigma, empirical, p, j, boot.as_ref(), conf),
+                ),
+                None => (
+                    Figure::null("no converged sample"),
+                    Figure::null("no converged sample"),
+                ),
+            };
+            if j == target_j {
+                rel_target = rel.clone();
+            }
+            RayleighPercentile {
+                percentile: Real(pct),
+                value,
+                empirical: empirical.and_then(real),
+                relative_difference: rel,
+                reason: empirical.is_none().then(|| "no converged sample".into()),
+            }
+        })
+        .collect();
+    let rayleigh = RayleighReport {
+        tan_theta_x: component_report(tx),
+        tan_theta_y: component_report(ty),
+        sigma_t,
+        sigma: match fit {
+            Some(f) => Figure::new(f.sigma, f.sigma_interval.lower, f.sigma_interval.upper),
+            None => Figure::null("no converged sample"),
+        },
+        percentiles: rayleigh_pcts,
+        caveats: caveats.clone(),
+    };
+    let empirical_target = quantile_sorted(&sample.values, settings.target_percentile / 100.0);
+    let gof = gof_report(
+        &sample,
+        fit.map(|f| f.sigma),
+        empirical_target,
+        &rel_target,
+        settings,
+        cache,
+        &caveats,
+    );
+
+    let (recorded, with_loose) = case.loose_joints();
+    let failed_ranges = case.failed_ranges();
+    let report = CaseReport {
+        name: case.info.name.clone(),
+        parameters: case
+            .info
+            .parameters
+            .iter()
+            .filter_map(|(k, v)| real(*v).map(|r| (k.clone(), r)))
+            .collect(),
+        expected: case.info.samples,
+        present: case.present,
+        n: n as u64,
+        failed: FailedCaseReport {
+            count: case.failed,
+            ranges: failed_ranges
+                .iter()
+                .take(100)
+                .map(|r| [r.start, r.end])
+                .collect(),
+            reasons: case
+                .failed_reasons
+                .iter()
+                .map(|(i, r)| FailedReason {
+                    index: *i,
+                    reason: r.clone(),
+                })
+                .collect(),
+        },
+        caveats: caveats.clone(),
+        loose_joints: LooseJoints {
+            recorded,
+            with_loose,
+            fraction: clopper_pearson(with_loose, recorded, conf),
+        },
+        bootstrap: BootstrapCase {
+            replicates: if boot.is_some() {
+                settings.replicates
+            } else {
+                0
+            },
+            empty_replicates: boot.as_ref().map_or(0, |b| b.empty()),
+        },
+        percentiles: pcts.reports,
+        rayleigh,
+        gof,
+    };
+    CaseAnalysis {
+        report,
+        target: pcts.primary[target_j].clone(),
+        target_replicates: boot
+            .map(|b| b.quantiles[target_j].clone())
+            .unwrap_or_default(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Clopper–Pearson by hand: k = 0 of n gives upper 1 − (α/2)^{1/n} (the "rule of three"
+    /// family); n = 10, 95 %: 1 − 0.025^{0.1} = 0.3085.
+    #[test]
+    fn clopper_pearson_zero_successes_by_hand() {
+        let f = clopper_pearson(0, 10, 0.95);
+        assert_eq!(f.get(), Some(0.0));
+        let (lo, hi) = f.interval().unwrap();
+        assert_eq!(lo, 0.0);
+        assert!((hi - (1.0 - 0.025f64.powf(0.1))).abs() < 1e-6, "{hi}");
+        assert!(clopper_pearson(0, 0, 0.95).get().is_none());
+    }
+
+    #[test]
+    fn p_value_floor_is_shown_as_bound() {
+        assert_eq!(format_p(1.0 / 1001.0, 1000), "p ≤ 1.0e-3");
+        assert_eq!(format_p(0.41, 1000), "p = 0.41");
+    }
+}

@@ -1,0 +1,287 @@
+//! The command line: raw flags ([`Args`], parsed by clap) validated into [`Options`].
+
+use crate::errors::MergeError;
+use clap::Parser;
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// The default seed of the bootstrap and of the goodness-of-fit null simulation.
+pub const DEFAULT_SEED: u64 = 20_210_325;
+
+/// 20 arcseconds in radians, rounded as in the paper: 9.69e-5 rad.
+pub const DEFAULT_TARGET_ANGLE: f64 = 9.69e-5;
+
+/// Radians to arcseconds: 648000/π.
+pub const ARCSEC_PER_RAD: f64 = 648_000.0 / std::f64::consts::PI;
+
+const AFTER_HELP: &str = "\
+Exit codes:
+  0  the shards verified and the report was written
+  1  internal error (a bug)
+  2  usage error (bad flag or value)
+  3  verification failure: a torn, corrupt or incomplete shard, another job id, a wrong digest,
+     a missing index range, or overlapping shards that disagree
+  4  failed samples present (give --allow-failed to compute on the converged ones)
+  5  I/O error reading shards or writing the report
+
+Every number is reproducible: the bootstrap weights are a function of (seed, replicate, global
+sample index), so the report is byte-identical however the job was split and in whatever order
+the shard files are given.";
+
+/// Merges Monte Carlo shard files of one job into percentiles of the distortion angle θ_P with
+/// bootstrap confidence intervals, the paper's Rayleigh law with goodness of fit, sweeps over
+/// σ and the number of stages with the allowable σ, and SVG plots.
+#[derive(Debug, Clone, Parser)]
+#[command(name = "mc-merge", version, about, after_help = AFTER_HELP)]
+pub struct Args {
+    /// Shard files, or directories whose *.jsonl files are read.
+    #[arg(required = true, value_name = "DIR_OR_FILES")]
+    pub paths: Vec<PathBuf>,
+
+    /// Directory for report.json and the SVG plots (created if needed). Without it only the
+    /// table is printed.
+    #[arg(long, value_name = "REPORT_DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Percentiles of θ_P to estimate, in percent, comma separated, each strictly between 0 and 100.
+    #[arg(long, value_delimiter = ',', default_value = "50,90,95,99")]
+    pub percentiles: Vec<f64>,
+
+    /// Confidence level of every interval, a fraction in (0, 1).
+    #[arg(long, default_value_t = 0.95)]
+    pub confidence: f64,
+
+    /// Bootstrap replicates B.
+    #[arg(long, default_value_t = 2000)]
+    pub replicates: u32,
+
+    /// Seed of the counter-based bootstrap generator.
+    #[arg(long, default_value_t = DEFAULT_SEED)]
+    pub bootstrap_seed: u64,
+
+    /// Simulated null samples for the goodness-of-fit p-values.
+    #[arg(long, default_value_t = 1000)]
+    pub gof_replicates: u32,
+
+    /// Significance level of the Rayleigh goodness-of-fit verdict.
+    #[arg(long, default_value_t = 0.05)]
+    pub gof_level: f64,
+
+    /// Target distortion angle in rad for the allowable σ (9.69e-5 rad = 20 arcsec).
+    #[arg(long, default_value_t = DEFAULT_TARGET_ANGLE)]
+    pub target_angle: f64,
+
+    /// The percentile of θ_P that must meet the target angle (added to --percentiles if absent).
+    #[arg(long, default_value_t = 95.0)]
+    pub target_percentile: f64,
+
+    /// Worker threads (results do not depend on it; default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+
+    /// Compute on the samples present when index ranges are missing; every figure is marked partial.
+    #[arg(long)]
+    pub allow_partial: bool,
+
+    /// Compute on the converged samples when some failed; every affected figure says so.
+    #[arg(long)]
+    pub allow_failed: bool,
+
+    /// Do not draw the SVG plots.
+    #[arg(long)]
+    pub no_plots: bool,
+}
+
+/// The statistical settings of a merge, recorded in the report.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Settings {
+    /// Percentiles of θ_P in percent, ascending, distinct, including the target percentile.
+    pub percentiles: Vec<f64>,
+    /// Confidence level of every interval.
+    pub confidence: f64,
+    /// Bootstrap replicates B.
+    pub replicates: u32,
+    /// Bootstrap seed.
+    pub bootstrap_seed: u64,
+    /// Goodness-of-fit null samples M.
+    pub gof_replicates: u32,
+    /// Goodness-of-fit significance level.
+    pub gof_level: f64,
+    /// Target angle (rad).
+    pub target_angle: f64,
+    /// The percentile that must meet the target, in percent.
+    pub target_percentile: f64,
+    /// Whether missing ranges were tolerated.
+    pub allow_partial: bool,
+    /// Whether failed samples were tolerated.
+    pub allow_failed: bool,
+    /// Worker threads (not in the report: results do not depend on it).
+    #[serde(skip)]
+    pub threads: usize,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            percentiles: vec![50.0, 90.0, 95.0, 99.0],
+            confidence: 0.95,
+            replicates: 2000,
+            bootstrap_seed: DEFAULT_SEED,
+            gof_replicates: 1000,
+            gof_level: 0.05,
+            target_angle: DEFAULT_TARGET_ANGLE,
+            target_percentile: 95.0,
+            allow_partial: false,
+            allow_failed: false,
+            threads: default_threads(),
+        }
+    }
+}
+
+/// All available cores.
+pub fn default_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// A validated merge request.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// Shard files or directories.
+    pub paths: Vec<PathBuf>,
+    /// Report directory.
+    pub out: Option<PathBuf>,
+    /// Whether to draw plots (only with `out`).
+    pub plots: bool,
+    /// The statistics.
+    pub settings: Settings,
+}
+
+fn usage(message: String) -> MergeError {
+    MergeError::Usage { message }
+}
+
+impl Args {
+    /// Checks every value and builds the options.
+    pub fn validate(self) -> Result<Options, MergeError> {
+        if self.threads == Some(0) {
+            return Err(usage("--threads 0: at least one thread".into()));
+        }
+        let settings = Settings {
+            percentiles: self.percentiles.clone(),
+            confidence: self.confidence,
+            replicates: self.replicates,
+            bootstrap_seed: self.bootstrap_seed,
+            gof_replicates: self.gof_replicates,
+            gof_level: self.gof_level,
+            target_angle: self.target_angle,
+            target_percentile: self.target_percentile,
+            allow_partial: self.allow_partial,
+            allow_failed: self.allow_failed,
+            threads: self.threads.unwrap_or_else(default_threads),
+        }
+        .validate()?;
+        Ok(Options {
+            paths: self.paths,
+            plots: !self.no_plots,
+            out: self.out,
+            settings,
+        })
+    }
+}
+
+impl Settings {
+    /// Checks every value and returns the settings with the percentiles sorted, distinct and
+    /// including the target percentile. [`crate::merge`] calls it, so library users get the
+    /// same checks as the command line.
+    pub fn validate(&self) -> Result<Settings, MergeError> {
+        let open01 = |name: &str, v: f64| {
+            if v > 0.0 && v < 1.0 {
+                Ok(v)
+            } else {
+                Err(usage(format!(
+                    "--{name} {v}: must be a fraction strictly between 0 and 1 (e.g. 0.95)"
+                )))
+            }
+        };
+        open01("confidence", self.confidence)?;
+        open01("gof-level", self.gof_level)?;
+        let pct_ok = |v: f64| v > 0.0 && v < 100.0;
+        if let Some(bad) = self.percentiles.iter().find(|v| !pct_ok(**v)) {
+            return Err(usage(format!(
+                "--percentiles: {bad} is not a percentile strictly between 0 and 100"
+            )));
+        }
+        if !pct_ok(self.target_percentile) {
+            return Err(usage(format!(
+                "--target-percentile {}: must be strictly between 0 and 100",
+                self.target_percentile
+            )));
+        }
+        if !(self.target_angle > 0.0 && self.target_angle.is_finite()) {
+            return Err(usage(format!(
+                "--target-angle {}: must be a positive angle in rad",
+                self.target_angle
+            )));
+        }
+        if self.replicates < 10 {
+            return Err(usage(format!(
+                "--replicates {}: at least 10 bootstrap replicates are needed (2000 recommended)",
+                self.replicates
+            )));
+        }
+        if self.gof_replicates < 19 {
+            return Err(usage(format!(
+                "--gof-replicates {}: at least 19 null samples are needed (1000 recommended)",
+                self.gof_replicates
+            )));
+        }
+        let mut percentiles = self.percentiles.clone();
+        percentiles.push(self.target_percentile);
+        percentiles.sort_by(f64::total_cmp);
+        percentiles.dedup();
+        Ok(Settings {
+            percentiles,
+            threads: self.threads.max(1),
+            ..self.clone()
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(args: &[&str]) -> Result<Options, MergeError> {
+        let mut v = vec!["mc-merge"];
+        v.extend_from_slice(args);
+        Args::try_parse_from(v).unwrap().validate()
+    }
+
+    #[test]
+    fn defaults_and_target_added() {
+        let o = parse(&["d", "--percentiles", "50,99", "--target-percentile", "90"]).unwrap();
+        assert_eq!(o.settings.percentiles, vec![50.0, 90.0, 99.0]);
+        assert_eq!(o.settings.replicates, 2000);
+        assert!(o.plots && o.out.is_none());
+    }
+
+    #[test]
+    fn bad_values_are_usage_errors() {
+        for bad in [
+            &["d", "--percentiles", "0,95"][..],
+            &["d", "--percentiles", "100"],
+            &["d", "--confidence", "95"],
+            &["d", "--target-angle=-1"],
+            &["d", "--target-angle", "0"],
+            &["d", "--replicates", "3"],
+            &["d", "--threads", "0"],
+        ] {
+            let e = parse(bad).unwrap_err();
+            assert_eq!(
+                e.exit_code(),
+                crate::errors::ExitCodes::USAGE,
+                "{bad:?}: {e}"
+            );
+        }
+    }
+}

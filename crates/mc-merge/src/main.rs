@@ -1,0 +1,22 @@
+//! `mc-merge`: verifies the Monte Carlo shards of one job and reports percentiles with
+//! confidence intervals, the Rayleigh law and the allowable σ. Exit codes: see `--help` or
+//! [`mc_merge::ExitCodes`].
+
+use clap::Parser;
+use mc_merge::{Args, ExitCodes};
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    // Usage errors exit with clap's code 2, which is ExitCodes::USAGE.
+    let args = Args::parse();
+    let result = args
+        .validate()
+        .and_then(|options| mc_merge::run(&options, &mut std::io::stdout().lock()));
+    match result {
+        Ok(_) => ExitCode::from(ExitCodes::OK as u8),
+        Err(e) => {
+            eprintln!("mc-merge: error: {e}");
+            ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}

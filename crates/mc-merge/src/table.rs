@@ -1,0 +1,228 @@
+//! The readable summary printed on stdout: one row per case, then the sweeps and the allowable σ.
+//! Angles in rad and arcsec.
+
+use crate::cli::ARCSEC_PER_RAD;
+use crate::report::{Figure, Report, short};
+use std::fmt::Write;
+
+fn rad(x: f64) -> String {
+    format!("{x:.3e}")
+}
+
+/// `9.690e-5 (19.99") [19.82, 20.16]`: rad, then arcsec with the interval in arcsec.
+fn angle(f: &Figure) -> String {
+    match (f.get(), f.interval()) {
+        (Some(v), Some((lo, hi))) => format!(
+            "{} ({:.2}\") [{:.2}, {:.2}]",
+            rad(v),
+            v * ARCSEC_PER_RAD,
+            lo * ARCSEC_PER_RAD,
+            hi * ARCSEC_PER_RAD
+        ),
+        (Some(v), None) => format!("{} ({:.2}\") [no interval]", rad(v), v * ARCSEC_PER_RAD),
+        _ => format!("- ({})", f.reason.as_deref().unwrap_or("undefined")),
+    }
+}
+
+/// Like [`angle`], with the interval also in rad (for the sweeps, where there is room).
+fn angle_full(f: &Figure) -> String {
+    match (f.get(), f.interval()) {
+        (Some(v), Some((lo, hi))) => format!(
+            "{} [{}, {}] rad = {:.2} [{:.2}, {:.2}] arcsec",
+            rad(v),
+            rad(lo),
+            rad(hi),
+            v * ARCSEC_PER_RAD,
+            lo * ARCSEC_PER_RAD,
+            hi * ARCSEC_PER_RAD
+        ),
+        _ => angle(f),
+    }
+}
+
+fn plain(f: &Figure, digits: usize) -> String {
+    match (f.get(), f.interval()) {
+        (Some(v), Some((lo, hi))) => format!("{v:.digits$e} [{lo:.digits$e}, {hi:.digits$e}]"),
+        (Some(v), None) => format!("{v:.digits$e}"),
+        _ => format!("- ({})", f.reason.as_deref().unwrap_or("undefined")),
+    }
+}
+
+/// Renders the summary table.
+pub fn render(report: &Report, files: usize) -> String {
+    let mut s = String::new();
+    let c = &report.coverage;
+    let pct = report.sweep.percentile.0;
+    let _ = writeln!(
+        s,
+        "job {}: {} shard files, {} of {} samples{}",
+        report.job_id,
+        files,
+        c.present,
+        c.expected,
+        if c.complete {
+            " (complete)".to_string()
+        } else {
+            format!(
+                " — PARTIAL, {} missing ranges; every figure is marked partial",
+                c.missing_ranges
+            )
+        }
+    );
+    if report.failed.total > 0 {
+        let _ = writeln!(
+            s,
+            "{} failed samples EXCLUDED (--allow-failed); affected figures say so",
+            report.failed.total
+        );
+    }
+    let set = &report.settings;
+    let _ = writeln!(
+        s,
+        "percentiles: Hyndman-Fan definition 1; intervals {:.0} % BCa (percentile method where BCa is undefined), Poisson bootstrap B = {}, seed {}; 1 rad = 206265 arcsec\n",
+        set.confidence * 100.0,
+        set.replicates,
+        set.bootstrap_seed
+    );
+    // One row per case.
+    let name_w = report
+        .cases
+        .iter()
+        .map(|c| c.name.chars().count())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    let head_emp = format!(
+        "θ_P{pct} rad (arcsec) [{:.0} % CI, arcsec]",
+        set.confidence * 100.0
+    );
+    let head_ray = format!("Rayleigh θ_P{pct} rad (arcsec) [CI]");
+    let _ = writeln!(
+        s,
+        "{:<name_w$}  {:>8}  {:>6}  {:<42}  {:<42}  {:<9}  Rayleigh law",
+        "case", "n", "failed", head_emp, head_ray, "σ_t"
+    );
+    for case in &report.cases {
+        let emp = case
+            .percentiles
+            .iter()
+            .find(|p| p.percentile.0 == pct)
+            .map(|p| match (p.value, p.bca.lower, p.bca.upper) {
+                (Some(v), Some(lo), Some(hi)) => Figure::new(v.0, lo.0, hi.0),
+                (Some(v), _, _) => match p.percentile_bootstrap.get() {
+                    Some((lo, hi)) => Figure::new(v.0, lo, hi),
+                    None => Figure::without_interval(v.0, "no interval"),
+                },
+                _ => Figure::null(p.reason.clone().unwrap_or_default()),
+            })
+            .unwrap_or_default();
+        let ray = case
+            .rayleigh
+            .percentiles
+            .iter()
+            .find(|p| p.percentile.0 == pct)
+            .map(|p| p.value.clone())
+            .unwrap_or_default();
+        let verdict = match (&case.gof.verdict, &case.gof.ks, &case.gof.ad) {
+            (Some(v), Some(ks), Some(ad)) => format!(
+                "{v} (KS p = {:.3}, AD p = {:.3})",
+                ks.p_value.0, ad.p_value.0
+            ),
+            _ => "not tested".to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "{:<name_w$}  {:>8}  {:>6}  {:<42}  {:<42}  {:<9}  {}",
+            case.name,
+            case.n,
+            case.failed.count,
+            angle(&emp),
+            angle(&ray),
+            case.rayleigh
+                .sigma_t
+                .get()
+                .map_or("-".into(), |v| format!("{v:.3e}")),
+            verdict
+        );
+    }
+    // What the rows cannot hold: the Rayleigh verdicts in words, loose joints, caveats.
+    let _ = writeln!(s);
+    for case in &report.cases {
+        let _ = writeln!(s, "{}: {}", case.name, case.gof.summary);
+        if case.loose_joints.recorded > 0 {
+            let _ = writeln!(
+                s,
+                "{}: loose joints in {} of {} samples ({})",
+                case.name,
+                case.loose_joints.with_loose,
+                case.loose_joints.recorded,
+                plain(&case.loose_joints.fraction, 2)
+            );
+        }
+        for c in &case.caveats {
+            let _ = writeln!(s, "{}: CAVEAT {c}", case.name);
+        }
+    }
+    for ser in &report.sweep.sigma_series {
+        let _ = writeln!(s, "\nσ-series [{}]: θ_P{pct} against σ", ser.name);
+        let _ = writeln!(s, "  {:>10}  θ_P{pct}", "σ [mm]");
+        for p in &ser.points {
+            let _ = writeln!(s, "  {:>10}  {}", short(p.x.0), angle_full(&p.value));
+        }
+        let fit = |name: &str, f: &crate::report::LineFit| {
+            format!(
+                "  {name}: slope {} rad/mm, intercept {} rad, R² {}",
+                plain(&f.slope, 4),
+                plain(&f.intercept, 3),
+                f.r_squared.get().map_or("-".into(), |r| format!("{r:.5}"))
+            )
+        };
+        let _ = writeln!(s, "{}", fit("line through origin", &ser.through_origin));
+        let _ = writeln!(s, "{}", fit("line with intercept", &ser.with_intercept));
+        let a = &ser.allowable_sigma;
+        let _ = writeln!(
+            s,
+            "  allowable σ for θ_P{} ≤ {:.3e} rad ({:.1}\"): {} mm (through origin), {} mm (with intercept){}",
+            a.percentile.0,
+            a.target_angle.0,
+            a.target_arcsec.0,
+            plain(&a.through_origin, 3),
+            plain(&a.with_intercept, 3),
+            if a.extrapolated {
+                "  [extrapolated beyond the σ range]"
+            } else {
+                ""
+            }
+        );
+        if let Some((lo, _)) = a.through_origin.interval() {
+            let _ = writeln!(
+                s,
+                "  conservative choice: σ ≤ {lo:.3e} mm (lower {:.0} % bound)",
+                set.confidence * 100.0
+            );
+        }
+    }
+    for ser in &report.sweep.stages_series {
+        let _ = writeln!(
+            s,
+            "\nstages-series [{}]: θ_P{pct} normalised to {} stage(s)",
+            ser.name, ser.reference_stages.0
+        );
+        for p in &ser.points {
+            let _ = writeln!(
+                s,
+                "  {:>6}  {}",
+                short(p.stages.0),
+                match (p.normalised.get(), p.normalised.interval()) {
+                    (Some(v), Some((lo, hi))) => format!("{v:.3} [{lo:.3}, {hi:.3}]"),
+                    (Some(v), None) => format!("{v:.3}"),
+                    _ => "-".into(),
+                }
+            );
+        }
+        if let Some(peak) = ser.peak_stages {
+            let _ = writeln!(s, "  peak at {} stages", peak.0);
+        }
+    }
+    s
+}

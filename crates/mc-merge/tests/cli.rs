@@ -1,0 +1,455 @@
+//! The `mc-merge` binary end to end: verification failures and their exit codes and messages,
+//! tolerated inputs (byte-identical duplicates, agreeing overlaps, `--allow-partial`,
+//! `--allow-failed`), degenerate cases, and the invariants of the report (split, file order,
+//! threads; no NaN).
+//!
+//! Source of the contract: the crate doc of `mc-merge` (exit codes, verification rules) and the
+//! crate doc of `shard-record` (file format). Shards are synthetic (see `common`), written with
+//! `shard_record`'s own types so that they verify by construction unless a test breaks them.
+
+mod common;
+
+use common::{SynthCase, SynthJob};
+use serde_json::Value;
+use shard_record::ShardRange;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const BIN: &str = env!("CARGO_BIN_EXE_mc-merge");
+
+/// A small job: a σ-series of two cases and a stages case, 600 samples each.
+fn job() -> SynthJob {
+    SynthJob::new(
+        7,
+        vec![
+            SynthCase::rayleigh("s1", 600, 2e-5, &[("sigma", 0.0033), ("stages", 5.0)]),
+            SynthCase::rayleigh("s2", 600, 4e-5, &[("sigma", 0.0066), ("stages", 5.0)]),
+            SynthCase::rayleigh("s3", 600, 3e-5, &[("sigma", 0.0066), ("stages", 2.0)]),
+        ],
+    )
+}
+
+struct Out {
+    code: i32,
+    stdout: String,
+    stderr: String,
+}
+
+fn mc_merge(args: &[&str], paths: &[PathBuf]) -> Out {
+    let mut cmd = Command::new(BIN);
+    cmd.args(paths)
+        .args(["--replicates", "200", "--gof-replicates", "99"]);
+    cmd.args(args);
+    let o = cmd.output().expect("run mc-merge");
+    Out {
+        code: o.status.code().expect("exit code"),
+        stdout: String::from_utf8_lossy(&o.stdout).into(),
+        stderr: String::from_utf8_lossy(&o.stderr).into(),
+    }
+}
+
+fn report(dir: &Path) -> String {
+    std::fs::read_to_string(dir.join("report.json")).expect("report.json")
+}
+
+/// Every number is finite (serde_json cannot even parse NaN), and every null has a reason
+/// beside it or in an enclosing object.
+fn check_nulls_have_reasons(v: &Value, path: &str, reason_in_scope: bool) {
+    match v {
+        Value::Object(m) => {
+            let here = reason_in_scope || m.get("reason").is_some_and(|r| r.is_string());
+            for (k, x) in m {
+                if x.is_null() {
+                    assert!(here, "null without a reason at {path}.{k}");
+                }
+                check_nulls_have_reasons(x, &format!("{path}.{k}"), here);
+            }
+        }
+        Value::Array(a) => {
+            for (i, x) in a.iter().enumerate() {
+                check_nulls_have_reasons(x, &format!("{path}[{i}]"), reason_in_scope);
+            }
+        }
+        Value::Number(n) => assert!(n.as_f64().is_some_and(f64::is_finite), "{path}"),
+        _ => {}
+    }
+}
+
+#[test]
+fn complete_job_reports_and_plots() {
+    let shards = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    job().write_split(shards.path(), 3);
+    let o = mc_merge(
+        &["--out", out.path().to_str().unwrap()],
+        &[shards.path().to_path_buf()],
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stdout.contains("1800 of 1800 samples (complete)"),
+        "{}",
+        o.stdout
+    );
+    assert!(o.stdout.contains("Rayleigh law"), "{}", o.stdout);
+    assert!(o.stdout.contains("allowable σ"), "{}", o.stdout);
+    let text = report(out.path());
+    let v: Value = serde_json::from_str(&text).unwrap();
+    check_nulls_have_reasons(&v, "", false);
+    assert_eq!(v["format"], "truss-mc-merge-report");
+    assert_eq!(v["coverage"]["complete"], true);
+    assert_eq!(v["cases"].as_array().unwrap().len(), 3);
+    assert_eq!(v["sweep"]["sigma_series"].as_array().unwrap().len(), 1);
+    assert_eq!(v["sweep"]["stages_series"].as_array().unwrap().len(), 1);
+    assert!(
+        v["definitions"]["percentile"]
+            .as_str()
+            .unwrap()
+            .contains("Hyndman")
+    );
+    for f in [
+        "theta_p-s1.svg",
+        "tan-s2.svg",
+        "sigma-sweep.svg",
+        "stages-sweep.svg",
+    ] {
+        let svg = std::fs::read_to_string(out.path().join(f)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("</svg>"), "{f}");
+    }
+}
+
+/// The report does not depend on how the job was split, on the order of the files, on the
+/// thread count, nor on duplicate copies or agreeing overlaps.
+#[test]
+fn report_is_byte_identical_for_any_split_order_and_threads() {
+    let j = job();
+    let run = |paths: &[PathBuf], extra: &[&str]| {
+        let out = tempfile::tempdir().unwrap();
+        let mut args = vec!["--no-plots", "--out", out.path().to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = mc_merge(&args, paths);
+        assert_eq!(o.code, 0, "{}", o.stderr);
+        report(out.path())
+    };
+    let one = tempfile::tempdir().unwrap();
+    let seven = tempfile::tempdir().unwrap();
+    let mixed = tempfile::tempdir().unwrap();
+    let single = j.write_split(one.path(), 1);
+    let mut split = j.write_split(seven.path(), 7);
+    let reference = run(&single, &[]);
+    assert_eq!(run(&split, &[]), reference, "7 shards");
+    split.reverse();
+    split.swap(1, 4);
+    assert_eq!(run(&split, &[]), reference, "shuffled order");
+    assert_eq!(run(&split, &["--threads", "1"]), reference, "1 thread");
+    assert_eq!(run(&split, &["--threads", "3"]), reference, "3 threads");
+    // Overlapping ranges of different splits, plus a byte-identical copy of one file.
+    let mut overlap = j.write_split(mixed.path(), 2);
+    let other = mixed.path().join("other");
+    std::fs::create_dir(&other).unwrap();
+    overlap.extend(j.write_split(&other, 5));
+    let copy = mixed.path().join("copy.jsonl");
+    std::fs::copy(&overlap[0], &copy).unwrap();
+    overlap.push(copy);
+    assert_eq!(run(&overlap, &[]), reference, "overlaps and duplicates");
+}
+
+#[test]
+fn missing_range_is_refused_naming_ranges_and_cases() {
+    let dir = tempfile::tempdir().unwrap();
+    let files = job().write_split(dir.path(), 6);
+    std::fs::remove_file(&files[2]).unwrap(); // 600..900: case s2
+    let o = mc_merge(&[], &[dir.path().to_path_buf()]);
+    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert!(o.stderr.contains("600..900 (case \"s2\""), "{}", o.stderr);
+    assert!(o.stderr.contains("1500 of 1800"), "{}", o.stderr);
+}
+
+#[test]
+fn allow_partial_marks_every_figure_with_coverage() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let files = job().write_split(dir.path(), 4); // 0..450 | 450..900 | 900..1350 | 1350..1800
+    std::fs::remove_file(&files[1]).unwrap();
+    let o = mc_merge(
+        &[
+            "--allow-partial",
+            "--no-plots",
+            "--out",
+            out.path().to_str().unwrap(),
+        ],
+        &[dir.path().to_path_buf()],
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(o.stdout.contains("PARTIAL"), "{}", o.stdout);
+    let v: Value = serde_json::from_str(&report(out.path())).unwrap();
+    check_nulls_have_reasons(&v, "", false);
+    assert_eq!(v["coverage"]["complete"], false);
+    assert_eq!(v["coverage"]["present"], 1350);
+    assert_eq!(v["coverage"]["expected"], 1800);
+    let s1 = &v["cases"][0];
+    assert_eq!(s1["present"], 450);
+    let partial = |x: &Value| {
+        x["caveats"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c.as_str().unwrap().contains("450 of 600"))
+    };
+    assert!(partial(s1));
+    assert!(s1["percentiles"].as_array().unwrap().iter().all(partial));
+    assert!(partial(&s1["rayleigh"]) && partial(&s1["gof"]));
+    // The complete case s3 carries no caveat.
+    assert!(v["cases"][2]["caveats"].as_array().unwrap().is_empty());
+    let series = &v["sweep"]["sigma_series"][0];
+    assert!(!series["caveats"].as_array().unwrap().is_empty());
+}
+
+#[test]
+fn disagreeing_overlap_names_both_files_and_first_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = job();
+    let a = SynthJob::write_bytes(
+        dir.path(),
+        "a.jsonl",
+        &j.shard_bytes(ShardRange::new(0, 1000)),
+    );
+    // A valid shard of 500..1800 whose samples 700 and 750 differ from a's.
+    let bytes = j.shard_bytes_with(ShardRange::new(500, 1800), |s| {
+        if s.index == 700 || s.index == 750 {
+            s.theta_p = Some(s.theta_p.unwrap() * 1.5);
+        }
+    });
+    let b = SynthJob::write_bytes(dir.path(), "b.jsonl", &bytes);
+    for order in [vec![a.clone(), b.clone()], vec![b.clone(), a.clone()]] {
+        let o = mc_merge(&[], &order);
+        assert_eq!(o.code, 3, "{}", o.stderr);
+        assert!(o.stderr.contains("sample 700"), "{}", o.stderr);
+        assert!(
+            o.stderr.contains("a.jsonl") && o.stderr.contains("b.jsonl"),
+            "{}",
+            o.stderr
+        );
+    }
+}
+
+#[test]
+fn same_range_with_different_bytes_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = job();
+    let range = ShardRange::new(0, 1800);
+    let a = SynthJob::write_bytes(dir.path(), "a.jsonl", &j.shard_bytes(range));
+    // Same samples, written with a different iteration count: not byte-identical.
+    let b = SynthJob::write_bytes(
+        dir.path(),
+        "b.jsonl",
+        &j.shard_bytes_with(range, |s| {
+            if s.index == 5 {
+                s.iterations += 1;
+            }
+        }),
+    );
+    let o = mc_merge(&[], &[a, b]);
+    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("a.jsonl") && o.stderr.contains("b.jsonl"),
+        "{}",
+        o.stderr
+    );
+}
+
+#[test]
+fn torn_line_is_refused_naming_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = job();
+    let bytes = j.shard_bytes(ShardRange::new(0, 1800));
+    // Keep the header and 10 sample lines, then half of the 11th: line 12 is torn.
+    let lines: Vec<&[u8]> = bytes.split_inclusive(|&b| b == b'\n').collect();
+    let mut torn = lines[..11].concat();
+    torn.extend_from_slice(&lines[11][..20]);
+    let p = SynthJob::write_bytes(dir.path(), "torn.jsonl", &torn);
+    let o = mc_merge(&[], &[p]);
+    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("torn.jsonl:12: torn line"),
+        "{}",
+        o.stderr
+    );
+}
+
+#[test]
+fn incomplete_and_corrupt_files_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = job();
+    let bytes = String::from_utf8(j.shard_bytes(ShardRange::new(0, 1800))).unwrap();
+    let lines: Vec<&str> = bytes.split_inclusive('\n').collect();
+    let inc = SynthJob::write_bytes(dir.path(), "inc.jsonl", lines[..50].concat().as_bytes());
+    let o = mc_merge(&[], &[inc]);
+    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert!(o.stderr.contains("inc.jsonl: incomplete"), "{}", o.stderr);
+
+    let mut bad = lines.clone();
+    bad[30] = "{\"record\":\"sample\",\"index\":29,\n";
+    let p = SynthJob::write_bytes(dir.path(), "bad.jsonl", bad.concat().as_bytes());
+    let o = mc_merge(&[], &[p]);
+    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert!(o.stderr.contains("bad.jsonl:31:"), "{}", o.stderr);
+}
+
+#[test]
+fn digest_mismatch_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = job();
+    let bytes = String::from_utf8(j.shard_bytes(ShardRange::new(0, 1800))).unwrap();
+    // Change one number of sample 3 (line 5) without updating the closing digest.
+    let mut lines: Vec<String> = bytes.split_inclusive('\n').map(String::from).collect();
+    lines[4] = lines[4].replacen("\"iterations\":", "\"iterations\":1", 1);
+    let p = SynthJob::write_bytes(dir.path(), "d.jsonl", lines.concat().as_bytes());
+    let o = mc_merge(&[], &[p]);
+    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("d.jsonl:1802:") && o.stderr.contains("sha256"),
+        "{}",
+        o.stderr
+    );
+}
+
+#[test]
+fn other_job_id_is_refused_naming_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let j = job();
+    let mut other = job();
+    other.job_id = "ab".repeat(32);
+    let a = SynthJob::write_bytes(
+        dir.path(),
+        "a.jsonl",
+        &j.shard_bytes(ShardRange::new(0, 900)),
+    );
+    let b = SynthJob::write_bytes(
+        dir.path(),
+        "b.jsonl",
+        &other.shard_bytes(ShardRange::new(900, 1800)),
+    );
+    let o = mc_merge(&[], &[a, b]);
+    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert!(o.stderr.contains("b.jsonl:1: job id abab"), "{}", o.stderr);
+    assert!(o.stderr.contains("a.jsonl"), "{}", o.stderr);
+}
+
+#[test]
+fn failed_samples_are_refused_by_default_and_counted_when_allowed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let mut j = job();
+    j.cases[1].fail_every = Some(100); // samples 99, 199, … of s2: global 699, 799, …
+    j.write_split(dir.path(), 3);
+    let o = mc_merge(&[], &[dir.path().to_path_buf()]);
+    assert_eq!(o.code, 4, "{}", o.stderr);
+    assert!(o.stderr.contains("6 failed samples"), "{}", o.stderr);
+    assert!(
+        o.stderr.contains("case \"s2\": 6 failed, indices 699, 799"),
+        "{}",
+        o.stderr
+    );
+    assert!(o.stderr.contains("Newton did not converge"), "{}", o.stderr);
+
+    let o = mc_merge(
+        &[
+            "--allow-failed",
+            "--no-plots",
+            "--out",
+            out.path().to_str().unwrap(),
+        ],
+        &[dir.path().to_path_buf()],
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let v: Value = serde_json::from_str(&report(out.path())).unwrap();
+    let s2 = &v["cases"][1];
+    assert_eq!(s2["failed"]["count"], 6);
+    assert_eq!(s2["n"], 594);
+    assert_eq!(s2["failed"]["ranges"][0], serde_json::json!([699, 700]));
+    assert_eq!(s2["failed"]["reasons"].as_array().unwrap().len(), 5);
+    let says = |x: &Value| {
+        x["caveats"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c.as_str().unwrap().contains("6 failed samples excluded"))
+    };
+    assert!(says(s2) && says(&s2["percentiles"][2]) && says(&s2["gof"]));
+    assert!(!says(&v["cases"][0]));
+    assert_eq!(v["failed"]["total"], 6);
+}
+
+/// 0 or 1 sample in a case, or all-equal values: a message or an explicit null with a reason,
+/// never a panic or a NaN.
+#[test]
+fn degenerate_cases_give_nulls_with_reasons() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let j = SynthJob::new(
+        3,
+        vec![
+            SynthCase::rayleigh("single", 1, 1e-5, &[("sigma", 0.01)]),
+            SynthCase::rayleigh("zero", 3, 1e-5, &[]),
+            SynthCase::rayleigh("empty", 0, 1e-5, &[]),
+            SynthCase::rayleigh("pair", 2, 1e-5, &[("sigma", 0.02)]),
+        ],
+    );
+    let range = ShardRange::new(0, j.samples());
+    // The "zero" case has every angle exactly zero (a perfect truss).
+    let bytes = j.shard_bytes_with(range, |s| {
+        if s.case == "zero" {
+            s.theta_p = Some(0.0);
+            s.tan_theta_x = Some(0.0);
+            s.tan_theta_y = Some(0.0);
+        }
+    });
+    let p = SynthJob::write_bytes(dir.path(), "d.jsonl", &bytes);
+    let o = mc_merge(&["--out", out.path().to_str().unwrap()], &[p]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let v: Value = serde_json::from_str(&report(out.path())).unwrap();
+    check_nulls_have_reasons(&v, "", false);
+    let single = &v["cases"][0];
+    assert!(
+        single["percentiles"][0]["bca"]["reason"]
+            .as_str()
+            .unwrap()
+            .contains("n = 1")
+    );
+    assert!(single["gof"]["reason"].is_string());
+    let zero = &v["cases"][1];
+    assert!(zero["gof"]["reason"].as_str().unwrap().contains("zero"));
+    let empty = &v["cases"][2];
+    assert_eq!(empty["n"], 0);
+    assert!(empty["percentiles"][0]["value"].is_null());
+}
+
+#[test]
+fn usage_and_io_errors_have_their_codes() {
+    let o = mc_merge(&["--percentiles", "0,95"], &[PathBuf::from(".")]);
+    assert_eq!(o.code, 2, "{}", o.stderr);
+    let o = mc_merge(&["--no-such-flag"], &[PathBuf::from(".")]);
+    assert_eq!(o.code, 2, "{}", o.stderr);
+    let o = mc_merge(&[], &[PathBuf::from("/nonexistent/shards")]);
+    assert_eq!(o.code, 5, "{}", o.stderr);
+    let empty = tempfile::tempdir().unwrap();
+    let o = mc_merge(&[], &[empty.path().to_path_buf()]);
+    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert!(o.stderr.contains("no shard files"), "{}", o.stderr);
+}
+
+#[test]
+fn help_documents_exit_codes() {
+    let o = Command::new(BIN).arg("--help").output().unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let text = String::from_utf8_lossy(&o.stdout);
+    for code in [
+        "0  ",
+        "2  usage",
+        "3  verification",
+        "4  failed samples",
+        "5  I/O",
+    ] {
+        assert!(text.contains(code), "{code}: {text}");
+    }
+}
