@@ -9,8 +9,8 @@
 //!    naming the file and line.
 //! 2. All files carry the job id of the first file read, and the same cases.
 //! 3. Each global index `0..job_samples` is held at least once. Where shards overlap, every
-//!    overlapping sample must be identical, compared by a 64-bit fingerprint of all the fields of
-//!    its line (numbers by their bits, so a different float is a different sample); the first
+//!    overlapping sample must be identical, compared by a 64-bit fingerprint of the bytes of
+//!    its line (so a different number, to the last bit, is a different sample); the first
 //!    disagreeing index and both files are named. Two files of the same range must have the same
 //!    closing digest, that is byte-identical sample lines.
 //! 4. A missing index range is an error naming the ranges and their cases, unless partial
@@ -33,7 +33,7 @@
 
 use crate::errors::{FailedCase, MergeError, MissingRange};
 use crate::rng::mix64;
-use shard_record::{Begin, CaseInfo, Sample, ScanError, ShardRange, Status, read_shard};
+use shard_record::{Begin, CaseInfo, Sample, ScanError, ShardRange, read_shard};
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
@@ -284,48 +284,21 @@ impl Fold {
         self.0 = mix64(self.0 ^ w);
     }
 
-    fn text(&mut self, s: &str) {
+    fn bytes(&mut self, s: &[u8]) {
         self.word(s.len() as u64);
-        for chunk in s.as_bytes().chunks(8) {
+        for chunk in s.chunks(8) {
             let mut b = [0u8; 8];
             b[..chunk.len()].copy_from_slice(chunk);
             self.word(u64::from_le_bytes(b));
         }
     }
-
-    fn option(&mut self, w: Option<u64>) {
-        match w {
-            Some(v) => {
-                self.word(1);
-                self.word(v);
-            }
-            None => self.word(0),
-        }
-    }
 }
 
-/// A 64-bit fingerprint of every field of a sample line (floats by their bits), to compare
-/// overlapping copies of a sample without keeping the line.
-pub fn fingerprint(s: &Sample) -> u64 {
+/// A 64-bit fingerprint of a sample line's exact bytes, to compare overlapping copies of the
+/// same index: two copies agree only if their lines are identical, byte for byte.
+pub fn fingerprint(line: &[u8]) -> u64 {
     let mut h = Fold(0x243f_6a88_85a3_08d3);
-    h.word(s.index);
-    h.word(s.sample);
-    h.word(u64::from(s.status == Status::Converged));
-    h.word(u64::from(s.iterations));
-    h.option(s.theta_p.map(f64::to_bits));
-    h.option(s.tan_theta_x.map(f64::to_bits));
-    h.option(s.tan_theta_y.map(f64::to_bits));
-    h.option(s.residual.map(f64::to_bits));
-    h.option(s.slack_cables.map(u64::from));
-    h.option(s.loose_joints.map(u64::from));
-    h.text(&s.case);
-    match &s.reason {
-        Some(r) => {
-            h.word(1);
-            h.text(r);
-        }
-        None => h.word(0),
-    }
+    h.bytes(line);
     h.0
 }
 
@@ -395,12 +368,12 @@ struct Rec {
 }
 
 impl Rec {
-    fn new(line: u64, s: &Sample) -> Self {
+    fn new(line: u64, s: &Sample, bytes: &[u8]) -> Self {
         let a = s.angles();
         Rec {
             index: s.index,
             line,
-            fingerprint: fingerprint(s),
+            fingerprint: fingerprint(bytes),
             theta: a.map_or(0.0, |a| a.theta_p),
             tan_x: a.map_or(0.0, |a| a.tan_theta_x),
             tan_y: a.map_or(0.0, |a| a.tan_theta_y),
@@ -509,12 +482,12 @@ fn read_one(
     use std::sync::atomic::Ordering;
     let mut batch = Vec::with_capacity(BATCH);
     let mut stopped = false;
-    let result = read_shard(path, |line, sample| {
+    let result = read_shard(path, |line, sample, bytes| {
         if abort.load(Ordering::Relaxed) {
             stopped = true;
             return Err("stopped: another file failed".into());
         }
-        batch.push(Rec::new(line, sample));
+        batch.push(Rec::new(line, sample, bytes));
         if batch.len() == BATCH {
             let recs = std::mem::replace(&mut batch, Vec::with_capacity(BATCH));
             if tx.send(Msg::Batch { file, recs }).is_err() {
@@ -568,7 +541,7 @@ pub fn load(files: &[PathBuf], options: LoadOptions) -> Result<Dataset, MergeErr
     for path in files {
         let Some(begin) = peek_header(path)? else {
             // Let the strict reader name what is wrong with the header.
-            read_shard(path, |_, _| Ok(()))?;
+            read_shard(path, |_, _, _| Ok(()))?;
             return Err(MergeError::Shard(ScanError::Corrupt {
                 path: path.clone(),
                 line: 1,

@@ -98,14 +98,14 @@ impl ShardScan {
 }
 
 /// Scans the shard file at `path`, checking every complete line, and calls `visit` with each
-/// valid sample and its line number. `visit` may refuse a sample with a message, which
-/// becomes a [`ScanError::Corrupt`] at that line.
+/// valid sample, its line number and the line's bytes (with its `\n`). `visit` may refuse a
+/// sample with a message, which becomes a [`ScanError::Corrupt`] at that line.
 ///
 /// A torn last line or a missing end line is reported in [`ShardScan::tail`], not as an
 /// error; everything else that breaks the format is an error.
 pub fn scan_shard(
     path: &Path,
-    mut visit: impl FnMut(u64, &Sample) -> Result<(), String>,
+    mut visit: impl FnMut(u64, &Sample, &[u8]) -> Result<(), String>,
 ) -> Result<ShardScan, ScanError> {
     let io_err = |source| ScanError::Io {
         path: path.to_path_buf(),
@@ -196,7 +196,7 @@ pub fn scan_shard(
                     }
                 }
                 sample.check().map_err(|m| corrupt(line_no, m))?;
-                visit(line_no, &sample).map_err(|m| corrupt(line_no, m))?;
+                visit(line_no, &sample, &buf).map_err(|m| corrupt(line_no, m))?;
                 digest.add_line(&buf, sample.angles().is_none());
                 valid_len += n as u64;
             }
@@ -246,7 +246,7 @@ pub fn scan_shard(
 /// Reads a shard strictly: like [`scan_shard`], but a torn or incomplete file is an error.
 pub fn read_shard(
     path: &Path,
-    visit: impl FnMut(u64, &Sample) -> Result<(), String>,
+    visit: impl FnMut(u64, &Sample, &[u8]) -> Result<(), String>,
 ) -> Result<ShardScan, ScanError> {
     let scan = scan_shard(path, visit)?;
     match scan.tail {

@@ -95,7 +95,7 @@ fn complete_shard_scans_and_reads() {
     let bytes = shard_bytes(range);
     let f = write_temp(&bytes);
     let mut seen = vec![];
-    let scan = read_shard(f.path(), |_, s| {
+    let scan = read_shard(f.path(), |_, s, _| {
         seen.push(s.index);
         Ok(())
     })
@@ -114,11 +114,11 @@ fn torn_last_line_is_reported_with_valid_prefix() {
     let prefix = torn.len() as u64;
     torn.extend_from_slice(&lines[3][..lines[3].len() / 2]);
     let f = write_temp(&torn);
-    let scan = scan_shard(f.path(), |_, _| Ok(())).unwrap();
+    let scan = scan_shard(f.path(), |_, _, _| Ok(())).unwrap();
     assert_eq!(scan.tail, Tail::Torn { line: 4 });
     assert_eq!(scan.valid_len, prefix);
     assert_eq!(scan.next_index(), 2);
-    let err = read_shard(f.path(), |_, _| Ok(())).unwrap_err();
+    let err = read_shard(f.path(), |_, _, _| Ok(())).unwrap_err();
     assert!(matches!(err, ScanError::Torn { line: 4, .. }), "{err}");
 }
 
@@ -131,9 +131,9 @@ fn missing_end_line_is_incomplete() {
         .unwrap()
         + 1;
     let f = write_temp(&bytes[..cut]);
-    let scan = scan_shard(f.path(), |_, _| Ok(())).unwrap();
+    let scan = scan_shard(f.path(), |_, _, _| Ok(())).unwrap();
     assert_eq!(scan.tail, Tail::Open);
-    let err = read_shard(f.path(), |_, _| Ok(())).unwrap_err();
+    let err = read_shard(f.path(), |_, _, _| Ok(())).unwrap_err();
     assert!(err.to_string().contains("3 of the range's 3"), "{err}");
 }
 
@@ -142,7 +142,7 @@ fn changed_number_breaks_the_digest() {
     let bytes = String::from_utf8(shard_bytes(ShardRange::new(0, 3))).unwrap();
     let tampered = bytes.replacen("\"iterations\":3", "\"iterations\":4", 1);
     let f = write_temp(tampered.as_bytes());
-    let err = read_shard(f.path(), |_, _| Ok(())).unwrap_err();
+    let err = read_shard(f.path(), |_, _, _| Ok(())).unwrap_err();
     assert!(
         matches!(err, ScanError::Corrupt { line: 5, .. }) && err.to_string().contains("sha256"),
         "{err}"
@@ -155,13 +155,13 @@ fn out_of_order_and_corrupt_lines_name_their_line() {
     let mut lines: Vec<&str> = bytes.split_inclusive('\n').collect();
     lines.swap(1, 2);
     let f = write_temp(lines.concat().as_bytes());
-    let err = read_shard(f.path(), |_, _| Ok(())).unwrap_err();
+    let err = read_shard(f.path(), |_, _, _| Ok(())).unwrap_err();
     assert!(matches!(err, ScanError::Corrupt { line: 2, .. }), "{err}");
 
     let mut lines: Vec<&str> = bytes.split_inclusive('\n').collect();
     lines[2] = "{\"record\":\"sample\",\"index\":\n";
     let f = write_temp(lines.concat().as_bytes());
-    let err = read_shard(f.path(), |_, _| Ok(())).unwrap_err();
+    let err = read_shard(f.path(), |_, _, _| Ok(())).unwrap_err();
     assert!(matches!(err, ScanError::Corrupt { line: 3, .. }), "{err}");
 }
 
