@@ -1,1 +1,55 @@
-//! Reproducible seeded shards of a truss Monte Carlo job, written as JSON Lines.
+//! # mc-shard: reproducible seeded shards of a truss Monte Carlo job
+//!
+//! Turns a job file (a model, a seed, and cases of length-error distributions; see
+//! [`job`]) into samples, solves each with [`truss_core`], and writes the results as a shard
+//! file in the JSON Lines format of [`shard_record`]. A 50,000-sample job can be split over
+//! any number of processes, machines, Slurm array tasks or cron runs and still give exactly
+//! the same numbers.
+//!
+//! ## Determinism
+//!
+//! The global sample index runs over the cases in order; a shard is a contiguous range of
+//! it. Sample `k` of a case draws its length errors from a ChaCha20 stream keyed by (job
+//! seed, case name, `k`) in a documented order ([`sampler`]), turns words into numbers with
+//! the pure-Rust `libm` ([`distribution`]), and is solved by a solver whose arithmetic is in
+//! a fixed order. So a sample's line depends only on the job and its index: not on the
+//! shard split, the thread count, the order of cases in a run, or the machine. Numbers are
+//! written in shortest round-trip form. Tests check it byte for byte.
+//!
+//! ## Commands (see `mc-shard --help`)
+//!
+//! - `mc-shard plan JOB.json` — job id, cases, sample count, a suggested split.
+//! - `mc-shard run --job JOB.json --out DIR [--shard I/K | --range A..B] [--threads T]` —
+//!   one shard (selection in [`select`]); crash-safe and resumable ([`shard`]).
+//! - `mc-shard reproduce --job JOB.json --case NAME --sample K [--detail]` — the exact line
+//!   of one sample, or its draws, iterations, displacements and forces ([`reproduce`]).
+//! - `mc-shard status --job JOB.json --out DIR --shards K [--missing]` — which shards are
+//!   complete ([`status`]).
+//!
+//! ## Exit codes
+//!
+//! | code | meaning |
+//! |---|---|
+//! | 0 | success |
+//! | 1 | internal error (a bug) |
+//! | 2 | usage error, or a range outside the job |
+//! | 3 | invalid job (the message gives the JSON path of the fault) |
+//! | 4 | a file could not be read or written |
+//! | 5 | the shard file is in the way: another job's, locked by another process, or damaged |
+
+pub mod cli;
+pub mod distribution;
+pub mod errors;
+pub mod job;
+pub mod progress;
+pub mod reproduce;
+pub mod runner;
+pub mod sampler;
+pub mod select;
+pub mod shard;
+pub mod status;
+pub mod worker;
+
+pub use errors::{JobError, RunError, ShardError};
+pub use job::Job;
+pub use runner::{RunOptions, RunSummary, run_shard};

@@ -1,0 +1,345 @@
+//! The `mc-shard` command line: arguments, dispatch, and the exit code of each failure.
+
+use crate::errors::{JobError, RunError, ShardError};
+use crate::job::Job;
+use crate::runner::{RunOptions, run_shard};
+use crate::select::select;
+use crate::status::{ShardState, shard_states};
+use clap::{Args, Parser, Subcommand};
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Exit codes of `mc-shard` (also in `--help`).
+pub mod exit {
+    /// Success.
+    pub const OK: u8 = 0;
+    /// An internal error (a bug).
+    pub const INTERNAL: u8 = 1;
+    /// Bad arguments, or a range outside the job.
+    pub const USAGE: u8 = 2;
+    /// The job file is invalid (the message gives the JSON path).
+    pub const BAD_JOB: u8 = 3;
+    /// A file or directory could not be read or written.
+    pub const IO: u8 = 4;
+    /// The shard file is in the way: another job's, locked by another process, or damaged.
+    pub const SHARD_CONFLICT: u8 = 5;
+}
+
+/// Runs seeded Monte Carlo shards of a truss job and writes them as JSON Lines. Units: mm,
+/// N, rad.
+#[derive(Debug, Parser)]
+#[command(
+    name = "mc-shard",
+    version,
+    about,
+    after_help = "Exit codes: 0 success, 1 internal error, 2 usage error, 3 invalid job, 4 I/O error, 5 shard file in the way (another job's, locked, or damaged)."
+)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Validate a job and print its id, cases, sample count and a suggested split.
+    Plan(PlanArgs),
+    /// Run one shard (from --range, --shard, or the Slurm/Kubernetes environment).
+    Run(RunArgs),
+    /// Print the exact line a shard holds for one sample (with --detail, its draws,
+    /// iterations, displacements and forces).
+    Reproduce(ReproduceArgs),
+    /// Show which of K shards in a directory are complete, partial or missing.
+    Status(StatusArgs),
+}
+
+/// `mc-shard plan`.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// The job file.
+    pub job: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `mc-shard run`.
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// Directory for the shard file.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Run shard I of K (0-based).
+    #[arg(long, value_name = "I/K", conflicts_with = "range")]
+    pub shard: Option<String>,
+    /// Run the global sample indices A..B.
+    #[arg(long, value_name = "A..B")]
+    pub range: Option<String>,
+    /// Number of shards, for JOB_COMPLETION_INDEX (default: $MC_SHARD_COUNT).
+    #[arg(long)]
+    pub shards: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Show no progress.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// `mc-shard reproduce`.
+#[derive(Debug, Args)]
+pub struct ReproduceArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// The case's name.
+    #[arg(long)]
+    pub case: String,
+    /// The sample's index within the case.
+    #[arg(long)]
+    pub sample: u64,
+    /// Print the draws, Newton iterations, displacements and forces as JSON.
+    #[arg(long)]
+    pub detail: bool,
+}
+
+/// `mc-shard status`.
+#[derive(Debug, Args)]
+pub struct StatusArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// The shard directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The number of shards the job was split into.
+    #[arg(long)]
+    pub shards: u64,
+    /// Print only the 0-based indices of the shards not complete, comma-separated (a Slurm
+    /// --array list; an empty line when none).
+    #[arg(long)]
+    pub missing: bool,
+}
+
+/// An error of a command, with its exit code.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// From the run machinery.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// Writing output failed.
+    #[error("cannot write output: {0}")]
+    Output(#[from] std::io::Error),
+}
+
+impl From<JobError> for CliError {
+    fn from(e: JobError) -> Self {
+        CliError::Run(RunError::Job(e))
+    }
+}
+
+impl CliError {
+    /// The exit code (see [`exit`]).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Run(RunError::Usage(_)) => exit::USAGE,
+            CliError::Run(RunError::Job(JobError::Io { .. })) => exit::IO,
+            CliError::Run(RunError::Job(JobError::InFile { source, .. }))
+                if matches!(**source, JobError::Io { .. }) =>
+            {
+                exit::IO
+            }
+            CliError::Run(RunError::Job(_)) => exit::BAD_JOB,
+            CliError::Run(RunError::Shard(ShardError::Io { .. })) => exit::IO,
+            CliError::Run(RunError::Shard(_)) => exit::SHARD_CONFLICT,
+            CliError::Output(_) => exit::IO,
+        }
+    }
+}
+
+/// Runs a command, writing its report to `out`; progress goes to stderr.
+pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
+    match cli.command {
+        Command::Plan(a) => plan(&a, out),
+        Command::Run(a) => {
+            let job = Job::read(&a.job)?;
+            let (range, source) = select(
+                a.range.as_deref(),
+                a.shard.as_deref(),
+                a.shards,
+                job.samples(),
+                |k| std::env::var(k).ok(),
+            )?;
+            let threads = a
+                .threads
+                .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+            if threads == 0 {
+                return Err(RunError::Usage("--threads must be at least 1".into()).into());
+            }
+            let summary = run_shard(
+                &job,
+                &a.out,
+                range,
+                &RunOptions {
+                    threads,
+                    quiet: a.quiet,
+                },
+            )?;
+            if summary.already_complete {
+                writeln!(
+                    out,
+                    "{}: already complete and verified ({} samples, {} failed)",
+                    summary.path.display(),
+                    summary.resumed,
+                    summary.failed
+                )?;
+            } else {
+                writeln!(
+                    out,
+                    "{}: {} samples ({} computed now{}, {} failed) in {:.2} s, {:.0} samples/s [range from {:?}]",
+                    summary.path.display(),
+                    range.len(),
+                    summary.computed,
+                    if summary.resumed > 0 {
+                        format!(", {} kept from before", summary.resumed)
+                    } else {
+                        String::new()
+                    },
+                    summary.failed,
+                    summary.seconds,
+                    summary.computed as f64 / summary.seconds.max(1e-9),
+                    source
+                )?;
+            }
+            Ok(())
+        }
+        Command::Reproduce(a) => {
+            let job = Job::read(&a.job)?;
+            let c = job.case_named(&a.case).ok_or_else(|| {
+                RunError::Usage(format!(
+                    "no case {:?} (cases: {})",
+                    a.case,
+                    job.cases
+                        .iter()
+                        .map(|c| c.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })?;
+            if a.sample >= job.cases[c].samples {
+                return Err(RunError::Usage(format!(
+                    "case {:?} has samples 0..{}, not {}",
+                    a.case, job.cases[c].samples, a.sample
+                ))
+                .into());
+            }
+            out.write_all(crate::reproduce::reproduce(&job, c, a.sample, a.detail).as_bytes())?;
+            Ok(())
+        }
+        Command::Status(a) => {
+            let job = Job::read(&a.job)?;
+            let states = shard_states(&job, &a.out, a.shards).map_err(RunError::Usage)?;
+            if a.missing {
+                let missing: Vec<String> = states
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, (_, s))| *s != ShardState::Complete)
+                    .map(|(i, _)| i.to_string())
+                    .collect();
+                writeln!(out, "{}", missing.join(","))?;
+            } else {
+                for (i, (r, s)) in states.iter().enumerate() {
+                    let what = match s {
+                        ShardState::Complete => "complete".to_string(),
+                        ShardState::Partial(n) => format!("partial ({n} of {} samples)", r.len()),
+                        ShardState::Missing => "missing".to_string(),
+                        ShardState::Bad(why) => format!("bad: {why}"),
+                    };
+                    writeln!(out, "shard {i}/{} {r}: {what}", a.shards)?;
+                }
+            }
+            Ok(())
+        }
+    }
+}
+
+/// `mc-shard plan`: the job's id and cases, and a split suggested from a short timing.
+fn plan(a: &PlanArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let job = Job::read(&a.job)?;
+    // Time a few samples of each case (at most 50, at most about half a second in all).
+    let mut cpu_seconds = 0.0;
+    let mut per_case = Vec::new();
+    let mut worker = crate::worker::Worker::new(&job);
+    for c in &job.cases {
+        let n = c.samples.min(50);
+        let t = Instant::now();
+        let mut done = 0;
+        for k in 0..n {
+            worker.sample(c.start + k);
+            done += 1;
+            if t.elapsed().as_secs_f64() > 0.5 / job.cases.len() as f64 {
+                break;
+            }
+        }
+        let each = t.elapsed().as_secs_f64() / done as f64;
+        cpu_seconds += each * c.samples as f64;
+        per_case.push(each);
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+    // About five minutes of one core per cluster task.
+    let cluster_shards = ((cpu_seconds / 300.0).ceil() as u64).clamp(1, job.samples());
+    if a.json {
+        let value = serde_json::json!({
+            "job_id": job.id,
+            "samples": job.samples(),
+            "cases": job.cases.iter().zip(&per_case).map(|(c, t)| serde_json::json!({
+                "name": c.name, "start": c.start, "samples": c.samples,
+                "parameters": c.parameters, "seconds_per_sample": t,
+            })).collect::<Vec<_>>(),
+            "estimated_cpu_seconds": cpu_seconds,
+            "suggested": {"local_threads": cores, "cluster_shards": cluster_shards},
+        });
+        writeln!(
+            out,
+            "{}",
+            serde_json::to_string_pretty(&value).expect("serialises")
+        )?;
+        return Ok(());
+    }
+    writeln!(out, "job id   {}", job.id)?;
+    writeln!(
+        out,
+        "samples  {} in {} case(s)",
+        job.samples(),
+        job.cases.len()
+    )?;
+    for (c, t) in job.cases.iter().zip(&per_case) {
+        let params: Vec<String> = c
+            .parameters
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
+        writeln!(
+            out,
+            "  {:<24} {:>9} samples  indices {}..{}  ~{:.0} µs/sample  {}",
+            c.name,
+            c.samples,
+            c.start,
+            c.start + c.samples,
+            t * 1e6,
+            params.join(" ")
+        )?;
+    }
+    writeln!(out, "estimated {cpu_seconds:.1} CPU-seconds")?;
+    writeln!(
+        out,
+        "suggested: this machine, one shard on {cores} threads (mc-shard run --job {} --out DIR); a cluster, {cluster_shards} shards of about 5 CPU-minutes each (--shard I/{cluster_shards})",
+        a.job.display()
+    )?;
+    Ok(())
+}

@@ -1,0 +1,148 @@
+//! Running a shard: samples computed on T threads, written in index order to the shard file.
+//!
+//! Workers take chunks of consecutive indices from a shared counter and send each finished
+//! line to the writer (this thread), which keeps a small reordering buffer and appends every
+//! run of lines that is complete and next in order. Memory stays flat in the sample count:
+//! the buffer holds at most the lines in flight. Each sample's line depends only on the job
+//! and its index, so the file is the same bytes for any thread count.
+
+use crate::errors::RunError;
+use crate::job::Job;
+use crate::progress::Progress;
+use crate::shard::{Opened, ShardWriter, begin};
+use crate::worker::Worker;
+use shard_record::{ShardRange, Status};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::mpsc::sync_channel;
+use std::time::Instant;
+
+/// Indices a worker takes at a time.
+const CHUNK: u64 = 16;
+
+/// How a shard run ended.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunSummary {
+    /// The shard file.
+    pub path: PathBuf,
+    /// Its range.
+    pub range: ShardRange,
+    /// Whether it was already complete (nothing computed).
+    pub already_complete: bool,
+    /// Samples kept from an interrupted run.
+    pub resumed: u64,
+    /// Samples computed now.
+    pub computed: u64,
+    /// Failed samples in the whole shard.
+    pub failed: u64,
+    /// Wall time of this run [s].
+    pub seconds: f64,
+}
+
+/// Options of a shard run.
+#[derive(Debug, Clone)]
+pub struct RunOptions {
+    /// Worker threads (at least 1).
+    pub threads: usize,
+    /// Show no progress.
+    pub quiet: bool,
+}
+
+/// Runs (or resumes, or verifies as complete) the shard `range` of `job` in `dir`.
+pub fn run_shard(
+    job: &Job,
+    dir: &Path,
+    range: ShardRange,
+    options: &RunOptions,
+) -> Result<RunSummary, RunError> {
+    let range = range
+        .within(job.samples())
+        .map_err(|e| RunError::Usage(e.to_string()))?;
+    let started = Instant::now();
+    let mut writer = match ShardWriter::open(dir, &begin(job, range))? {
+        Opened::Complete { path, scan } => {
+            return Ok(RunSummary {
+                path,
+                range,
+                already_complete: true,
+                resumed: scan.digest.samples(),
+                computed: 0,
+                failed: scan.digest.end().failed,
+                seconds: started.elapsed().as_secs_f64(),
+            });
+        }
+        Opened::Writer(w) => w,
+    };
+    let resumed = writer.resumed();
+    let first = writer.next_index();
+    let mut progress = Progress::new(
+        &format!("shard {range}"),
+        range.len(),
+        first - range.start,
+        options.quiet,
+    );
+    let threads = options.threads.max(1);
+    let next = AtomicU64::new(first);
+    let stop = AtomicBool::new(false);
+    let (tx, rx) = sync_channel::<(u64, String, bool)>(4096);
+    let result = std::thread::scope(|scope| {
+        for _ in 0..threads {
+            let tx = tx.clone();
+            let (next, stop) = (&next, &stop);
+            scope.spawn(move || {
+                let mut worker = Worker::new(job);
+                loop {
+                    let start = next.fetch_add(CHUNK, Ordering::Relaxed);
+                    if start >= range.end || stop.load(Ordering::Relaxed) {
+                        break;
+                    }
+                    for index in start..(start + CHUNK).min(range.end) {
+                        let sample = worker.sample(index);
+                        let failed = sample.status == Status::Failed;
+                        if tx.send((index, sample.to_line(), failed)).is_err() {
+                            return;
+                        }
+                    }
+                }
+            });
+        }
+        drop(tx);
+        // The writer: append runs of lines in index order as they complete.
+        let mut pending: BTreeMap<u64, (String, bool)> = BTreeMap::new();
+        let mut expect = first;
+        let mut bytes = Vec::with_capacity(1 << 16);
+        let mut lines = Vec::with_capacity(256);
+        for (index, line, failed) in rx {
+            pending.insert(index, (line, failed));
+            bytes.clear();
+            lines.clear();
+            while let Some((line, failed)) = pending.remove(&expect) {
+                bytes.extend_from_slice(line.as_bytes());
+                lines.push((line.len(), failed));
+                expect += 1;
+            }
+            if !lines.is_empty() {
+                if let Err(e) = writer.append(&bytes, &lines) {
+                    stop.store(true, Ordering::Relaxed);
+                    return Err(e);
+                }
+                progress.advance(lines.len() as u64);
+            }
+        }
+        Ok(())
+    });
+    progress.finish();
+    result?;
+    let path = writer.path().to_path_buf();
+    let end = writer.finish()?;
+    Ok(RunSummary {
+        path,
+        range,
+        already_complete: false,
+        resumed,
+        computed: range.end - first,
+        failed: end.failed,
+        seconds: started.elapsed().as_secs_f64(),
+    })
+}
