@@ -25,6 +25,7 @@
 //! | `cases[].samples` | ≥ 1 |
 //! | `cases[].model` | optional: this case's own model, same forms as `model` |
 //! | `cases[].length_errors` | per member group, a distribution of the length error (natural length minus nominal, mm): `{"normal": {"sigma": s}}` (optional `"mean"`), `{"uniform": {"low": a, "high": b}}`, `{"constant": {"value": v}}`. Groups not named get none. |
+//! | `cases[].effects` | optional deterministic effects: `gravity` (self-weight) and `thermal_gradient` (a linear temperature field); see [`crate::effects`] |
 //!
 //! Unknown fields are refused. Every fault is reported with its JSON path
 //! (`cases[2].length_errors.longron: the model has no group "longron" …`).
@@ -39,6 +40,7 @@
 //! to mix ids.
 
 use crate::distribution::DistributionSpec;
+use crate::effects::{Applied, EffectsSpec};
 use crate::errors::JobError;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -79,6 +81,9 @@ pub struct CaseSpec {
     /// Length-error distribution per member group [mm].
     #[serde(default)]
     pub length_errors: BTreeMap<String, DistributionSpec>,
+    /// Deterministic effects: self-weight, a temperature field (see [`crate::effects`]).
+    #[serde(default)]
+    pub effects: EffectsSpec,
 }
 
 /// The prism generator's options as a job writes them; absent fields take Table 1's values.
@@ -154,6 +159,10 @@ pub struct Case {
     pub member_errors: Vec<Option<DistributionSpec>>,
     /// Named numbers describing the case, for sweeps (`sigma`, `stages`, …).
     pub parameters: BTreeMap<String, f64>,
+    /// The effects as given.
+    pub effects: EffectsSpec,
+    /// What the effects do: extra loads per node, extra length errors per member.
+    pub applied: Applied,
 }
 
 /// A validated job (see the module doc).
@@ -236,6 +245,10 @@ impl Job {
                 }
                 dist.check().map_err(|m| JobError::at(&path, &m))?;
             }
+            c.effects
+                .check()
+                .map_err(|(field, m)| JobError::at(&at(&format!("effects.{field}")), &m))?;
+            let applied = c.effects.apply(&model);
             let member_errors = model
                 .members()
                 .iter()
@@ -266,6 +279,8 @@ impl Job {
                 length_errors: c.length_errors.clone(),
                 member_errors,
                 parameters,
+                effects: c.effects.clone(),
+                applied,
             });
             start = start.checked_add(c.samples).ok_or_else(|| {
                 JobError::at(&at("samples"), "the job has more than 2^64 samples")
@@ -390,6 +405,7 @@ struct CanonicalCase<'a> {
     name: &'a str,
     samples: u64,
     length_errors: &'a BTreeMap<String, DistributionSpec>,
+    effects: &'a EffectsSpec,
     model: ModelFile,
 }
 
@@ -406,6 +422,7 @@ fn job_id(seed: u64, cases: &[Case]) -> String {
                 name: &c.name,
                 samples: c.samples,
                 length_errors: &c.length_errors,
+                effects: &c.effects,
                 model: c.model.to_file(),
             })
             .collect(),

@@ -39,6 +39,7 @@
 
 pub mod cli;
 pub mod distribution;
+pub mod effects;
 pub mod errors;
 pub mod job;
 pub mod progress;

@@ -46,12 +46,15 @@ impl<'j> Worker<'j> {
         let (c, k) = self.job.case_of(index).expect("index within the job");
         let case = &self.job.cases[c];
         draw_length_errors(&self.keys[c], case, k, &mut self.errors);
+        for (e, t) in self.errors.iter_mut().zip(&case.applied.length_changes) {
+            *e += t;
+        }
         let options = &self.options;
         let solver = self.solvers[c]
             .get_or_insert_with(|| Solver::with_structure(case.structure.clone(), options.clone()));
         let result = solver.solve_perturbed(Perturbation {
             length_errors: &self.errors,
-            extra_loads: &[],
+            extra_loads: &case.applied.loads,
         });
         let base = Sample {
             index,
@@ -105,7 +108,8 @@ impl<'j> Worker<'j> {
         }
     }
 
-    /// The length errors drawn for the last sample [mm], model order.
+    /// The length errors of the last sample [mm], model order: the drawn ones plus any
+    /// thermal length change.
     pub fn last_errors(&self) -> &[f64] {
         &self.errors
     }
