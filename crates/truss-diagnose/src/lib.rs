@@ -1,0 +1,1 @@
+//! Diagnosis of measured trusses against simulation (under construction).
