@@ -53,6 +53,60 @@ pub enum Command {
     Reproduce(ReproduceArgs),
     /// Show which of K shards in a directory are complete, partial or missing.
     Status(StatusArgs),
+    /// Claim the next unclaimed shard, run it, and repeat until none is left (for cron on
+    /// machines sharing the directory).
+    Work(WorkArgs),
+    /// Run every shard on this machine as concurrent processes, then merge into DIR/report.
+    RunAll(RunAllArgs),
+}
+
+/// `mc-shard work`.
+#[derive(Debug, Args)]
+pub struct WorkArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// The shared shard directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The number of shards the job is split into (the same for every worker).
+    #[arg(long)]
+    pub shards: u64,
+    /// Threads per shard (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Seconds between heartbeats of a claim.
+    #[arg(long, default_value_t = 5.0)]
+    pub heartbeat: f64,
+    /// Seconds after which an untouched claim is stale and taken over.
+    #[arg(long, default_value_t = 60.0)]
+    pub stale_after: f64,
+    /// Show no progress.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// `mc-shard run-all`.
+#[derive(Debug, Args)]
+pub struct RunAllArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// Directory for the shard files; the report goes to DIR/report.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Number of shards (default: the number of workers).
+    #[arg(long)]
+    pub shards: Option<u64>,
+    /// Concurrent worker processes (default: all cores).
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// Show no progress.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Do not merge at the end.
+    #[arg(long)]
+    pub no_merge: bool,
 }
 
 /// `mc-shard plan`.
@@ -241,6 +295,68 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
             out.write_all(crate::reproduce::reproduce(&job, c, a.sample, a.detail).as_bytes())?;
             Ok(())
         }
+        Command::Work(a) => {
+            let job = Job::read(&a.job)?;
+            let seconds = |name: &str, v: f64| {
+                if v.is_finite() && v > 0.0 {
+                    Ok(std::time::Duration::from_secs_f64(v))
+                } else {
+                    Err(RunError::Usage(format!(
+                        "--{name} must be a positive number of seconds"
+                    )))
+                }
+            };
+            let options = crate::work::WorkOptions {
+                shards: a.shards,
+                threads: a.threads.unwrap_or_else(default_threads),
+                heartbeat: seconds("heartbeat", a.heartbeat)?,
+                stale_after: seconds("stale-after", a.stale_after)?,
+                quiet: a.quiet,
+            };
+            let mut failed = None;
+            crate::work::work(&job, &a.out, &options, |action| {
+                let line = serde_json::to_string(action).expect("actions serialise");
+                if let Err(e) = writeln!(out, "{line}").and_then(|_| out.flush()) {
+                    failed.get_or_insert(e);
+                }
+            })?;
+            match failed {
+                Some(e) => Err(e.into()),
+                None => Ok(()),
+            }
+        }
+        Command::RunAll(a) => {
+            let job = Job::read(&a.job)?;
+            let workers = a.workers.unwrap_or_else(default_threads);
+            if workers == 0 {
+                return Err(RunError::Usage("--workers must be at least 1".into()).into());
+            }
+            let options = crate::run_all::RunAllOptions {
+                job_path: a.job.clone(),
+                out: a.out.clone(),
+                shards: a.shards.unwrap_or(workers as u64),
+                workers,
+                quiet: a.quiet,
+                no_merge: a.no_merge,
+            };
+            let exe = std::env::current_exe()?;
+            let started = Instant::now();
+            crate::run_all::run_all(&exe, &job, &options, out)?;
+            writeln!(
+                out,
+                "run-all: {} samples in {} shards on {} workers, {:.2} s{}",
+                job.samples(),
+                options.shards,
+                workers,
+                started.elapsed().as_secs_f64(),
+                if a.no_merge {
+                    String::new()
+                } else {
+                    format!("; report in {}", a.out.join("report").display())
+                }
+            )?;
+            Ok(())
+        }
         Command::Status(a) => {
             let job = Job::read(&a.job)?;
             let states = shard_states(&job, &a.out, a.shards).map_err(RunError::Usage)?;
@@ -266,6 +382,11 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
             Ok(())
         }
     }
+}
+
+/// The number of cores.
+fn default_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// `mc-shard plan`: the job's id and cases, and a split suggested from a short timing.

@@ -25,6 +25,10 @@
 //!   of one sample, or its draws, iterations, displacements and forces ([`reproduce`]).
 //! - `mc-shard status --job JOB.json --out DIR --shards K [--missing]` — which shards are
 //!   complete ([`status`]).
+//! - `mc-shard work --job JOB.json --out DIR --shards K` — claim, run and repeat until no
+//!   shard is left: for cron on machines sharing DIR ([`work`]).
+//! - `mc-shard run-all --job JOB.json --out DIR [--shards K] [--workers W]` — every shard on
+//!   this machine as concurrent processes, then the merge ([`run_all`]).
 //!
 //! ## Exit codes
 //!
@@ -44,11 +48,13 @@ pub mod errors;
 pub mod job;
 pub mod progress;
 pub mod reproduce;
+pub mod run_all;
 pub mod runner;
 pub mod sampler;
 pub mod select;
 pub mod shard;
 pub mod status;
+pub mod work;
 pub mod worker;
 
 pub use errors::{JobError, RunError, ShardError};

@@ -1,0 +1,268 @@
+//! `mc-shard work`: a worker that claims the next unclaimed shard of a job in a shared
+//! directory, runs it, and repeats until none is left. Safe with several workers on several
+//! machines (cron on workstations sharing a directory).
+//!
+//! ## Protocol
+//!
+//! - **Claim.** Shard `i` of `K` is claimed by creating `DIR/claims/shard-i-of-K.claim` with
+//!   `O_CREAT|O_EXCL` (atomic: exactly one creator wins), holding the claimant's host, pid
+//!   and claim time as JSON.
+//! - **Heartbeat.** While it works, the claimant rewrites its claim's modification time
+//!   every `heartbeat` (default 5 s).
+//! - **Stale claims are taken over.** A claim not touched for `stale_after` (default 60 s)
+//!   belongs to a dead worker. To replace it a worker first creates the takeover lock
+//!   `shard-i-of-K.claim.takeover` (again `O_EXCL`, so one worker at a time), re-checks that the
+//!   claim is still stale, replaces it, and removes the lock. A takeover lock itself older
+//!   than `stale_after` is removed.
+//! - **The shard file's own lock decides.** Running a shard takes the exclusive OS lock on
+//!   its file (see [`crate::shard`]), so even two workers that both believe they hold a claim
+//!   cannot write one file together: the second finds it locked and moves on. A dead
+//!   worker's partial shard is resumed from its last whole line.
+//! - **A finished shard is never rerun**: a complete file is recognised (its end line) and
+//!   skipped; the claim of a finished shard is removed.
+//!
+//! Claims and locks need a shared filesystem with atomic `O_EXCL` create and working file
+//! locks across machines (a local disk, NFSv4, CephFS, Lustre).
+//!
+//! Each action is printed as one JSON line on stdout (`{"shard": i, "action": "completed",
+//! "computed": n, "kept": m, "host": …, "pid": …}`), for logs and tests.
+
+use crate::errors::{RunError, ShardError};
+use crate::job::Job;
+use crate::runner::{RunOptions, run_shard};
+use shard_record::ShardRange;
+use std::fs::{File, OpenOptions};
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, SystemTime};
+
+/// Options of a worker.
+#[derive(Debug, Clone)]
+pub struct WorkOptions {
+    /// Number of shards the job is split into.
+    pub shards: u64,
+    /// Threads per shard.
+    pub threads: usize,
+    /// How often the claim is touched.
+    pub heartbeat: Duration,
+    /// A claim untouched this long is stale.
+    pub stale_after: Duration,
+    /// Show no progress.
+    pub quiet: bool,
+}
+
+/// One thing a worker did.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Action {
+    /// Shard index.
+    pub shard: u64,
+    /// `completed`, `already-complete`, `claimed-elsewhere`, `locked-elsewhere`, `took-over`.
+    pub action: &'static str,
+    /// Samples computed by this worker.
+    pub computed: u64,
+    /// Samples kept from an earlier, interrupted run.
+    pub kept: u64,
+    /// This worker's host.
+    pub host: String,
+    /// This worker's pid.
+    pub pid: u32,
+}
+
+/// This machine's host name.
+pub fn host_name() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .map(|s| s.trim().to_string())
+        .ok()
+        .filter(|s| !s.is_empty())
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// Works until every shard of `job` in `dir` is complete (or claimed by a live worker),
+/// calling `report` with each action. Returns the actions.
+pub fn work(
+    job: &Job,
+    dir: &Path,
+    options: &WorkOptions,
+    mut report: impl FnMut(&Action),
+) -> Result<Vec<Action>, RunError> {
+    let ranges = ShardRange::partition(options.shards, job.samples())
+        .map_err(|e| RunError::Usage(e.to_string()))?;
+    let claims = dir.join("claims");
+    std::fs::create_dir_all(&claims).map_err(|source| ShardError::Io {
+        path: claims.clone(),
+        source,
+    })?;
+    let host = host_name();
+    let pid = std::process::id();
+    let mut actions = Vec::new();
+    let mut act = |shard: u64, action: &'static str, computed: u64, kept: u64| {
+        let a = Action {
+            shard,
+            action,
+            computed,
+            kept,
+            host: host.clone(),
+            pid,
+        };
+        report(&a);
+        actions.push(a);
+    };
+    for (i, range) in ranges.iter().enumerate() {
+        let i = i as u64;
+        if looks_complete(&dir.join(range.file_name())) {
+            continue;
+        }
+        let claim = claims.join(format!("shard-{i}-of-{}.claim", options.shards));
+        let took_over = match try_claim(&claim, &host, pid, options.stale_after)? {
+            Claim::Ours { took_over } => took_over,
+            Claim::Live => {
+                act(i, "claimed-elsewhere", 0, 0);
+                continue;
+            }
+        };
+        if took_over {
+            act(i, "took-over", 0, 0);
+        }
+        let result = with_heartbeat(&claim, options.heartbeat, || {
+            run_shard(
+                job,
+                dir,
+                *range,
+                &RunOptions {
+                    threads: options.threads,
+                    quiet: options.quiet,
+                },
+            )
+        });
+        match result {
+            Ok(summary) => {
+                let _ = std::fs::remove_file(&claim);
+                if summary.already_complete {
+                    act(i, "already-complete", 0, summary.resumed);
+                } else {
+                    act(i, "completed", summary.computed, summary.resumed);
+                }
+            }
+            Err(RunError::Shard(ShardError::Locked { .. })) => {
+                // Another worker writes it: its claim will show it; leave ours to go stale.
+                let _ = std::fs::remove_file(&claim);
+                act(i, "locked-elsewhere", 0, 0);
+            }
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(actions)
+}
+
+/// Whether a shard file ends with an end line (a cheap look; running it verifies).
+fn looks_complete(path: &Path) -> bool {
+    let Ok(mut f) = File::open(path) else {
+        return false;
+    };
+    let len = f.metadata().map_or(0, |m| m.len());
+    let tail = len.min(512);
+    let mut buf = vec![0; tail as usize];
+    if f.seek(SeekFrom::End(-(tail as i64))).is_err() || f.read_exact(&mut buf).is_err() {
+        return false;
+    }
+    let text = String::from_utf8_lossy(&buf);
+    let last = text
+        .trim_end_matches('\n')
+        .rsplit('\n')
+        .next()
+        .unwrap_or("");
+    text.ends_with('\n') && last.starts_with(r#"{"record":"end""#)
+}
+
+enum Claim {
+    Ours { took_over: bool },
+    Live,
+}
+
+/// Claims `path` (see the module doc).
+fn try_claim(path: &Path, host: &str, pid: u32, stale_after: Duration) -> Result<Claim, RunError> {
+    let io = |source| {
+        RunError::Shard(ShardError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+    };
+    match create_claim(path, host, pid) {
+        Ok(()) => return Ok(Claim::Ours { took_over: false }),
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+        Err(e) => return Err(io(e)),
+    }
+    if !is_stale(path, stale_after) {
+        return Ok(Claim::Live);
+    }
+    let lock = path.with_extension("claim.takeover");
+    if is_stale(&lock, stale_after) {
+        let _ = std::fs::remove_file(&lock);
+    }
+    match OpenOptions::new().write(true).create_new(true).open(&lock) {
+        Ok(_) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => return Ok(Claim::Live),
+        Err(e) => return Err(io(e)),
+    }
+    // Holding the takeover lock: re-check, then replace the stale claim.
+    let result = if is_stale(path, stale_after) || !path.exists() {
+        let _ = std::fs::remove_file(path);
+        match create_claim(path, host, pid) {
+            Ok(()) => Ok(Claim::Ours { took_over: true }),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(Claim::Live),
+            Err(e) => Err(io(e)),
+        }
+    } else {
+        Ok(Claim::Live)
+    };
+    let _ = std::fs::remove_file(&lock);
+    result
+}
+
+fn create_claim(path: &Path, host: &str, pid: u32) -> std::io::Result<()> {
+    let mut f = OpenOptions::new().write(true).create_new(true).open(path)?;
+    let since = SystemTime::now()
+        .duration_since(SystemTime::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    writeln!(
+        f,
+        "{}",
+        serde_json::json!({"host": host, "pid": pid, "claimed_at_unix": since})
+    )?;
+    f.sync_all()
+}
+
+/// Whether `path` exists and was last modified more than `stale_after` ago.
+fn is_stale(path: &Path, stale_after: Duration) -> bool {
+    std::fs::metadata(path)
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| t.elapsed().ok())
+        .is_some_and(|age| age > stale_after)
+}
+
+/// Runs `f` while a thread touches `claim` every `every`.
+fn with_heartbeat<T>(claim: &PathBuf, every: Duration, f: impl FnOnce() -> T) -> T {
+    let done = AtomicBool::new(false);
+    std::thread::scope(|s| {
+        s.spawn(|| {
+            let step = Duration::from_millis(50).min(every);
+            let mut since = Duration::ZERO;
+            while !done.load(Ordering::Relaxed) {
+                std::thread::sleep(step);
+                since += step;
+                if since >= every {
+                    since = Duration::ZERO;
+                    if let Ok(f) = OpenOptions::new().append(true).open(claim) {
+                        let _ = f.set_modified(SystemTime::now());
+                    }
+                }
+            }
+        });
+        let out = f();
+        done.store(true, Ordering::Relaxed);
+        out
+    })
+}

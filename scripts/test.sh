@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# test.sh: the project's test command (the README's, and what CI runs).
+#
+# Usage: scripts/test.sh
+#
+# 1. cargo test --workspace: unit, verification, property and CLI tests of every crate and
+#    the cross-crate pipeline (tests/). A few minutes.
+# 2. The release binaries, then the end-to-end checks with real parts:
+#    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
+#      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted;
+#    - scripts/smoke-test.sh: the README's main command on a small job, and its SVG plots
+#      rendered to PNG with rsvg-convert.
+# Needs what scripts/setup.sh installs (it is run first when something is missing).
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$REPO"
+
+command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null || scripts/setup.sh
+
+echo "test: cargo test --workspace" >&2
+cargo test --workspace --quiet
+
+echo "test: release binaries" >&2
+cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli
+
+echo "test: Slurm end to end" >&2
+scripts/slurm/e2e-test.sh
+
+echo "test: smoke test of the main command" >&2
+scripts/smoke-test.sh
+
+echo "test: all passed" >&2
