@@ -30,22 +30,22 @@ use serde::{Deserialize, Serialize};
 pub enum DistributionSpec {
     /// Normal with mean (default 0) and standard deviation σ ≥ 0.
     Normal {
-        /// Mean [mm].
+        /// Mean \[mm\].
         #[serde(default)]
         mean: f64,
-        /// Standard deviation [mm].
+        /// Standard deviation \[mm\].
         sigma: f64,
     },
     /// Uniform on [low, high], low ≤ high.
     Uniform {
-        /// Lower end [mm].
+        /// Lower end \[mm\].
         low: f64,
-        /// Upper end [mm].
+        /// Upper end \[mm\].
         high: f64,
     },
     /// Always the same value.
     Constant {
-        /// The value [mm].
+        /// The value \[mm\].
         value: f64,
     },
 }
@@ -80,7 +80,7 @@ impl DistributionSpec {
         Ok(())
     }
 
-    /// Mean [mm].
+    /// Mean \[mm\].
     pub fn mean(&self) -> f64 {
         match *self {
             DistributionSpec::Normal { mean, .. } => mean,
@@ -89,7 +89,7 @@ impl DistributionSpec {
         }
     }
 
-    /// Standard deviation [mm].
+    /// Standard deviation \[mm\].
     pub fn std_dev(&self) -> f64 {
         match *self {
             DistributionSpec::Normal { sigma, .. } => sigma,

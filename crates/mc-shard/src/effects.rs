@@ -7,7 +7,7 @@
 //! "effects": {"gravity": {"direction": [0, 0, -1], "g": 9.80665, "density": 2.7e-6}}
 //! ```
 //!
-//! Each member's weight `W = ρ·A·L·g` [N] (ρ in kg/mm³, A in mm², L its nominal length in mm,
+//! Each member's weight `W = ρ·A·L·g` \[N\] (ρ in kg/mm³, A in mm², L its nominal length in mm,
 //! g in m/s²: kg·m/s² = N) is lumped half to each of its two nodes, along `direction`
 //! (normalised; it need not be vertical, since the truss may be tested on its side). Defaults:
 //! aluminium, ρ = 2700 kg/m³ = 2.7e-6 kg/mm³; standard gravity g = 9.80665 m/s².
@@ -18,19 +18,19 @@
 //! "effects": {"thermal_gradient": {"gradient": [0, 0, 0.002], "offset": 0.5, "alpha": 23e-6}}
 //! ```
 //!
-//! A temperature change `ΔT(x) = offset + gradient·(x − reference)` [K] (gradient in K/mm,
+//! A temperature change `ΔT(x) = offset + gradient·(x − reference)` \[K\] (gradient in K/mm,
 //! `reference` a point in mm, default the origin) lengthens each member by
-//! `α·ΔT(x_mid)·L` [mm], its midpoint's temperature times its nominal length, added to its
+//! `α·ΔT(x_mid)·L` \[mm\], its midpoint's temperature times its nominal length, added to its
 //! length error. Default α = 23e-6 /K (aluminium).
 
 use serde::{Deserialize, Serialize};
 use truss_core::Model;
 
-/// Standard gravity [m/s²].
+/// Standard gravity \[m/s²\].
 pub const STANDARD_GRAVITY: f64 = 9.80665;
-/// Density of aluminium [kg/mm³] (2700 kg/m³).
+/// Density of aluminium \[kg/mm³\] (2700 kg/m³).
 pub const ALUMINIUM_DENSITY: f64 = 2.7e-6;
-/// Thermal expansion coefficient of aluminium [1/K].
+/// Thermal expansion coefficient of aluminium \[1/K\].
 pub const ALUMINIUM_ALPHA: f64 = 23e-6;
 
 /// The effects of a case, as a job writes them.
@@ -51,10 +51,10 @@ pub struct EffectsSpec {
 pub struct GravitySpec {
     /// Direction of gravity in the model's frame (normalised).
     pub direction: [f64; 3],
-    /// Acceleration [m/s²].
+    /// Acceleration \[m/s²\].
     #[serde(default = "standard_gravity")]
     pub g: f64,
-    /// Density [kg/mm³].
+    /// Density \[kg/mm³\].
     #[serde(default = "aluminium_density")]
     pub density: f64,
 }
@@ -63,15 +63,15 @@ pub struct GravitySpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ThermalSpec {
-    /// Temperature gradient [K/mm].
+    /// Temperature gradient \[K/mm\].
     pub gradient: [f64; 3],
-    /// Temperature change at `reference` [K].
+    /// Temperature change at `reference` \[K\].
     #[serde(default)]
     pub offset: f64,
-    /// Expansion coefficient [1/K].
+    /// Expansion coefficient \[1/K\].
     #[serde(default = "aluminium_alpha")]
     pub alpha: f64,
-    /// Where the change is `offset` [mm].
+    /// Where the change is `offset` \[mm\].
     #[serde(default)]
     pub reference: [f64; 3],
 }
@@ -86,13 +86,13 @@ fn aluminium_alpha() -> f64 {
     ALUMINIUM_ALPHA
 }
 
-/// What the effects do to a model: extra nodal loads [N] (per node; empty for none) and
-/// extra length errors [mm] (per member; empty for none).
+/// What the effects do to a model: extra nodal loads \[N\] (per node; empty for none) and
+/// extra length errors \[mm\] (per member; empty for none).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Applied {
-    /// Extra force on each node [N].
+    /// Extra force on each node \[N\].
     pub loads: Vec<[f64; 3]>,
-    /// Extra length error of each member [mm].
+    /// Extra length error of each member \[mm\].
     pub length_changes: Vec<f64>,
 }
 

@@ -78,7 +78,7 @@ pub struct CaseSpec {
     /// This case's own model, if any.
     #[serde(default)]
     pub model: Option<serde_json::Value>,
-    /// Length-error distribution per member group [mm].
+    /// Length-error distribution per member group \[mm\].
     #[serde(default)]
     pub length_errors: BTreeMap<String, DistributionSpec>,
     /// Deterministic effects: self-weight, a temperature field (see [`crate::effects`]).

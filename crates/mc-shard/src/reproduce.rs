@@ -5,7 +5,7 @@
 //!
 //! `line` (the shard's line, byte for byte, without its newline), `length_errors` (mm per
 //! member id, model order, as drawn), `iterations` (per Newton iteration: out-of-balance
-//! force [N], step [mm], line-search α, whether the tangent was factorised afresh, the slack
+//! force \[N\], step \[mm\], line-search α, whether the tangent was factorised afresh, the slack
 //! cables), and, when it converged, `displacements` (mm per node id), `forces` (N per member
 //! id, tension positive) and `slack_cables`.
 

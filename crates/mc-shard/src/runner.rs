@@ -36,7 +36,7 @@ pub struct RunSummary {
     pub computed: u64,
     /// Failed samples in the whole shard.
     pub failed: u64,
-    /// Wall time of this run [s].
+    /// Wall time of this run \[s\].
     pub seconds: f64,
 }
 

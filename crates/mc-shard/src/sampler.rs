@@ -42,7 +42,7 @@ pub fn sample_stream(key: &[u8; 32], k: u64) -> ChaCha20Rng {
     rng
 }
 
-/// Draws the length errors [mm] of sample `k` of `case` into `errors` (one per member,
+/// Draws the length errors \[mm\] of sample `k` of `case` into `errors` (one per member,
 /// model order; zero where the member's group has no distribution).
 pub fn draw_length_errors(key: &[u8; 32], case: &Case, k: u64, errors: &mut Vec<f64>) {
     let mut rng = sample_stream(key, k);

@@ -108,7 +108,7 @@ impl<'j> Worker<'j> {
         }
     }
 
-    /// The length errors of the last sample [mm], model order: the drawn ones plus any
+    /// The length errors of the last sample \[mm\], model order: the drawn ones plus any
     /// thermal length change.
     pub fn last_errors(&self) -> &[f64] {
         &self.errors

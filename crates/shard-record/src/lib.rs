@@ -156,16 +156,16 @@ pub struct Sample {
     pub status: Status,
     /// Newton iterations taken.
     pub iterations: u32,
-    /// Distortion angle θ_P between top and bottom normals [rad].
+    /// Distortion angle θ_P between top and bottom normals \[rad\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub theta_p: Option<f64>,
-    /// tan θ_x of the top surface (paper eq. 8) [-].
+    /// tan θ_x of the top surface (paper eq. 8) \[-\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tan_theta_x: Option<f64>,
-    /// tan θ_y of the top surface (paper eq. 9) [-].
+    /// tan θ_y of the top surface (paper eq. 9) \[-\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tan_theta_y: Option<f64>,
-    /// Final out-of-balance force, max norm over free DOFs [N].
+    /// Final out-of-balance force, max norm over free DOFs \[N\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub residual: Option<f64>,
     /// Number of tension-only members that ended slack.
@@ -182,11 +182,11 @@ pub struct Sample {
 /// The angles of a converged sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Angles {
-    /// θ_P [rad].
+    /// θ_P \[rad\].
     pub theta_p: f64,
-    /// tan θ_x [-].
+    /// tan θ_x \[-\].
     pub tan_theta_x: f64,
-    /// tan θ_y [-].
+    /// tan θ_y \[-\].
     pub tan_theta_y: f64,
 }
 

@@ -74,31 +74,31 @@ pub struct PrismArgs {
     /// Number of stages N.
     #[arg(long, default_value_t = 5)]
     pub stages: usize,
-    /// Batten length l, the triangle's side [mm].
+    /// Batten length l, the triangle's side \[mm\].
     #[arg(long, default_value_t = 380.0)]
     pub side: f64,
-    /// Stage height h, the longeron length [mm].
+    /// Stage height h, the longeron length \[mm\].
     #[arg(long, default_value_t = 380.0)]
     pub height: f64,
-    /// Batten cross-section [mm²].
+    /// Batten cross-section \[mm²\].
     #[arg(long, default_value_t = 14.9)]
     pub batten_area: f64,
-    /// Batten Young's modulus [MPa].
+    /// Batten Young's modulus \[MPa\].
     #[arg(long, default_value_t = 70_000.0)]
     pub batten_modulus: f64,
-    /// Longeron cross-section [mm²].
+    /// Longeron cross-section \[mm²\].
     #[arg(long, default_value_t = 14.9)]
     pub longeron_area: f64,
-    /// Longeron Young's modulus [MPa].
+    /// Longeron Young's modulus \[MPa\].
     #[arg(long, default_value_t = 70_000.0)]
     pub longeron_modulus: f64,
-    /// Diagonal cable cross-section [mm²].
+    /// Diagonal cable cross-section \[mm²\].
     #[arg(long, default_value_t = 3.1)]
     pub diagonal_area: f64,
-    /// Diagonal cable Young's modulus [MPa].
+    /// Diagonal cable Young's modulus \[MPa\].
     #[arg(long, default_value_t = 70_000.0)]
     pub diagonal_modulus: f64,
-    /// Diagonal natural length [mm] (Table 1: 537.4).
+    /// Diagonal natural length \[mm\] (Table 1: 537.4).
     #[arg(long, default_value_t = TABLE1_DIAGONAL_LENGTH, conflicts_with = "exact_diagonals")]
     pub diagonal_length: f64,
     /// Give the diagonals the exact face-diagonal length √(l² + h²) instead.

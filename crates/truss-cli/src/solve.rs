@@ -67,10 +67,10 @@ pub struct SolveOutput {
     /// Tangent factorisations.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub factorisations: Option<u32>,
-    /// Final out-of-balance force [N].
+    /// Final out-of-balance force \[N\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub residual: Option<f64>,
-    /// θ_P [rad].
+    /// θ_P \[rad\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub theta_p: Option<f64>,
     /// tan θ_x.
@@ -81,10 +81,10 @@ pub struct SolveOutput {
     pub tan_theta_y: Option<f64>,
     /// Units.
     pub units: Units,
-    /// Node displacements [mm].
+    /// Node displacements \[mm\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub displacements: Option<Ordered<[f64; 3]>>,
-    /// Member axial forces, tension positive [N].
+    /// Member axial forces, tension positive \[N\].
     #[serde(skip_serializing_if = "Option::is_none")]
     pub forces: Option<Ordered<f64>>,
     /// Ids of the slack cables.

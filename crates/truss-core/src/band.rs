@@ -15,9 +15,9 @@
 pub struct NotPositiveDefinite {
     /// Row (degree of freedom) of the pivot.
     pub index: usize,
-    /// The pivot's value before the square root [N/mm].
+    /// The pivot's value before the square root \[N/mm\].
     pub pivot: f64,
-    /// The row's diagonal entry before factorisation [N/mm].
+    /// The row's diagonal entry before factorisation \[N/mm\].
     pub diagonal: f64,
 }
 

@@ -25,7 +25,7 @@ pub type Block = [[f64; 3]; 3];
 pub struct PivotFailure {
     /// Scalar row (3·node + direction) of the pivot.
     pub index: usize,
-    /// The pivot's value before the square root [N/mm].
+    /// The pivot's value before the square root \[N/mm\].
     pub pivot: f64,
 }
 

@@ -5,15 +5,15 @@
 //! `L_r = |D|`), natural length `L₀`, relative displacement `d = u_j − u_i`:
 //!
 //! ```text
-//! c = D + d                                    current vector [mm]
-//! L = |c|,  n = c / L                          current length [mm], unit direction
-//! e = L − L₀ = (2 D·d + d·d)/(L + L_r) + s₀,   s₀ = L_r − L₀          elongation [mm]
-//! k = E·A / L₀                                 axial stiffness [N/mm]
+//! c = D + d                                    current vector \[mm\]
+//! L = |c|,  n = c / L                          current length \[mm\], unit direction
+//! e = L − L₀ = (2 D·d + d·d)/(L + L_r) + s₀,   s₀ = L_r − L₀          elongation \[mm\]
+//! k = E·A / L₀                                 axial stiffness \[N/mm\]
 //! k_e = k, or r·k for a cable with e < 0       effective stiffness (r: compression ratio)
-//! N = k_e · e                                  axial force, tension positive [N]
-//! W = ½ · k_e · e²                             strain energy [N·mm]
-//! ∂W/∂u_j = −∂W/∂u_i = N · n                   internal force on the nodes [N]
-//! K_jj = K_ii = −K_ij = k_e · n nᵀ + (N/L)(I − n nᵀ)    tangent stiffness [N/mm]
+//! N = k_e · e                                  axial force, tension positive \[N\]
+//! W = ½ · k_e · e²                             strain energy \[N·mm\]
+//! ∂W/∂u_j = −∂W/∂u_i = N · n                   internal force on the nodes \[N\]
+//! K_jj = K_ii = −K_ij = k_e · n nᵀ + (N/L)(I − n nᵀ)    tangent stiffness \[N/mm\]
 //! ```
 //!
 //! `(L − L_r)` is computed as `(L² − L_r²)/(L + L_r)` with `L² − L_r² = 2 D·d + d·d` exactly
@@ -25,15 +25,15 @@
 /// The constants of one member for one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AxialMember {
-    /// Nominal vector `D = X_j − X_i` [mm].
+    /// Nominal vector `D = X_j − X_i` \[mm\].
     pub reference: [f64; 3],
-    /// Nominal length `L_r = |D|` [mm].
+    /// Nominal length `L_r = |D|` \[mm\].
     pub reference_length: f64,
-    /// Natural length `L₀` [mm].
+    /// Natural length `L₀` \[mm\].
     pub natural_length: f64,
-    /// `s₀ = L_r − L₀` [mm]; positive when the member is too short and starts in tension.
+    /// `s₀ = L_r − L₀` \[mm\]; positive when the member is too short and starts in tension.
     pub initial_stretch: f64,
-    /// `E·A` [N].
+    /// `E·A` \[N\].
     pub rigidity: f64,
     /// Compression stiffness ratio `r`: 1 for a bar, small for a cable.
     pub compression_ratio: f64,
@@ -44,13 +44,13 @@ pub struct AxialMember {
 pub struct AxialState {
     /// Unit vector from node `i` to node `j` in the current configuration.
     pub direction: [f64; 3],
-    /// Current length `L` [mm].
+    /// Current length `L` \[mm\].
     pub length: f64,
-    /// Elongation `e = L − L₀` [mm].
+    /// Elongation `e = L − L₀` \[mm\].
     pub elongation: f64,
-    /// Axial force `N`, tension positive [N].
+    /// Axial force `N`, tension positive \[N\].
     pub force: f64,
-    /// Effective axial stiffness `k_e` [N/mm].
+    /// Effective axial stiffness `k_e` \[N/mm\].
     pub stiffness: f64,
     /// Whether a cable is slack (`e < 0` and `r < 1`).
     pub slack: bool,
@@ -78,7 +78,7 @@ impl AxialMember {
         }
     }
 
-    /// The member's state at relative displacement `d = u_j − u_i` [mm].
+    /// The member's state at relative displacement `d = u_j − u_i` \[mm\].
     #[inline]
     pub fn state(&self, d: [f64; 3]) -> AxialState {
         let c = add(self.reference, d);
@@ -99,7 +99,7 @@ impl AxialMember {
         }
     }
 
-    /// Strain energy `W = ½·k_e·e²` [N·mm] at relative displacement `d`.
+    /// Strain energy `W = ½·k_e·e²` \[N·mm\] at relative displacement `d`.
     pub fn energy(&self, d: [f64; 3]) -> f64 {
         let s = self.state(d);
         0.5 * s.stiffness * s.elongation * s.elongation
@@ -108,7 +108,7 @@ impl AxialMember {
 
 impl AxialState {
     /// The 3×3 tangent block `k_e n nᵀ + (N/L)(I − n nᵀ)`, as its six distinct entries
-    /// `[xx, yx, yy, zx, zy, zz]` [N/mm].
+    /// `[xx, yx, yy, zx, zy, zz]` \[N/mm\].
     #[inline]
     pub fn tangent_block(&self) -> [f64; 6] {
         self.tangent_block_with(self.stiffness)

@@ -109,9 +109,9 @@ pub enum SolveError {
     NotConverged {
         /// Iterations taken.
         iterations: u32,
-        /// Final out-of-balance force, max over free DOFs [N].
+        /// Final out-of-balance force, max over free DOFs \[N\].
         residual: f64,
-        /// Size of the last step, max over free DOFs [mm].
+        /// Size of the last step, max over free DOFs \[mm\].
         step: f64,
     },
     /// The tangent stiffness is singular: a mechanism in the deformed state.

@@ -35,7 +35,7 @@ pub(crate) struct CableBasis {
     pub z: Vec<f64>,
     /// `G`, row-major `n_c × n_c`.
     pub g: Vec<f64>,
-    /// `1/((1 − r_c)·k_c)` per cable, with nominal `k_c` [mm/N].
+    /// `1/((1 − r_c)·k_c)` per cable, with nominal `k_c` \[mm/N\].
     pub w_inv: Vec<f64>,
 }
 

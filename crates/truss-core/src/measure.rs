@@ -4,8 +4,8 @@
 //!
 //! ```text
 //! n_t = (p₂ − p₁) × (p₃ − p₁)                          surface normal (eq. 5)
-//! θ_P = atan2(|n_t × n_b|, n_t · n_b)                   angle to the reference n_b (eq. 2) [rad]
-//! tan θ_x = −n_tx / n_tz,   tan θ_y = −n_ty / n_tz       (eqs. 6, 8, 9) [-]
+//! θ_P = atan2(|n_t × n_b|, n_t · n_b)                   angle to the reference n_b (eq. 2) \[rad\]
+//! tan θ_x = −n_tx / n_tz,   tan θ_y = −n_ty / n_tz       (eqs. 6, 8, 9) \[-\]
 //! ```
 //!
 //! The paper writes θ_P = cos⁻¹(n_t·n_b / |n_t||n_b|). For θ_P ≈ 1e-5 rad the cosine is
@@ -21,11 +21,11 @@ use crate::element::{add, dot, norm, sub};
 /// The tilt of a surface against a reference normal.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Distortion {
-    /// Distortion angle θ_P [rad], in [0, π].
+    /// Distortion angle θ_P \[rad\], in [0, π].
     pub theta_p: f64,
-    /// tan θ_x = −n_tx/n_tz [-] (paper eq. 8).
+    /// tan θ_x = −n_tx/n_tz \[-\] (paper eq. 8).
     pub tan_theta_x: f64,
-    /// tan θ_y = −n_ty/n_tz [-] (paper eq. 9).
+    /// tan θ_y = −n_ty/n_tz \[-\] (paper eq. 9).
     pub tan_theta_y: f64,
     /// The unit normal of the deformed surface.
     pub normal: [f64; 3],
@@ -42,7 +42,7 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 /// The distortion of the surface through nodes with nominal positions `x` and displacements
-/// `u` (both [mm], in the paper's Fig. 5 order), against the unit reference normal `n_b`.
+/// `u` (both \[mm\], in the paper's Fig. 5 order), against the unit reference normal `n_b`.
 pub fn distortion(x: [[f64; 3]; 3], u: [[f64; 3]; 3], n_b: [f64; 3]) -> Distortion {
     let e1 = add(sub(x[1], x[0]), sub(u[1], u[0]));
     let e2 = add(sub(x[2], x[0]), sub(u[2], u[0]));

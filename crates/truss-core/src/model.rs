@@ -17,7 +17,7 @@ use std::path::Path;
 pub struct Node {
     /// Unique id.
     pub id: String,
-    /// Nominal position [mm].
+    /// Nominal position \[mm\].
     pub xyz: [f64; 3],
 }
 
@@ -50,18 +50,18 @@ pub struct Member {
     pub nodes: [usize; 2],
     /// Group name; length-error distributions are given per group.
     pub group: String,
-    /// Cross-sectional area [mm²].
+    /// Cross-sectional area \[mm²\].
     pub area: f64,
-    /// Young's modulus [MPa].
+    /// Young's modulus \[MPa\].
     pub youngs_modulus: f64,
-    /// Stress-free length [mm].
+    /// Stress-free length \[mm\].
     pub natural_length: f64,
     /// Bar or cable.
     pub behaviour: Behaviour,
 }
 
 impl Member {
-    /// Axial stiffness `E·A/L₀` in tension [N/mm].
+    /// Axial stiffness `E·A/L₀` in tension \[N/mm\].
     pub fn axial_stiffness(&self) -> f64 {
         self.youngs_modulus * self.area / self.natural_length
     }
@@ -187,7 +187,7 @@ impl Model {
         self.fixed[node]
     }
 
-    /// The total nodal load on node `node` [N].
+    /// The total nodal load on node `node` \[N\].
     pub fn load(&self, node: usize) -> [f64; 3] {
         self.loads[node]
     }
@@ -218,7 +218,7 @@ impl Model {
         groups
     }
 
-    /// Nominal length of member `m` (distance between its nodes' nominal positions) [mm].
+    /// Nominal length of member `m` (distance between its nodes' nominal positions) \[mm\].
     pub fn nominal_length(&self, m: usize) -> f64 {
         let [a, b] = self.members[m].nodes;
         distance(self.nodes[a].xyz, self.nodes[b].xyz)
@@ -291,7 +291,7 @@ impl Model {
     }
 }
 
-/// Euclidean distance [mm].
+/// Euclidean distance \[mm\].
 pub(crate) fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
     (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()

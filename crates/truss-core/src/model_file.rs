@@ -50,7 +50,7 @@ pub struct ModelFile {
     /// Fixed degrees of freedom.
     #[serde(default)]
     pub supports: Vec<SupportSpec>,
-    /// Nodal forces [N].
+    /// Nodal forces \[N\].
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub loads: Vec<LoadSpec>,
     /// The surface whose tilt is measured.
@@ -64,7 +64,7 @@ pub struct ModelFile {
 pub struct NodeSpec {
     /// Unique id.
     pub id: String,
-    /// Nominal position [mm].
+    /// Nominal position \[mm\].
     pub xyz: [f64; 3],
 }
 
@@ -88,11 +88,11 @@ pub struct MemberSpec {
     pub nodes: [String; 2],
     /// Group name.
     pub group: String,
-    /// Cross-sectional area [mm²].
+    /// Cross-sectional area \[mm²\].
     pub area: f64,
-    /// Young's modulus [MPa].
+    /// Young's modulus \[MPa\].
     pub youngs_modulus: f64,
-    /// Stress-free length [mm]; defaults to the distance between the nodes.
+    /// Stress-free length \[mm\]; defaults to the distance between the nodes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub natural_length: Option<f64>,
     /// Bar or cable.
@@ -118,7 +118,7 @@ pub struct SupportSpec {
 pub struct LoadSpec {
     /// The node id.
     pub node: String,
-    /// Force [N].
+    /// Force \[N\].
     pub force: [f64; 3],
 }
 

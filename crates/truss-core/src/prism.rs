@@ -26,7 +26,7 @@ use crate::model_file::{
 };
 use crate::{DEFAULT_COMPRESSION_RATIO, Model, ModelError};
 
-/// The diagonal natural length of the paper's Table 1 [mm].
+/// The diagonal natural length of the paper's Table 1 \[mm\].
 pub const TABLE1_DIAGONAL_LENGTH: f64 = 537.4;
 
 /// Options of the prism generator; the defaults are the paper's Table 1.
@@ -34,23 +34,23 @@ pub const TABLE1_DIAGONAL_LENGTH: f64 = 537.4;
 pub struct PrismOptions {
     /// Number of stages N ≥ 1.
     pub stages: usize,
-    /// Batten length l, the side of the triangle [mm].
+    /// Batten length l, the side of the triangle \[mm\].
     pub side: f64,
-    /// Stage height h, the longeron length [mm].
+    /// Stage height h, the longeron length \[mm\].
     pub height: f64,
-    /// Batten cross-section [mm²].
+    /// Batten cross-section \[mm²\].
     pub batten_area: f64,
-    /// Batten Young's modulus [MPa].
+    /// Batten Young's modulus \[MPa\].
     pub batten_modulus: f64,
-    /// Longeron cross-section [mm²].
+    /// Longeron cross-section \[mm²\].
     pub longeron_area: f64,
-    /// Longeron Young's modulus [MPa].
+    /// Longeron Young's modulus \[MPa\].
     pub longeron_modulus: f64,
-    /// Diagonal cross-section [mm²].
+    /// Diagonal cross-section \[mm²\].
     pub diagonal_area: f64,
-    /// Diagonal Young's modulus [MPa].
+    /// Diagonal Young's modulus \[MPa\].
     pub diagonal_modulus: f64,
-    /// Diagonal natural length [mm]; `None` for the exact face diagonal √(l² + h²).
+    /// Diagonal natural length \[mm\]; `None` for the exact face diagonal √(l² + h²).
     pub diagonal_length: Option<f64>,
     /// Diagonals' compression stiffness ratio (they are tension-only cables).
     pub compression_ratio: f64,

@@ -26,15 +26,15 @@ pub(crate) struct CompiledMember {
     /// Row numbers of (`i`x, `i`y, `i`z, `j`x, `j`y, `j`z); a fixed direction points at the
     /// zero slot (index `free`), whose value is always zero.
     pub dofs: [usize; 6],
-    /// Nominal vector `X_j − X_i` [mm].
+    /// Nominal vector `X_j − X_i` \[mm\].
     pub reference: [f64; 3],
     /// Nominal unit direction `(X_j − X_i)/L_r`.
     pub unit: [f64; 3],
-    /// Nominal natural length [mm].
+    /// Nominal natural length \[mm\].
     pub natural_length: f64,
-    /// Nominal `L_r − L₀` [mm].
+    /// Nominal `L_r − L₀` \[mm\].
     pub nominal_stretch: f64,
-    /// `E·A` [N].
+    /// `E·A` \[N\].
     pub rigidity: f64,
     /// 1 for bars; the compression ratio for cables.
     pub compression_ratio: f64,
@@ -62,7 +62,7 @@ pub struct Structure {
     pub(crate) members: Vec<CompiledMember>,
     /// Block slots and directions of fixed directions of active nodes (identity rows).
     pub(crate) identity_rows: Vec<(usize, usize)>,
-    /// External load per row (plus the zero slot) [N].
+    /// External load per row (plus the zero slot) \[N\].
     pub(crate) loads: Vec<f64>,
     /// `K₀`, factorised.
     pub(crate) nominal: BlockBandMatrix,
@@ -224,7 +224,7 @@ impl Structure {
         }
     }
 
-    /// The member's constants for a sample with length error `error` [mm].
+    /// The member's constants for a sample with length error `error` \[mm\].
     #[inline]
     pub(crate) fn nominal_member(&self, m: &CompiledMember, error: f64) -> AxialMember {
         AxialMember::new(

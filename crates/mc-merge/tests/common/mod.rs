@@ -32,7 +32,7 @@ pub struct SynthCase {
     pub samples: u64,
     /// Parameters (sigma in mm, stages, ...).
     pub parameters: BTreeMap<String, f64>,
-    /// σ_t of the slopes [-].
+    /// σ_t of the slopes \[-\].
     pub sigma_t: f64,
     /// The law.
     pub law: Law,

@@ -3,8 +3,8 @@
 //! ## Algorithm
 //!
 //! Equilibrium is the stationary point of `Π(u) = Σ_m W_m(u) − fᵀu` (see [`crate::element`]);
-//! its gradient is the out-of-balance force `r(u) = g(u) − f` [N], its Hessian the tangent
-//! stiffness `K(u)` [N/mm].
+//! its gradient is the out-of-balance force `r(u) = g(u) − f` \[N\], its Hessian the tangent
+//! stiffness `K(u)` \[N/mm\].
 //!
 //! 1. **The linearised problem, exactly.** With linear kinematics the energy is convex and
 //!    piecewise quadratic in the set of slack cables; its minimiser is found by an
@@ -89,10 +89,10 @@ impl Default for SolveOptions {
 /// What a sample changes in the model: per-member length errors and extra nodal loads.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Perturbation<'a> {
-    /// Length error per member, in model order [mm] (natural length = model's + error);
+    /// Length error per member, in model order \[mm\] (natural length = model's + error);
     /// empty for none.
     pub length_errors: &'a [f64],
-    /// Extra nodal force per node, in model order [N]; empty for none.
+    /// Extra nodal force per node, in model order \[N\]; empty for none.
     pub extra_loads: &'a [[f64; 3]],
 }
 
@@ -103,9 +103,9 @@ pub struct SolveReport {
     pub iterations: u32,
     /// Tangent factorisations (the shared nominal one not counted).
     pub factorisations: u32,
-    /// Final out-of-balance force, max over free DOFs [N].
+    /// Final out-of-balance force, max over free DOFs \[N\].
     pub residual: f64,
-    /// Size of the last step, max over free DOFs [mm].
+    /// Size of the last step, max over free DOFs \[mm\].
     pub step: f64,
     /// Number of tension-only members that ended slack.
     pub slack_cables: u32,
@@ -118,9 +118,9 @@ pub struct SolveReport {
 pub struct IterationRecord {
     /// Iteration number, from 1.
     pub iteration: u32,
-    /// Out-of-balance force before the step, max over free DOFs [N].
+    /// Out-of-balance force before the step, max over free DOFs \[N\].
     pub residual: f64,
-    /// Size of the step taken, max over free DOFs [mm].
+    /// Size of the step taken, max over free DOFs \[mm\].
     pub step: f64,
     /// Line-search step length α.
     pub alpha: f64,
@@ -139,9 +139,9 @@ pub struct IterationRecord {
 pub struct Equilibrium {
     /// How the solve went.
     pub report: SolveReport,
-    /// Displacement of every node, model order [mm].
+    /// Displacement of every node, model order \[mm\].
     pub displacements: Vec<[f64; 3]>,
-    /// Axial force of every member, model order, tension positive [N].
+    /// Axial force of every member, model order, tension positive \[N\].
     pub forces: Vec<f64>,
     /// Indices of the slack cables.
     pub slack: Vec<usize>,
@@ -190,9 +190,9 @@ pub struct Solver {
 /// Result of evaluating the out-of-balance force at a point.
 #[derive(Debug, Clone, Copy)]
 struct Evaluation {
-    /// Max |r| over free DOFs [N].
+    /// Max |r| over free DOFs \[N\].
     residual: f64,
-    /// Max |N| over members [N].
+    /// Max |N| over members \[N\].
     force_scale: f64,
 }
 
@@ -253,7 +253,7 @@ impl Solver {
         &self.options
     }
 
-    /// Solves with per-member length errors [mm] (model order) and no extra loads.
+    /// Solves with per-member length errors \[mm\] (model order) and no extra loads.
     pub fn solve(&mut self, length_errors: &[f64]) -> Result<SolveReport, SolveError> {
         self.solve_perturbed(Perturbation {
             length_errors,
@@ -322,7 +322,7 @@ impl Solver {
         self.last
     }
 
-    /// Displacement of node `node` at the last equilibrium [mm].
+    /// Displacement of node `node` at the last equilibrium \[mm\].
     pub fn displacement(&self, node: usize) -> [f64; 3] {
         self.structure.node_dofs[node].map(|d| {
             if d == crate::structure::FIXED {
@@ -333,7 +333,7 @@ impl Solver {
         })
     }
 
-    /// Axial force of member `m` at the last equilibrium, tension positive [N].
+    /// Axial force of member `m` at the last equilibrium, tension positive \[N\].
     pub fn member_force(&self, m: usize) -> f64 {
         self.states[m].force
     }
@@ -372,7 +372,7 @@ impl Solver {
         })
     }
 
-    /// Total potential energy `Π(u) = Σ W − fᵀu` at the last point evaluated [N·mm] (for
+    /// Total potential energy `Π(u) = Σ W − fᵀu` at the last point evaluated \[N·mm\] (for
     /// tests: Π is minimal at a stable equilibrium).
     pub fn potential_energy(&self) -> f64 {
         let strain: f64 = self

@@ -28,7 +28,7 @@ impl Normals {
     }
 }
 
-/// Length errors [mm] with standard deviation `sigma` on the members whose group is in
+/// Length errors \[mm\] with standard deviation `sigma` on the members whose group is in
 /// `groups`, zero elsewhere.
 pub fn errors(
     model: &truss_core::Model,
