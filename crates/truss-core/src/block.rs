@@ -88,7 +88,7 @@ impl BlockBandMatrix {
 
     /// Sets every entry to zero, ready for assembly.
     pub fn clear(&mut self) {
-        self.a.fill(ZERO);
+        self.a.as_flattened_mut().as_flattened_mut().fill(0.0);
         self.factored = false;
     }
 
@@ -162,36 +162,41 @@ impl BlockBandMatrix {
     pub fn factor_collecting(&mut self, failures: &mut Vec<PivotFailure>, max: usize) {
         failures.clear();
         self.factored = false;
-        let (nb, q) = (self.nb, self.q);
+        let q = self.q;
         let w = q + 1;
-        for i in 0..nb {
-            let d = &self.a[i * w + q];
-            self.diag[i] = [d[0][0], d[1][1], d[2][2]];
+        for (d, row) in self.diag.iter_mut().zip(self.a.chunks_exact(w)) {
+            let a = &row[q];
+            *d = [a[0][0], a[1][1], a[2][2]];
         }
-        for i in 0..nb {
-            let ri = i * w;
+        for i in 0..self.nb {
             let j0 = i.saturating_sub(q);
-            for j in j0..i {
-                let rj = j * w;
-                let mut s = self.a[ri + j + q - i];
-                for k in j0..j {
-                    sub_mul_t(&mut s, &self.a[ri + k + q - i], &self.a[rj + k + q - j]);
+            // Rows before i (already factorised) and row i, whose blocks (i, j0 ..= i) sit at
+            // `row[q − (i − j0) ..= q]`.
+            let (done, from_i) = self.a.split_at_mut(i * w);
+            let row = &mut from_i[..w];
+            let first = q - (i - j0);
+            let earlier = done[j0 * w..].chunks_exact(w).zip(&self.inv_diag[j0..i]);
+            for (n, (row_j, inv)) in earlier.enumerate() {
+                // Blocks (i, j0 .. j) of row i and (j, j0 .. j) of row j, j = j0 + n.
+                let (left, at) = row.split_at_mut(first + n);
+                let mut s = at[0];
+                for (x, y) in left[first..].iter().zip(&row_j[q - n..q]) {
+                    sub_mul_t(&mut s, x, y);
                 }
-                let ljj = &self.a[rj + q];
-                let inv = &self.inv_diag[j];
+                let ljj = &row_j[q];
                 // Row by row: x·L_JJᵀ = s, i.e. L_JJ·xᵀ = sᵀ.
-                for row in &mut s {
-                    let x0 = row[0] * inv[0];
-                    let x1 = (row[1] - ljj[1][0] * x0) * inv[1];
-                    let x2 = (row[2] - ljj[2][0] * x0 - ljj[2][1] * x1) * inv[2];
-                    *row = [x0, x1, x2];
+                for r in &mut s {
+                    let x0 = r[0] * inv[0];
+                    let x1 = (r[1] - ljj[1][0] * x0) * inv[1];
+                    let x2 = (r[2] - ljj[2][0] * x0 - ljj[2][1] * x1) * inv[2];
+                    *r = [x0, x1, x2];
                 }
-                self.a[ri + j + q - i] = s;
+                at[0] = s;
             }
-            let mut s = self.a[ri + q];
-            for k in j0..i {
-                let l = self.a[ri + k + q - i];
-                sub_mul_t(&mut s, &l, &l);
+            let (left, at) = row.split_at_mut(q);
+            let mut s = at[0];
+            for l in &left[first..] {
+                sub_mul_t_lower(&mut s, l);
             }
             // 3×3 Cholesky of the lower triangle of s; a failed pivot is recorded and
             // replaced by the row's diagonal.
@@ -216,7 +221,7 @@ impl BlockBandMatrix {
             let i1 = 1.0 / l[1][1];
             l[2][1] = (s[2][1] - l[2][0] * l[1][0]) * i1;
             l[2][2] = pivot(2, s[2][2] - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
-            self.a[ri + q] = l;
+            at[0] = l;
             self.inv_diag[i] = [i0, i1, 1.0 / l[2][2]];
             if failures.len() >= max {
                 return;
@@ -231,41 +236,37 @@ impl BlockBandMatrix {
     /// If the matrix is not factorised, or `b` is shorter than `3·blocks`: both are bugs.
     pub fn solve_in_place(&self, b: &mut [f64]) {
         assert!(self.factored, "solve with an unfactorised matrix");
-        let (nb, q) = (self.nb, self.q);
+        let q = self.q;
         let w = q + 1;
-        let b = &mut b[..3 * nb];
-        for i in 0..nb {
-            let ri = i * w;
+        let (x, _) = b[..3 * self.nb].as_chunks_mut::<3>();
+        let rows = self.a.chunks_exact(w).zip(&self.inv_diag);
+        for (i, (row, inv)) in rows.clone().enumerate() {
             let j0 = i.saturating_sub(q);
-            let mut y = [b[3 * i], b[3 * i + 1], b[3 * i + 2]];
-            for k in j0..i {
-                let l = &self.a[ri + k + q - i];
-                let x = [b[3 * k], b[3 * k + 1], b[3 * k + 2]];
+            let (done, at) = x.split_at_mut(i);
+            let mut y = at[0];
+            for (l, xk) in row[q - (i - j0)..q].iter().zip(&done[j0..]) {
                 for (r, yr) in y.iter_mut().enumerate() {
-                    *yr -= l[r][0] * x[0] + l[r][1] * x[1] + l[r][2] * x[2];
+                    *yr -= l[r][0] * xk[0] + l[r][1] * xk[1] + l[r][2] * xk[2];
                 }
             }
-            let l = &self.a[ri + q];
-            let inv = &self.inv_diag[i];
+            let l = &row[q];
             let y0 = y[0] * inv[0];
             let y1 = (y[1] - l[1][0] * y0) * inv[1];
             let y2 = (y[2] - l[2][0] * y0 - l[2][1] * y1) * inv[2];
-            b[3 * i..3 * i + 3].copy_from_slice(&[y0, y1, y2]);
+            at[0] = [y0, y1, y2];
         }
-        for i in (0..nb).rev() {
-            let ri = i * w;
+        for (i, (row, inv)) in rows.enumerate().rev() {
             let j0 = i.saturating_sub(q);
-            let l = &self.a[ri + q];
-            let inv = &self.inv_diag[i];
-            let y = [b[3 * i], b[3 * i + 1], b[3 * i + 2]];
+            let (below, at) = x.split_at_mut(i);
+            let l = &row[q];
+            let y = at[0];
             let x2 = y[2] * inv[2];
             let x1 = (y[1] - l[2][1] * x2) * inv[1];
             let x0 = (y[0] - l[1][0] * x1 - l[2][0] * x2) * inv[0];
-            b[3 * i..3 * i + 3].copy_from_slice(&[x0, x1, x2]);
-            for k in j0..i {
-                let l = &self.a[ri + k + q - i];
-                for c in 0..3 {
-                    b[3 * k + c] -= l[0][c] * x0 + l[1][c] * x1 + l[2][c] * x2;
+            at[0] = [x0, x1, x2];
+            for (l, xk) in row[q - (i - j0)..q].iter().zip(&mut below[j0..]) {
+                for (c, xc) in xk.iter_mut().enumerate() {
+                    *xc -= l[0][c] * x0 + l[1][c] * x1 + l[2][c] * x2;
                 }
             }
         }
@@ -326,6 +327,16 @@ impl BlockBandMatrix {
                 .enumerate()
                 .map(|(c, xc)| self.get(r, c) * xc)
                 .sum();
+        }
+    }
+}
+
+/// The lower triangle of `s −= l·lᵀ` for 3×3 blocks (the upper one is never read).
+#[inline(always)]
+fn sub_mul_t_lower(s: &mut Block, l: &Block) {
+    for r in 0..3 {
+        for c in 0..=r {
+            s[r][c] -= l[r][0] * l[c][0] + l[r][1] * l[c][1] + l[r][2] * l[c][2];
         }
     }
 }

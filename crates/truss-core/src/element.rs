@@ -81,11 +81,22 @@ impl AxialMember {
     /// The member's state at relative displacement `d = u_j − u_i` \[mm\].
     #[inline]
     pub fn state(&self, d: [f64; 3]) -> AxialState {
+        self.state_with(d, self.tension_stiffness())
+    }
+
+    /// Axial stiffness in tension `k = E·A/L₀` \[N/mm\].
+    #[inline]
+    pub fn tension_stiffness(&self) -> f64 {
+        self.rigidity / self.natural_length
+    }
+
+    /// [`AxialMember::state`] with `k = E·A/L₀` given (computed once per sample).
+    #[inline(always)]
+    pub(crate) fn state_with(&self, d: [f64; 3], k: f64) -> AxialState {
         let c = add(self.reference, d);
         let length = norm(c);
         let stretch_sq = 2.0 * dot(self.reference, d) + dot(d, d);
         let elongation = stretch_sq / (length + self.reference_length) + self.initial_stretch;
-        let k = self.rigidity / self.natural_length;
         let slack = elongation < 0.0 && self.compression_ratio < 1.0;
         let stiffness = if slack { self.compression_ratio * k } else { k };
         let inv = 1.0 / length;

@@ -46,6 +46,12 @@ pub(crate) struct CompiledMember {
     pub coupling_rows_i: bool,
     /// 1 for a free direction, 0 for a fixed one, of node `i` then node `j`.
     pub masks: [[f64; 3]; 2],
+    /// Blocks of node `i` and node `j` (rows `3b .. 3b + 3`), or [`NONE`] for a node with
+    /// no free direction.
+    pub ends: [usize; 2],
+    /// Whether a node of the member has a block and a fixed direction, so that its rows
+    /// need the masks (never for a node fixed in all or no directions).
+    pub masked: bool,
 }
 
 /// A model compiled for solving (see the module doc).
@@ -133,6 +139,9 @@ impl Structure {
                     slots: [slot(bi, bi), slot(bj, bj), slot(bi, bj)],
                     coupling_rows_i: bi > bj,
                     masks: [mask(i), mask(j)],
+                    ends: [bi.unwrap_or(NONE), bj.unwrap_or(NONE)],
+                    masked: (bi.is_some() && fixed[i].iter().any(|&f| f))
+                        || (bj.is_some() && fixed[j].iter().any(|&f| f)),
                 }
             })
             .collect();
@@ -194,12 +203,38 @@ impl Structure {
 
     /// Adds a member's contribution `[[K, −K], [−K, K]]` (from the six distinct entries of
     /// the symmetric 3×3 `K`, order `[xx, yx, yy, zx, zy, zz]`), fixed directions masked.
+    /// Only the lower triangles of diagonal blocks are written (the only part read).
     #[inline]
     pub(crate) fn add_member(&self, k: &mut BlockBandMatrix, c: &CompiledMember, e: &[f64; 6]) {
-        let full: Block = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
-        let [mi, mj] = c.masks;
         let [sii, sjj, sij] = c.slots;
         let storage = k.storage_mut();
+        if !c.masked {
+            // Masks of ones: `x·1·1` is `x` exactly, so this is the masked sum without the
+            // multiplications.
+            for slot in [sii, sjj] {
+                if slot != NONE {
+                    let b = &mut storage[slot];
+                    b[0][0] += e[0];
+                    b[1][0] += e[1];
+                    b[1][1] += e[2];
+                    b[2][0] += e[3];
+                    b[2][1] += e[4];
+                    b[2][2] += e[5];
+                }
+            }
+            if sij != NONE {
+                let b = &mut storage[sij];
+                let full = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
+                for (row, f) in b.iter_mut().zip(&full) {
+                    for (x, y) in row.iter_mut().zip(f) {
+                        *x -= y;
+                    }
+                }
+            }
+            return;
+        }
+        let full: Block = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
+        let [mi, mj] = c.masks;
         if sii != NONE {
             add_masked(&mut storage[sii], &full, &mi, &mi, 1.0);
         }

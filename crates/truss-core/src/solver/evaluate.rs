@@ -6,9 +6,28 @@ use crate::element::{AxialMember, AxialState};
 use crate::structure::Structure;
 
 /// `r = g(u) − f` and the member states at `u`; returns max |r| and max |N|.
+#[cfg(test)]
 pub(super) fn evaluate(
     s: &Structure,
     members: &[AxialMember],
+    loads: &[f64],
+    u: &[f64],
+    r: &mut [f64],
+    states: &mut [AxialState],
+) -> Evaluation {
+    let k = members.iter().map(AxialMember::tension_stiffness);
+    evaluate_with(s, members, k, loads, u, r, states)
+}
+
+/// [`evaluate`] with each member's `k = E·A/L₀` given, in member order.
+///
+/// Member by member: gather `d = u_j − u_i` by node blocks (a node without a block is
+/// fixed: zero), the state, then scatter `∓N·n` into the rows of the two nodes. A member
+/// with a partly fixed node scatters row by row, skipping the fixed ones.
+pub(super) fn evaluate_with(
+    s: &Structure,
+    members: &[AxialMember],
+    k: impl Iterator<Item = f64>,
     loads: &[f64],
     u: &[f64],
     r: &mut [f64],
@@ -18,21 +37,38 @@ pub(super) fn evaluate(
     for (ri, f) in r.iter_mut().zip(loads) {
         *ri = -f;
     }
+    let (ub, _) = u[..n].as_chunks::<3>();
     let mut force_scale = 0.0f64;
-    for ((c, m), st) in s.members.iter().zip(members).zip(states.iter_mut()) {
-        let dof = c.dofs;
-        let d = [
-            u[dof[3]] - u[dof[0]],
-            u[dof[4]] - u[dof[1]],
-            u[dof[5]] - u[dof[2]],
-        ];
-        *st = m.state(d);
+    for (((c, m), st), k) in s.members.iter().zip(members).zip(states.iter_mut()).zip(k) {
+        let [a, b] = c.ends;
+        let ua = ub.get(a).copied().unwrap_or([0.0; 3]);
+        let uj = ub.get(b).copied().unwrap_or([0.0; 3]);
+        *st = m.state_with([uj[0] - ua[0], uj[1] - ua[1], uj[2] - ua[2]], k);
         let f = st.force;
         force_scale = force_scale.max(f.abs());
-        for k in 0..3 {
-            let fk = f * st.direction[k];
-            r[dof[k]] -= fk;
-            r[dof[3 + k]] += fk;
+        let fk = [
+            f * st.direction[0],
+            f * st.direction[1],
+            f * st.direction[2],
+        ];
+        if c.masked {
+            let dof = c.dofs;
+            for k in 0..3 {
+                r[dof[k]] -= fk[k];
+                r[dof[3 + k]] += fk[k];
+            }
+        } else {
+            let (rb, _) = r[..n].as_chunks_mut::<3>();
+            if let Some(ra) = rb.get_mut(a) {
+                for (x, y) in ra.iter_mut().zip(&fk) {
+                    *x -= y;
+                }
+            }
+            if let Some(rj) = rb.get_mut(b) {
+                for (x, y) in rj.iter_mut().zip(&fk) {
+                    *x += y;
+                }
+            }
         }
     }
     r[n] = 0.0;

@@ -1,7 +1,7 @@
 //! The line search: a bracket on the directional derivative of the energy, seeded by an
 //! exact minimiser of the piecewise quadratic model along the line.
 
-use super::evaluate::{dot_n, evaluate, max_abs};
+use super::evaluate::{dot_n, evaluate_with, max_abs};
 use super::{Evaluation, Solver};
 use crate::SolveError;
 
@@ -101,12 +101,13 @@ impl Solver {
         let d = &self.d;
         let mut curvature = 0.0;
         self.breakpoints.clear();
-        for ((c, st), m) in self
+        for (((c, st), m), &k) in self
             .structure
             .members
             .iter()
             .zip(&self.states)
             .zip(&self.members)
+            .zip(&self.tension)
         {
             let dv = [
                 d[c.dofs[3]] - d[c.dofs[0]],
@@ -120,7 +121,6 @@ impl Solver {
             if c.is_cable && along != 0.0 {
                 let at = -st.elongation / along;
                 if at > 0.0 && at < cap {
-                    let k = m.rigidity / m.natural_length;
                     let jump = (1.0 - m.compression_ratio) * k * along * along;
                     // Slack → taut stiffens; taut → slack softens.
                     self.breakpoints
@@ -155,9 +155,10 @@ impl Solver {
         for ((t, u), d) in self.trial_u.iter_mut().zip(&self.u).zip(&self.d) {
             *t = u + alpha * d;
         }
-        evaluate(
+        evaluate_with(
             &self.structure,
             &self.members,
+            self.tension.iter().copied(),
             &self.loads,
             &self.trial_u,
             &mut self.trial_r,

@@ -165,6 +165,8 @@ pub struct Solver {
     structure: Arc<Structure>,
     options: SolveOptions,
     members: Vec<AxialMember>,
+    /// Each member's `k = E·A/L₀` for the current sample \[N/mm\].
+    tension: Vec<f64>,
     states: Vec<AxialState>,
     trial_states: Vec<AxialState>,
     slack: Vec<bool>,
@@ -219,6 +221,7 @@ impl Solver {
         Self {
             k: BlockBandMatrix::new(structure.nominal.blocks(), structure.bandwidth()),
             options,
+            tension: members.iter().map(AxialMember::tension_stiffness).collect(),
             members,
             states: vec![zero_state; m],
             trial_states: vec![zero_state; m],
@@ -298,6 +301,7 @@ impl Solver {
                 )));
             }
             self.members[i] = s.nominal_member(c, e);
+            self.tension[i] = self.members[i].tension_stiffness();
         }
         self.loads.copy_from_slice(&s.loads);
         for (node, f) in p.extra_loads.iter().enumerate() {

@@ -1,7 +1,7 @@
 //! The iteration of the module doc: the linearised problem, then chord steps or model
 //! steps, each followed by a line search, until converged.
 
-use super::evaluate::{evaluate, max_abs};
+use super::evaluate::{evaluate_with, max_abs};
 use super::step::Step;
 use super::{IterationRecord, Mode, SolveReport, Solver};
 use crate::SolveError;
@@ -29,9 +29,10 @@ impl Solver {
                 Mode::Tangent
             }
         };
-        let mut eval = evaluate(
+        let mut eval = evaluate_with(
             &structure,
             &self.members,
+            self.tension.iter().copied(),
             &self.loads,
             &self.u,
             &mut self.r,

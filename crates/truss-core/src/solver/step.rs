@@ -99,7 +99,7 @@ impl Solver {
             let s = &*self.structure;
             for (m, c) in s.members.iter().enumerate() {
                 if c.is_cable && self.factor_slack[m] != self.slack[m] {
-                    let k = self.members[m].rigidity / self.members[m].natural_length;
+                    let k = self.tension[m];
                     let k_model = if self.factor_slack[m] {
                         c.compression_ratio * k
                     } else {
@@ -242,7 +242,7 @@ impl Solver {
         let s = &*self.structure;
         for (m, (c, st)) in s.members.iter().zip(&self.states).enumerate() {
             let stiffness = if c.is_cable && self.factor_slack[m] != st.slack {
-                let k = self.members[m].rigidity / self.members[m].natural_length;
+                let k = self.tension[m];
                 if self.factor_slack[m] {
                     c.compression_ratio * k
                 } else {
