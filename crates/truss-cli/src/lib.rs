@@ -7,17 +7,23 @@
 //!   truss to stdout (Table 1 defaults, every one overridable).
 //! - `truss solve MODEL.json [--length-error ID=MM]...` solves the model's equilibrium and
 //!   prints a JSON result (see [`solve::SolveOutput`]).
+//! - `truss diagnose --job J --case NAME --measured M.csv --out DIR` compares measurements
+//!   with the case's simulation, names the missing effect, writes the updated job and shows
+//!   the gap shrink (the `truss_diagnose` crate; [`diagnose`]).
+//! - `truss synth-measured --job J --case NAME --specimens N --seed S --effect NAME:P=V,…`
+//!   writes measured data with a hidden effect to stdout ([`truss_diagnose::synth`]).
 //!
 //! ## Exit codes
 //!
 //! | code | meaning |
 //! |---|---|
 //! | 0 | success |
-//! | 1 | the solve failed (not converged, mechanism); the JSON result says why |
+//! | 1 | the solve failed (not converged, mechanism); the JSON result says why; or a diagnosis's simulation failed |
 //! | 2 | usage error (bad arguments) |
-//! | 3 | the model file is invalid (the message names the item) |
+//! | 3 | the model file, job or measured data is invalid (the message names the item or line) |
 //! | 4 | a file could not be read or written |
 
+pub mod diagnose;
 pub mod solve;
 
 use clap::{Args, Parser, Subcommand};
@@ -59,6 +65,11 @@ pub enum Command {
     },
     /// Solve a model file's equilibrium and print the result as JSON.
     Solve(SolveArgs),
+    /// Compare measured trusses with a job case's simulation: where they disagree, which
+    /// effect is missing (fitted), the updated job, and the gap before and after.
+    Diagnose(diagnose::DiagnoseArgs),
+    /// Write measured data (CSV, stdout) made from a case with a hidden effect.
+    SynthMeasured(diagnose::SynthArgs),
 }
 
 /// Model generators.
@@ -156,6 +167,9 @@ pub enum CliError {
     /// Output could not be written.
     #[error("cannot write output: {0}")]
     Io(#[from] std::io::Error),
+    /// A diagnosis (or synthetic measurement) failed.
+    #[error(transparent)]
+    Diagnose(#[from] truss_diagnose::DiagnoseError),
 }
 
 impl From<truss_core::ModelError> for CliError {
@@ -171,6 +185,7 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
         Some(CliError::Model(truss_core::ModelError::Io { .. })) | Some(CliError::Io(_)) => EXIT_IO,
         Some(CliError::Model(_)) => EXIT_BAD_MODEL,
         Some(CliError::Solve(_)) => EXIT_SOLVE_FAILED,
+        Some(CliError::Diagnose(e)) => diagnose::exit_code(e),
         None => EXIT_IO,
     }
 }
@@ -186,6 +201,8 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> anyhow::Result<()> {
                 .map_err(CliError::from)?;
         }
         Command::Solve(args) => solve::run(&args, out)?,
+        Command::Diagnose(args) => diagnose::run_diagnose(&args, out)?,
+        Command::SynthMeasured(args) => diagnose::run_synth(&args, out)?,
     }
     Ok(())
 }

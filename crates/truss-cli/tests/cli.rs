@@ -124,3 +124,129 @@ fn a_failed_solve_prints_why_and_exits_1() {
     assert_eq!(r["converged"], false);
     assert!(r["error"].as_str().unwrap().contains("natural length"));
 }
+
+fn job_path() -> String {
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../jobs/diagnose-baseline.json"
+    )
+    .to_string()
+}
+
+/// `synth-measured` then `diagnose`, as a user runs them: a strong hidden pretension on 40
+/// specimens is named, every output file is written, and the updated job is a valid job
+/// whose case carries the fitted diagonal length error.
+#[test]
+fn synth_measured_then_diagnose_names_the_hidden_effect() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = job_path();
+    let out = truss(&[
+        "synth-measured",
+        "--job",
+        &job,
+        "--case",
+        "as-built",
+        "--specimens",
+        "40",
+        "--seed",
+        "5",
+        "--effect",
+        "diagonal_pretension:length_error=-0.08",
+        "--measurement-sigma",
+        "0.001",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("specimen,node,x,y,z\n"));
+    assert_eq!(text.lines().count(), 1 + 40 * 3);
+    let measured = dir.path().join("m.csv");
+    std::fs::write(&measured, text).unwrap();
+    let report = dir.path().join("report");
+    let out = truss(&[
+        "diagnose",
+        "--job",
+        &job,
+        "--case",
+        "as-built",
+        "--measured",
+        measured.to_str().unwrap(),
+        "--measurement-sigma",
+        "0.001",
+        "--samples",
+        "600",
+        "--out",
+        report.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.starts_with("named_effect: diagonal_pretension\n"),
+        "{stdout}"
+    );
+    // Progress went to stderr.
+    assert!(String::from_utf8_lossy(&out.stderr).contains("fitting length_sigma"));
+    for f in [
+        "diagnosis.json",
+        "diagnosis.md",
+        "updated-job.json",
+        "theta_p-ecdf-before.svg",
+        "theta_p-ecdf-after.svg",
+        "top-scatter-before.svg",
+        "top-scatter-after.svg",
+    ] {
+        assert!(report.join(f).is_file(), "{f} missing");
+    }
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("diagnosis.json")).unwrap())
+            .unwrap();
+    assert_eq!(d["named_effect"], "diagonal_pretension");
+    assert!(d["indistinguishable"].is_array());
+    assert!(d["statistics"]["after"]["statistics"].is_array());
+    assert!(d["discrepancy_after"].as_f64().unwrap() < d["discrepancy_before"].as_f64().unwrap());
+    let updated =
+        truss_diagnose::baseline::Baseline::read(&report.join("updated-job.json"), "as-built")
+            .unwrap();
+    let fitted = d["parameters"][0]["value"].as_f64().unwrap();
+    match updated.distributions().get("diagonal") {
+        Some(mc_dist) => assert!((mc_dist.mean() - fitted).abs() < 1e-12),
+        None => panic!("the updated case has no diagonal length error"),
+    }
+    assert_eq!(updated.case().samples, 4000);
+}
+
+/// A bad row is an invalid-data error (exit 3) naming the file and line.
+#[test]
+fn diagnose_reports_a_bad_row_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let measured = dir.path().join("m.csv");
+    std::fs::write(
+        &measured,
+        "specimen,node,x,y,z\r\nA,n5.0,0,0,1900\r\nA,n5.1,380,zero,1900\r\n",
+    )
+    .unwrap();
+    let out = truss(&[
+        "diagnose",
+        "--job",
+        &job_path(),
+        "--case",
+        "as-built",
+        "--measured",
+        measured.to_str().unwrap(),
+        "--out",
+        dir.path().join("r").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("m.csv:3: y = \"zero\" is not a finite number"),
+        "{err}"
+    );
+}

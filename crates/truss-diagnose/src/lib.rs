@@ -1,1 +1,192 @@
-//! Diagnosis of measured trusses against simulation (under construction).
+//! # truss-diagnose: where simulation and measurement disagree, and which effect is missing
+//!
+//! An engineer has built trusses (or reassembled one many times) and measured them. This
+//! crate compares the measurements with the Monte Carlo prediction of a baseline job case,
+//! says where they disagree, names the physical effect the model is missing with its fitted
+//! size, writes the updated job, and shows the disagreement shrink.
+//!
+//! ```text
+//! truss diagnose --job BASELINE.json --case NAME --measured M.csv [--measured-members MM.csv]
+//!                [--measurement-sigma MM] [--samples N] --out DIR
+//! truss synth-measured --job J --case NAME --specimens N --seed S --effect NAME:P=V,…
+//!                [--measurement-sigma MM] [--all-nodes] [--members-out MM.csv] > M.csv
+//! ```
+//!
+//! ## Workflow
+//!
+//! 1. **Where** ([`compare`]). The baseline case is simulated with N samples (default
+//!    max(2000, 20·n), at most 10 000, for n specimens: the simulation's noise is at most
+//!    a twentieth of the data's in variance) under the job's seed and the case's name, so
+//!    every later simulation sees the same random words (common random numbers), with the
+//!    instrument's noise σ_m added to every simulated coordinate. Means, standard
+//!    deviations and covariances of every measured coordinate's displacement, of the top
+//!    surface's height (piston), tan θ_x and tan θ_y, θ_P's percentiles, a KS test on θ_P and
+//!    an energy-distance test on the displacement vectors, each with a 95 % interval and a
+//!    sentence; Holm-adjusted p-values say which disagree.
+//! 2. **Which effect** ([`candidates`], [`likelihood`], [`fit`], [`diagnose`]). Each
+//!    candidate's Gaussian synthetic likelihood is maximised over its parameters; candidates
+//!    are compared with the baseline by a likelihood-ratio test (χ²_k, Bonferroni over the
+//!    candidates, the statistic deflated by 1 + n/N for the simulation's own noise) and with
+//!    each other by BIC = −2ℓ + k ln n. The verdict is one of
+//!    - `named`: the best candidate by BIC is significant and better than the baseline by
+//!      ΔBIC ≤ −2; candidates within ΔBIC 2 of it are listed as *indistinguishable*;
+//!    - `cannot_tell`: some candidate improves the fit but not both significantly and by
+//!      that margin; or none does, and the intervals are too wide to show that the baseline
+//!      agrees within tolerance (see [`compare`]): more specimens are needed;
+//!    - `none`: no candidate improves the fit and the baseline agrees within tolerance;
+//!    - `unexplained`: no candidate improves the fit, yet the baseline disagrees (a
+//!      Holm-significant statistic, with at least 30 specimens; with fewer: `cannot_tell`).
+//! 3. **Add it**: `DIR/updated-job.json`, the baseline job with the named effect in the
+//!    case at its fitted values (same case name), which mc-shard and mc-merge run as usual.
+//! 4. **The gap shrinks**: step 1 again with the effect; every statistic before and after,
+//!    and the overall discrepancy (the energy distance) before and after.
+//!
+//! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
+//! plots of [`plot`]. Progress goes to stderr.
+//!
+//! ## Candidate effects
+//!
+//! `gravity`, `thermal_gradient`, `length_bias`, `length_sigma`, `diagonal_pretension`
+//! (parameters and ranges in [`candidates`]). `backlash` waits for joint clearances in
+//! truss-core and the job format; it will be one more [`candidates::Candidate`].
+//!
+//! ## Measured data
+//!
+//! See [`measured`]: CSV with a header, any column and row order, quoting and CRLF; bad rows
+//! are errors with their line; specimens missing a compared node are left out and counted.
+
+pub mod baseline;
+pub mod candidates;
+pub mod compare;
+pub mod diagnose;
+mod errors;
+pub mod fit;
+pub mod likelihood;
+pub mod measured;
+pub mod plot;
+pub mod report;
+pub mod simulate;
+pub mod synth;
+
+pub use errors::DiagnoseError;
+
+use std::path::PathBuf;
+
+/// Options of `truss diagnose`.
+#[derive(Debug, Clone)]
+pub struct DiagnoseOptions {
+    /// The baseline job.
+    pub job: PathBuf,
+    /// The case.
+    pub case: String,
+    /// The node CSV.
+    pub measured: PathBuf,
+    /// The member CSV, if any.
+    pub measured_members: Option<PathBuf>,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Settings.
+    pub settings: diagnose::Settings,
+    /// Draw plots.
+    pub plots: bool,
+}
+
+/// What `run` found, for the caller's summary line.
+#[derive(Debug, Clone)]
+pub struct Summary {
+    /// The verdict.
+    pub verdict: diagnose::Verdict,
+    /// The named effect or `none`.
+    pub named_effect: String,
+    /// The reason.
+    pub reason: String,
+    /// Discrepancy before and after.
+    pub discrepancy: (f64, f64),
+    /// Files written.
+    pub files: Vec<PathBuf>,
+}
+
+/// Fewest specimens accepted.
+pub const MIN_SPECIMENS: usize = 5;
+
+/// Runs the diagnosis and writes `diagnosis.json`, `diagnosis.md`, `updated-job.json` and
+/// the plots into the output directory.
+pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
+    let s = &options.settings;
+    if !(s.measurement_sigma >= 0.0 && s.measurement_sigma.is_finite()) {
+        return Err(DiagnoseError::Usage(
+            "--measurement-sigma must be a non-negative number of mm".into(),
+        ));
+    }
+    if s.samples.is_some_and(|n| n < 100) {
+        return Err(DiagnoseError::Usage(
+            "--samples must be at least 100".into(),
+        ));
+    }
+    let progress = diagnose::Progress::new(s.quiet);
+    let base = baseline::Baseline::read(&options.job, &options.case)?;
+    let data = measured::read(
+        base.model(),
+        &options.measured,
+        options.measured_members.as_deref(),
+        MIN_SPECIMENS,
+    )?;
+    if data.report.left_out_count > 0 {
+        progress.note(&format!(
+            "{} specimens left out for a missing node",
+            data.report.left_out_count
+        ));
+    }
+    let d = diagnose::diagnose(&base, &data, s, &progress)?;
+    let dir = &options.out;
+    std::fs::create_dir_all(dir).map_err(|e| DiagnoseError::io(dir, e))?;
+    let mut files = Vec::new();
+    let mut plots = Vec::new();
+    if options.plots {
+        plots.extend(plot::draw(
+            dir,
+            "before",
+            &data,
+            &d.simulations.0,
+            d.top,
+            "the baseline",
+        )?);
+        if let Some(sim) = &d.simulations.1 {
+            let label = format!("with {}", report::named_effect(&d));
+            plots.extend(plot::draw(dir, "after", &data, sim, d.top, &label)?);
+        }
+    }
+    let write = |name: &str, text: &str, files: &mut Vec<PathBuf>| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).map_err(|e| DiagnoseError::io(&p, e))?;
+        files.push(p);
+        Ok::<(), DiagnoseError>(())
+    };
+    write(
+        "diagnosis.json",
+        &report::json(&base, &data, &d, s.measurement_sigma),
+        &mut files,
+    )?;
+    write(
+        "diagnosis.md",
+        &report::markdown(&base, &data, &d, &plots),
+        &mut files,
+    )?;
+    write(
+        "updated-job.json",
+        &base.updated_job_json(&d.updated),
+        &mut files,
+    )?;
+    files.extend(plots.iter().map(|p| dir.join(p)));
+    progress.note(&format!("wrote {}", dir.display()));
+    Ok(Summary {
+        verdict: d.verdict,
+        named_effect: report::named_effect(&d).to_string(),
+        reason: d.reason.clone(),
+        discrepancy: (
+            d.before.energy,
+            d.after.as_ref().map_or(d.before.energy, |a| a.energy),
+        ),
+        files,
+    })
+}

@@ -1,0 +1,131 @@
+//! `truss diagnose` and `truss synth-measured`: argument parsing over the `truss_diagnose`
+//! library, which does the work.
+
+use crate::{CliError, EXIT_BAD_MODEL, EXIT_IO, EXIT_SOLVE_FAILED, EXIT_USAGE};
+use clap::Args;
+use std::io::Write;
+use std::path::PathBuf;
+use truss_diagnose::DiagnoseError;
+
+/// Options of `truss diagnose`.
+#[derive(Debug, Args)]
+pub struct DiagnoseArgs {
+    /// The baseline job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// The case of the job the measurements are compared with.
+    #[arg(long)]
+    pub case: String,
+    /// Measured node positions: CSV `specimen,node,x,y,z` [mm].
+    #[arg(long)]
+    pub measured: PathBuf,
+    /// Measured member length errors: CSV `specimen,member,length_error` [mm].
+    #[arg(long)]
+    pub measured_members: Option<PathBuf>,
+    /// The instrument's standard deviation per coordinate [mm].
+    #[arg(long, default_value_t = 0.0)]
+    pub measurement_sigma: f64,
+    /// Simulated samples per evaluation (default max(2000, 20 × specimens), at most 10 000).
+    #[arg(long)]
+    pub samples: Option<usize>,
+    /// Output directory (diagnosis.json, diagnosis.md, updated-job.json, plots).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// No SVG plots.
+    #[arg(long)]
+    pub no_plots: bool,
+    /// No progress on stderr.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Options of `truss synth-measured`.
+#[derive(Debug, Args)]
+pub struct SynthArgs {
+    /// The baseline job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// The case to make specimens of.
+    #[arg(long)]
+    pub case: String,
+    /// Number of specimens.
+    #[arg(long)]
+    pub specimens: usize,
+    /// Seed of the specimens (independent of the job's seed).
+    #[arg(long)]
+    pub seed: u64,
+    /// The hidden effect: `none`, or `NAME:PARAM=VALUE,…` (unnamed parameters at their
+    /// baseline values), e.g. `thermal_gradient:gradient_x=0.002`.
+    #[arg(long)]
+    pub effect: String,
+    /// The instrument's standard deviation per coordinate [mm].
+    #[arg(long, default_value_t = 0.0)]
+    pub measurement_sigma: f64,
+    /// Write every node, not only the top surface.
+    #[arg(long)]
+    pub all_nodes: bool,
+    /// Also write measured member length errors to this CSV.
+    #[arg(long)]
+    pub members_out: Option<PathBuf>,
+}
+
+/// The exit code of a diagnosis error (see the crate doc).
+pub fn exit_code(e: &DiagnoseError) -> u8 {
+    if e.is_io() {
+        return EXIT_IO;
+    }
+    match e {
+        DiagnoseError::Usage(_) | DiagnoseError::NoCase { .. } => EXIT_USAGE,
+        DiagnoseError::Simulation { .. } => EXIT_SOLVE_FAILED,
+        _ => EXIT_BAD_MODEL,
+    }
+}
+
+/// Runs `truss diagnose`; prints the verdict and the files written.
+pub fn run_diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let options = truss_diagnose::DiagnoseOptions {
+        job: args.job.clone(),
+        case: args.case.clone(),
+        measured: args.measured.clone(),
+        measured_members: args.measured_members.clone(),
+        out: args.out.clone(),
+        settings: truss_diagnose::diagnose::Settings {
+            samples: args.samples,
+            measurement_sigma: args.measurement_sigma,
+            quiet: args.quiet,
+            ..Default::default()
+        },
+        plots: !args.no_plots,
+    };
+    let s = truss_diagnose::run(&options)?;
+    writeln!(
+        out,
+        "named_effect: {}\nverdict: {:?}\nreason: {}\ndiscrepancy: {:.4} before, {:.4} after",
+        s.named_effect, s.verdict, s.reason, s.discrepancy.0, s.discrepancy.1
+    )?;
+    for f in &s.files {
+        writeln!(out, "wrote {}", f.display())?;
+    }
+    Ok(())
+}
+
+/// Runs `truss synth-measured`, the CSV to `out`.
+pub fn run_synth(args: &SynthArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let options = truss_diagnose::synth::SynthOptions {
+        job: args.job.clone(),
+        case: args.case.clone(),
+        specimens: args.specimens,
+        seed: args.seed,
+        effect: args.effect.clone(),
+        measurement_sigma: args.measurement_sigma,
+        all_nodes: args.all_nodes,
+        members_out: args.members_out.clone(),
+    };
+    if args.specimens == 0 {
+        return Err(CliError::Usage("--specimens must be at least 1".into()));
+    }
+    let mut buf = std::io::BufWriter::new(out);
+    truss_diagnose::synth::synth(&options, &mut buf)?;
+    buf.flush()?;
+    Ok(())
+}

@@ -1,0 +1,488 @@
+//! The library of candidate effects: physical mechanisms the baseline may lack, each with a
+//! few parameters in a plausible range, applied to a case through mc-shard's job format.
+//!
+//! | name | parameters | what it does to the case |
+//! |---|---|---|
+//! | `gravity` | `g_x`, `g_y`, `g_z` [g], the self-weight vector in units of standard gravity, \|g\| ≤ 1 | `effects.gravity` with direction g/\|g\| and acceleration 9.806 65·\|g\| m/s² (aluminium 2700 kg/m³, each member's weight lumped half to each end). Its direction is the test orientation's gravity direction; \|g\| < 1 is a partly off-loaded ground test |
+//! | `thermal_gradient` | `gradient_x`, `gradient_y`, `gradient_z` [K/mm] in ±0.01, `offset` [K] in ±20 | `effects.thermal_gradient`: ΔT(x) = offset + gradient·(x − c), c the centroid of the model's nodes, α = 23e-6 /K; each member lengthens by α·ΔT(midpoint)·L |
+//! | `length_bias` | `bias.GROUP` [mm] in ±0.1 for each bar group | adds the bias to the group's length-error mean (a constant if it has none) |
+//! | `length_sigma` | `sigma.GROUP` [mm] from 1/5 to 5 times the stated σ, for each group with a stated spread | scales the group's spread about its mean to the new σ |
+//! | `diagonal_pretension` | `length_error` [mm] in [−0.2, 0] | adds a common length error to every cable group: diagonals made short, so pretensioned (lengthening them instead would make them slack, a different mechanism whose likelihood is not smooth at the null) |
+//! | `backlash` | (not yet: waits for joint clearances in truss-core and the job format) | |
+//!
+//! Every candidate reduces to the baseline at its *null* parameters (zero, or the stated σ),
+//! so the baseline is nested in it and a likelihood-ratio test applies (for
+//! `diagonal_pretension` the null is the end of the range, where P(χ²₁ ≥ Λ) is conservative:
+//! the null distribution is ½χ²₀ + ½χ²₁). A new mechanism is
+//! one more implementation of [`Candidate`]: its parameters and how it edits a [`CaseEdit`]
+//! (case fields, or the case's model, as backlash will).
+
+use crate::baseline::{Baseline, CaseEdit};
+use crate::errors::DiagnoseError;
+use mc_shard::distribution::DistributionSpec;
+use mc_shard::effects::{
+    ALUMINIUM_ALPHA, ALUMINIUM_DENSITY, GravitySpec, STANDARD_GRAVITY, ThermalSpec,
+};
+
+/// One parameter of a candidate and its plausible range.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Parameter {
+    /// Name, as in reports and `--effect NAME:PARAM=VALUE`.
+    pub name: String,
+    /// Unit.
+    pub unit: &'static str,
+    /// Lower end of the plausible range.
+    pub low: f64,
+    /// Upper end of the plausible range.
+    pub high: f64,
+    /// The value at which the candidate is the baseline.
+    pub null: f64,
+    /// Whether the fit works on its logarithm (a scale parameter; `low > 0`).
+    pub log: bool,
+}
+
+impl Parameter {
+    fn linear(name: impl Into<String>, unit: &'static str, low: f64, high: f64, null: f64) -> Self {
+        Self {
+            name: name.into(),
+            unit,
+            low,
+            high,
+            null,
+            log: false,
+        }
+    }
+
+    /// The value at internal coordinate `t ∈ [0, 1]`.
+    pub fn value(&self, t: f64) -> f64 {
+        if self.log {
+            (self.low.ln() + t * (self.high.ln() - self.low.ln())).exp()
+        } else {
+            self.low + t * (self.high - self.low)
+        }
+    }
+
+    /// The internal coordinate of `v`.
+    pub fn internal(&self, v: f64) -> f64 {
+        if self.log {
+            (v.ln() - self.low.ln()) / (self.high.ln() - self.low.ln())
+        } else {
+            (v - self.low) / (self.high - self.low)
+        }
+    }
+}
+
+/// A physical mechanism the baseline may lack.
+pub trait Candidate: Send + Sync {
+    /// The name reports use (`gravity`, `thermal_gradient`, …).
+    fn name(&self) -> &'static str;
+    /// One line on the mechanism, for the report.
+    fn mechanism(&self) -> &'static str;
+    /// The parameters and their plausible ranges.
+    fn parameters(&self) -> &[Parameter];
+    /// Applies the effect with `values` (one per parameter) to the case.
+    fn apply(&self, values: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError>;
+    /// Moves `values` onto the feasible set if the box alone does not describe it
+    /// (gravity's \|g\| ≤ 1); the default does nothing.
+    fn project(&self, _values: &mut [f64]) {}
+}
+
+/// The applicable candidates, and the (name, reason) of those that are not.
+pub type Library = (Vec<Box<dyn Candidate>>, Vec<(String, String)>);
+
+/// The candidates that apply to the baseline case, and the names of those that do not,
+/// with why.
+pub fn library(baseline: &Baseline) -> Library {
+    let mut out: Vec<Box<dyn Candidate>> = Vec::new();
+    let mut skipped = Vec::new();
+    let case = baseline.case();
+    let model = baseline.model();
+    let mut bar_groups = Vec::new();
+    let mut cable_groups = Vec::new();
+    for g in model.groups() {
+        let cable = model
+            .members()
+            .iter()
+            .filter(|m| m.group == g)
+            .all(|m| m.behaviour.is_cable());
+        if cable {
+            cable_groups.push(g.to_string());
+        } else {
+            bar_groups.push(g.to_string());
+        }
+    }
+    // backlash: waits for the joint-clearance model (see the crate doc).
+    skipped.push((
+        "backlash".to_string(),
+        "not available yet: truss-core has no joint clearances".to_string(),
+    ));
+    if case.effects.gravity.is_some() {
+        skipped.push(("gravity".into(), "the baseline already has gravity".into()));
+    } else {
+        out.push(Box::new(Gravity::new()));
+    }
+    if case.effects.thermal_gradient.is_some() {
+        skipped.push((
+            "thermal_gradient".into(),
+            "the baseline already has a temperature field".into(),
+        ));
+    } else {
+        let n = model.nodes().len() as f64;
+        let mut c = [0.0; 3];
+        for node in model.nodes() {
+            for (ck, x) in c.iter_mut().zip(node.xyz) {
+                *ck += x / n;
+            }
+        }
+        out.push(Box::new(Thermal::new(c)));
+    }
+    if bar_groups.is_empty() {
+        skipped.push(("length_bias".into(), "the model has no bar group".into()));
+    } else {
+        out.push(Box::new(LengthBias::new(bar_groups)));
+    }
+    let spread: Vec<(String, f64)> = case
+        .length_errors
+        .iter()
+        .filter(|(_, d)| d.std_dev() > 0.0)
+        .map(|(g, d)| (g.clone(), d.std_dev()))
+        .collect();
+    if spread.is_empty() {
+        skipped.push((
+            "length_sigma".into(),
+            "the baseline states no length-error spread".into(),
+        ));
+    } else {
+        out.push(Box::new(LengthSigma::new(spread)));
+    }
+    if cable_groups.is_empty() {
+        skipped.push((
+            "diagonal_pretension".into(),
+            "the model has no cable group".into(),
+        ));
+    } else {
+        out.push(Box::new(DiagonalPretension::new(cable_groups)));
+    }
+    (out, skipped)
+}
+
+/// Adds `shift` to a distribution's values.
+fn shifted(d: Option<DistributionSpec>, shift: f64) -> DistributionSpec {
+    match d {
+        None => DistributionSpec::Constant { value: shift },
+        Some(DistributionSpec::Normal { mean, sigma }) => DistributionSpec::Normal {
+            mean: mean + shift,
+            sigma,
+        },
+        Some(DistributionSpec::Uniform { low, high }) => DistributionSpec::Uniform {
+            low: low + shift,
+            high: high + shift,
+        },
+        Some(DistributionSpec::Constant { value }) => DistributionSpec::Constant {
+            value: value + shift,
+        },
+    }
+}
+
+/// Self-weight of a ground test.
+pub struct Gravity {
+    parameters: Vec<Parameter>,
+}
+
+impl Gravity {
+    fn new() -> Self {
+        Self {
+            parameters: ["g_x", "g_y", "g_z"]
+                .iter()
+                .map(|n| Parameter::linear(*n, "g", -1.0, 1.0, 0.0))
+                .collect(),
+        }
+    }
+}
+
+impl Candidate for Gravity {
+    fn name(&self) -> &'static str {
+        "gravity"
+    }
+    fn mechanism(&self) -> &'static str {
+        "ground-test self-weight along the test orientation's gravity direction"
+    }
+    fn parameters(&self) -> &[Parameter] {
+        &self.parameters
+    }
+    fn apply(&self, v: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError> {
+        let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let mut effects = edit.effects();
+        effects.gravity = (norm > 0.0).then(|| GravitySpec {
+            direction: [v[0] / norm, v[1] / norm, v[2] / norm],
+            g: STANDARD_GRAVITY * norm,
+            density: ALUMINIUM_DENSITY,
+        });
+        edit.set_effects(&effects);
+        Ok(())
+    }
+    fn project(&self, v: &mut [f64]) {
+        let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if norm > 1.0 {
+            v.iter_mut().for_each(|x| *x /= norm);
+        }
+    }
+}
+
+/// A linear temperature field.
+pub struct Thermal {
+    parameters: Vec<Parameter>,
+    reference: [f64; 3],
+}
+
+impl Thermal {
+    fn new(reference: [f64; 3]) -> Self {
+        let mut parameters: Vec<Parameter> = ["gradient_x", "gradient_y", "gradient_z"]
+            .iter()
+            .map(|n| Parameter::linear(*n, "K/mm", -0.01, 0.01, 0.0))
+            .collect();
+        parameters.push(Parameter::linear("offset", "K", -20.0, 20.0, 0.0));
+        Self {
+            parameters,
+            reference,
+        }
+    }
+}
+
+impl Candidate for Thermal {
+    fn name(&self) -> &'static str {
+        "thermal_gradient"
+    }
+    fn mechanism(&self) -> &'static str {
+        "a linear temperature field (gradient and uniform offset about the model's centroid), aluminium α = 23e-6 /K"
+    }
+    fn parameters(&self) -> &[Parameter] {
+        &self.parameters
+    }
+    fn apply(&self, v: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError> {
+        let mut effects = edit.effects();
+        effects.thermal_gradient = v.iter().any(|&x| x != 0.0).then(|| ThermalSpec {
+            gradient: [v[0], v[1], v[2]],
+            offset: v[3],
+            alpha: ALUMINIUM_ALPHA,
+            reference: self.reference,
+        });
+        edit.set_effects(&effects);
+        Ok(())
+    }
+}
+
+/// A systematic length offset per bar group.
+pub struct LengthBias {
+    groups: Vec<String>,
+    parameters: Vec<Parameter>,
+}
+
+impl LengthBias {
+    fn new(groups: Vec<String>) -> Self {
+        let parameters = groups
+            .iter()
+            .map(|g| Parameter::linear(format!("bias.{g}"), "mm", -0.1, 0.1, 0.0))
+            .collect();
+        Self { groups, parameters }
+    }
+}
+
+impl Candidate for LengthBias {
+    fn name(&self) -> &'static str {
+        "length_bias"
+    }
+    fn mechanism(&self) -> &'static str {
+        "a systematic member-length offset per bar group (members made long or short on average)"
+    }
+    fn parameters(&self) -> &[Parameter] {
+        &self.parameters
+    }
+    fn apply(&self, v: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError> {
+        for (g, &b) in self.groups.iter().zip(v) {
+            if b != 0.0 {
+                let d = shifted(edit.distribution(g), b);
+                edit.set_distribution(g, d);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A mis-stated manufacturing σ per group.
+pub struct LengthSigma {
+    groups: Vec<(String, f64)>,
+    parameters: Vec<Parameter>,
+}
+
+impl LengthSigma {
+    fn new(groups: Vec<(String, f64)>) -> Self {
+        let parameters = groups
+            .iter()
+            .map(|(g, s)| Parameter {
+                name: format!("sigma.{g}"),
+                unit: "mm",
+                low: s / 5.0,
+                high: s * 5.0,
+                null: *s,
+                log: true,
+            })
+            .collect();
+        Self { groups, parameters }
+    }
+}
+
+impl Candidate for LengthSigma {
+    fn name(&self) -> &'static str {
+        "length_sigma"
+    }
+    fn mechanism(&self) -> &'static str {
+        "a mis-stated manufacturing σ per group (the members scatter more or less than stated)"
+    }
+    fn parameters(&self) -> &[Parameter] {
+        &self.parameters
+    }
+    fn apply(&self, v: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError> {
+        for ((g, s0), &s) in self.groups.iter().zip(v) {
+            let r = s / s0;
+            let d = match edit.distribution(g) {
+                Some(DistributionSpec::Normal { mean, sigma }) => DistributionSpec::Normal {
+                    mean,
+                    sigma: sigma * r,
+                },
+                Some(DistributionSpec::Uniform { low, high }) => {
+                    let (m, h) = (0.5 * (low + high), 0.5 * (high - low) * r);
+                    DistributionSpec::Uniform {
+                        low: m - h,
+                        high: m + h,
+                    }
+                }
+                other => {
+                    return Err(DiagnoseError::Usage(format!(
+                        "length_sigma: group {g} has no spread to scale ({other:?})"
+                    )));
+                }
+            };
+            edit.set_distribution(g, d);
+        }
+        Ok(())
+    }
+}
+
+/// A common length error of the diagonals (cables).
+pub struct DiagonalPretension {
+    groups: Vec<String>,
+    parameters: Vec<Parameter>,
+}
+
+impl DiagonalPretension {
+    fn new(groups: Vec<String>) -> Self {
+        Self {
+            groups,
+            parameters: vec![Parameter::linear("length_error", "mm", -0.2, 0.0, 0.0)],
+        }
+    }
+}
+
+impl Candidate for DiagonalPretension {
+    fn name(&self) -> &'static str {
+        "diagonal_pretension"
+    }
+    fn mechanism(&self) -> &'static str {
+        "a common length error of the diagonals (negative: made short, pretensioning the frame)"
+    }
+    fn parameters(&self) -> &[Parameter] {
+        &self.parameters
+    }
+    fn apply(&self, v: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError> {
+        if v[0] != 0.0 {
+            for g in &self.groups {
+                let d = shifted(edit.distribution(g), v[0]);
+                edit.set_distribution(g, d);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Parses `NAME:P=V,P=V` or `NAME:V,V,…` (positional) into the candidate's index in
+/// `candidates` and a full parameter vector (unnamed parameters take their null values);
+/// `none` gives `None`.
+pub fn parse_effect(
+    text: &str,
+    candidates: &[Box<dyn Candidate>],
+) -> Result<Option<(usize, Vec<f64>)>, DiagnoseError> {
+    let text = text.trim();
+    if text == "none" {
+        return Ok(None);
+    }
+    let (name, rest) = text.split_once(':').unwrap_or((text, ""));
+    let names = || {
+        candidates
+            .iter()
+            .map(|c| c.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let i = candidates
+        .iter()
+        .position(|c| c.name() == name)
+        .ok_or_else(|| {
+            DiagnoseError::Usage(format!(
+                "--effect: no candidate effect {name:?} for this case (available: none, {})",
+                names()
+            ))
+        })?;
+    let params = candidates[i].parameters();
+    let mut values: Vec<f64> = params.iter().map(|p| p.null).collect();
+    for (k, item) in rest.split(',').filter(|s| !s.trim().is_empty()).enumerate() {
+        let (key, value) = match item.split_once('=') {
+            Some((k, v)) => (Some(k.trim()), v.trim()),
+            None => (None, item.trim()),
+        };
+        let j = match key {
+            Some(key) => params.iter().position(|p| p.name == key).ok_or_else(|| {
+                DiagnoseError::Usage(format!(
+                    "--effect {name}: no parameter {key:?} (its parameters: {})",
+                    params
+                        .iter()
+                        .map(|p| p.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            })?,
+            None if k < params.len() => k,
+            None => {
+                return Err(DiagnoseError::Usage(format!(
+                    "--effect {name}: more values than its {} parameters",
+                    params.len()
+                )));
+            }
+        };
+        values[j] = value.parse().map_err(|_| {
+            DiagnoseError::Usage(format!("--effect {name}: {value:?} is not a number"))
+        })?;
+    }
+    Ok(Some((i, values)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_and_linear_parameters_map_the_unit_interval_onto_their_range() {
+        let p = Parameter {
+            name: "s".into(),
+            unit: "mm",
+            low: 0.001,
+            high: 0.1,
+            null: 0.01,
+            log: true,
+        };
+        assert!((p.value(0.5) - 0.01).abs() < 1e-15);
+        assert!((p.internal(0.01) - 0.5).abs() < 1e-12);
+        let q = Parameter::linear("b", "mm", -0.1, 0.1, 0.0);
+        assert!((q.value(0.75) - 0.05).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,690 @@
+//! Step 1, *where*: the statistics of the measured specimens against a simulated case, each
+//! with a 95 % confidence interval, a p-value and a sentence.
+//!
+//! ## Statistics (measured `y`, n specimens; simulated with the instrument's noise, N samples)
+//!
+//! | id | statistic | interval and p-value |
+//! |---|---|---|
+//! | `mean NODE AXIS`, `mean piston`, `mean tan_theta_x`, `mean tan_theta_y` | difference of means | Welch: `ȳ − x̄ ± 1.96·√(s_y²/n + s_x²/N)`, normal p |
+//! | `sd …` (same columns) | ratio of standard deviations (divisor n − 1) | `ln(s_y/s_x) ± 1.96·√((κ_y − 1)/4n + (κ_x − 1)/4N)`, κ the sample kurtosis m₄/m₂² (the large-sample variance of ln s, valid without normality) |
+//! | `cov A / B` (every pair of compared coordinates, and tan θ_x / tan θ_y) | difference of covariances | `± 1.96·√(V_y/n + V_x/N)`, `V = mean((a − ā)²(b − b̄)²) − s_ab²` |
+//! | `p50 theta_p`, `p90 …`, `p95 …`, `p99 …` | ratio of percentiles (Hyndman–Fan definition 1, `mc_merge::quantile`) | Poisson bootstrap of both samples (`mc_merge::bootstrap`, B = 1000, seeds 1 and 2), percentile interval of the ratio; p from the normal approximation of ln ratio with the replicates' standard deviation |
+//! | `ks theta_p` | two-sample Kolmogorov–Smirnov D | asymptotic Kolmogorov p with Stephens' correction λ = (√nₑ + 0.12 + 0.11/√nₑ)·D, nₑ = nN/(n + N) |
+//! | `energy displacements` | energy distance (Székely & Rizzo 2004, unbiased U-statistic) of the displacement vectors, each coordinate divided by the measured standard deviation (floored at the noise) | permutation p with R = 199 (seeded), on the first ≤ 2000 specimens and ≤ 1000 samples |
+//!
+//! "piston" is the mean z displacement of the three top-surface nodes (the top surface's
+//! height). A statistic *disagrees* when its Holm-adjusted p-value (over every statistic of
+//! the comparison) is below 0.05.
+//!
+//! ## Tolerance
+//!
+//! The baseline *agrees within tolerance* when the 95 % intervals show every coordinate's
+//! mean within ±[`TOL_MEAN`] predicted standard deviations, every coordinate's scatter and the
+//! median and 95th percentile of θ_P within a factor [`TOL_RATIO`] of the prediction.
+
+use crate::measured::{Coordinate, Measured};
+use crate::simulate::Simulation;
+use mc_merge::bootstrap::{BootstrapConfig, SortedSample, bootstrap_quantiles};
+use mc_merge::rng::mix64;
+use serde::Serialize;
+use statrs::distribution::{ContinuousCDF, Normal};
+
+/// Mean tolerance, in predicted standard deviations.
+pub const TOL_MEAN: f64 = 0.5;
+/// Ratio tolerance for scatter and θ_P percentiles.
+pub const TOL_RATIO: f64 = 1.3;
+const Z95: f64 = 1.959_963_984_540_054;
+const PERCENTILES: [f64; 4] = [0.5, 0.9, 0.95, 0.99];
+const ARCSEC_PER_RAD: f64 = 206_264.806_247_096_36;
+
+/// A value with its 95 % interval.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Estimate {
+    /// The estimate.
+    pub value: f64,
+    /// Lower end.
+    pub lower: f64,
+    /// Upper end.
+    pub upper: f64,
+}
+
+/// One compared statistic.
+#[derive(Debug, Clone, Serialize)]
+pub struct Statistic {
+    /// Identifier, stable across runs (`mean n5.1 z`).
+    pub id: String,
+    /// `mean`, `sd`, `cov`, `percentile`, `ks`, `energy`.
+    pub kind: &'static str,
+    /// Unit of `measured` and `simulated`.
+    pub unit: &'static str,
+    /// Measured value.
+    pub measured: f64,
+    /// Simulated value.
+    pub simulated: f64,
+    /// `difference` (measured − simulated) or `ratio` (measured / simulated); for `ks` and
+    /// `energy`, the statistic itself.
+    pub comparison: &'static str,
+    /// The comparison with its 95 % interval.
+    pub estimate: Estimate,
+    /// p-value of "no difference".
+    pub p_value: f64,
+    /// Holm-adjusted p-value over the comparison's statistics.
+    pub p_holm: f64,
+    /// Whether it disagrees (p_holm < 0.05).
+    pub disagrees: bool,
+    /// The sentence for engineers.
+    pub words: String,
+}
+
+/// Whether the baseline agrees within the stated tolerance, and what fails it.
+#[derive(Debug, Clone, Serialize)]
+pub struct Tolerance {
+    /// Every tolerance statistic's interval lies within its band.
+    pub within: bool,
+    /// Ids of the statistics whose interval leaves the band.
+    pub outside: Vec<String>,
+    /// The bands, in words.
+    pub bands: String,
+}
+
+/// Measured against one simulated case.
+#[derive(Debug, Clone, Serialize)]
+pub struct Comparison {
+    /// Specimens n.
+    pub specimens: usize,
+    /// Simulated samples N (converged).
+    pub samples: usize,
+    /// Every statistic.
+    pub statistics: Vec<Statistic>,
+    /// The energy distance (the overall discrepancy).
+    pub energy: f64,
+    /// Its permutation p-value.
+    pub energy_p: f64,
+    /// Tolerance check.
+    pub tolerance: Tolerance,
+}
+
+fn normal_p(z: f64) -> f64 {
+    if !z.is_finite() {
+        return if z.is_nan() { 1.0 } else { 0.0 };
+    }
+    2.0 * (1.0 - Normal::standard().cdf(z.abs()))
+}
+
+struct Moments {
+    mean: f64,
+    sd: f64,
+    kurtosis: f64,
+}
+
+fn moments(v: &[f64]) -> Moments {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let (mut m2, mut m4) = (0.0, 0.0);
+    for x in v {
+        let c = (x - mean) * (x - mean);
+        m2 += c;
+        m4 += c * c;
+    }
+    let var = m2 / (n - 1.0).max(1.0);
+    let (m2n, m4n) = (m2 / n, m4 / n);
+    Moments {
+        mean,
+        sd: var.sqrt(),
+        kurtosis: if m2n > 0.0 {
+            (m4n / (m2n * m2n)).max(1.0)
+        } else {
+            3.0
+        },
+    }
+}
+
+fn column(x: &[f64], d: usize, j: usize) -> Vec<f64> {
+    x.iter().skip(j).step_by(d).copied().collect()
+}
+
+/// How a column is described in words.
+#[derive(Clone)]
+struct Column {
+    id: String,
+    unit: &'static str,
+    /// Factor from mm (or 1) to the unit shown.
+    scale: f64,
+    /// Sentence subject and the words for a positive / negative difference.
+    subject: String,
+    more: String,
+    less: String,
+    /// Whether it enters the tolerance check.
+    tolerance: bool,
+}
+
+fn coordinate_column(c: &Coordinate) -> Column {
+    let axis = ["x", "y", "z"][c.axis];
+    let (more, less) = if c.axis == 2 {
+        ("higher".to_string(), "lower".to_string())
+    } else {
+        (format!("further in +{axis}"), format!("further in −{axis}"))
+    };
+    Column {
+        id: c.label(),
+        unit: "µm",
+        scale: 1e3,
+        subject: format!("node {} ({axis})", c.node_id),
+        more,
+        less,
+        tolerance: true,
+    }
+}
+
+fn fmt(v: f64) -> String {
+    let a = v.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if a >= 100.0 {
+        format!("{v:.0}")
+    } else if a >= 10.0 {
+        format!("{v:.1}")
+    } else if a >= 0.1 {
+        format!("{v:.2}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+fn mean_statistic(col: &Column, y: &[f64], x: &[f64]) -> Statistic {
+    let (my, mx) = (moments(y), moments(x));
+    let diff = my.mean - mx.mean;
+    let se = (my.sd.powi(2) / y.len() as f64 + mx.sd.powi(2) / x.len() as f64).sqrt();
+    let est = Estimate {
+        value: diff * col.scale,
+        lower: (diff - Z95 * se) * col.scale,
+        upper: (diff + Z95 * se) * col.scale,
+    };
+    let (dir, lo, hi) = if diff >= 0.0 {
+        (&col.more, est.lower, est.upper)
+    } else {
+        (&col.less, -est.upper, -est.lower)
+    };
+    let words = format!(
+        "{} is {} {} {dir} on average than predicted (95 % CI {}–{} {})",
+        col.subject,
+        fmt(est.value.abs()),
+        col.unit,
+        fmt(lo),
+        fmt(hi),
+        col.unit
+    );
+    Statistic {
+        id: format!("mean {}", col.id),
+        kind: "mean",
+        unit: col.unit,
+        measured: my.mean * col.scale,
+        simulated: mx.mean * col.scale,
+        comparison: "difference",
+        estimate: est,
+        p_value: normal_p(diff / se),
+        p_holm: 1.0,
+        disagrees: false,
+        words,
+    }
+}
+
+fn sd_statistic(col: &Column, y: &[f64], x: &[f64]) -> Statistic {
+    let (my, mx) = (moments(y), moments(x));
+    let ratio = my.sd / mx.sd;
+    let se = ((my.kurtosis - 1.0) / (4.0 * y.len() as f64)
+        + (mx.kurtosis - 1.0) / (4.0 * x.len() as f64))
+        .sqrt();
+    let est = Estimate {
+        value: ratio,
+        lower: ratio * (-Z95 * se).exp(),
+        upper: ratio * (Z95 * se).exp(),
+    };
+    let words = format!(
+        "{} scatters {} times as much as predicted (95 % CI {}–{}): SD {} against {} {}",
+        col.subject,
+        fmt(ratio),
+        fmt(est.lower),
+        fmt(est.upper),
+        fmt(my.sd * col.scale),
+        fmt(mx.sd * col.scale),
+        col.unit
+    );
+    Statistic {
+        id: format!("sd {}", col.id),
+        kind: "sd",
+        unit: col.unit,
+        measured: my.sd * col.scale,
+        simulated: mx.sd * col.scale,
+        comparison: "ratio",
+        estimate: est,
+        p_value: normal_p(ratio.ln() / se),
+        p_holm: 1.0,
+        disagrees: false,
+        words,
+    }
+}
+
+fn cov_parts(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
+    let (mut s, mut s2) = (0.0, 0.0);
+    for (x, y) in a.iter().zip(b) {
+        let p = (x - ma) * (y - mb);
+        s += p;
+        s2 += p * p;
+    }
+    let cov = s / (n - 1.0).max(1.0);
+    (cov, (s2 / n - (s / n).powi(2)).max(0.0))
+}
+
+fn cov_statistic(
+    ca: &Column,
+    cb: &Column,
+    ya: &[f64],
+    yb: &[f64],
+    xa: &[f64],
+    xb: &[f64],
+) -> Statistic {
+    let (cy, vy) = cov_parts(ya, yb);
+    let (cx, vx) = cov_parts(xa, xb);
+    let scale = ca.scale * cb.scale;
+    let unit = if ca.unit == "µm" { "µm²" } else { "µrad²" };
+    let diff = cy - cx;
+    let se = (vy / ya.len() as f64 + vx / xa.len() as f64).sqrt();
+    let est = Estimate {
+        value: diff * scale,
+        lower: (diff - Z95 * se) * scale,
+        upper: (diff + Z95 * se) * scale,
+    };
+    let words = format!(
+        "the covariance of {} and {} is {} {unit} {} than predicted (95 % CI {}–{} {unit}): {} against {}",
+        ca.id,
+        cb.id,
+        fmt(diff.abs() * scale),
+        if diff >= 0.0 { "more" } else { "less" },
+        fmt(est.lower),
+        fmt(est.upper),
+        fmt(cy * scale),
+        fmt(cx * scale)
+    );
+    Statistic {
+        id: format!("cov {} / {}", ca.id, cb.id),
+        kind: "cov",
+        unit,
+        measured: cy * scale,
+        simulated: cx * scale,
+        comparison: "difference",
+        estimate: est,
+        p_value: normal_p(diff / se),
+        p_holm: 1.0,
+        disagrees: false,
+        words,
+    }
+}
+
+fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
+    let sorted = |v: &[f64], offset: u64| {
+        SortedSample::new(
+            v.iter()
+                .enumerate()
+                .map(|(i, &t)| (t, i as u64 + offset))
+                .collect(),
+        )
+    };
+    let (sy, sx) = (sorted(y, 0), sorted(x, 0));
+    let config = |seed| BootstrapConfig {
+        replicates: 1000,
+        seed,
+        threads: crate::simulate::threads(),
+    };
+    let by = bootstrap_quantiles(&sy, &PERCENTILES, &config(1));
+    let bx = bootstrap_quantiles(&sx, &PERCENTILES, &config(2));
+    PERCENTILES
+        .iter()
+        .enumerate()
+        .map(|(j, &p)| {
+            let qy = mc_merge::quantile::quantile_sorted(&sy.values, p).unwrap_or(f64::NAN);
+            let qx = mc_merge::quantile::quantile_sorted(&sx.values, p).unwrap_or(f64::NAN);
+            let mut logs: Vec<f64> = by.quantiles[j]
+                .iter()
+                .zip(&bx.quantiles[j])
+                .filter_map(|(a, b)| match (a, b) {
+                    (Some(a), Some(b)) if *a > 0.0 && *b > 0.0 => Some((a / b).ln()),
+                    _ => None,
+                })
+                .collect();
+            logs.sort_by(f64::total_cmp);
+            let ratio = qy / qx;
+            let (lo, hi) = mc_merge::bootstrap::percentile_interval(&logs, 0.95)
+                .map_or((f64::NAN, f64::NAN), |(a, b)| (a.exp(), b.exp()));
+            let m = logs.iter().sum::<f64>() / logs.len().max(1) as f64;
+            let sd = (logs.iter().map(|v| (v - m).powi(2)).sum::<f64>()
+                / (logs.len().max(2) - 1) as f64)
+                .sqrt();
+            let pct = (p * 100.0).round() as u32;
+            let words = format!(
+                "the {pct}th percentile of θ_P is {} times the predicted (95 % CI {}–{}): {} µrad ({}″) measured against {} µrad",
+                fmt(ratio),
+                fmt(lo),
+                fmt(hi),
+                fmt(qy * 1e6),
+                fmt(qy * ARCSEC_PER_RAD),
+                fmt(qx * 1e6)
+            );
+            Statistic {
+                id: format!("p{pct} theta_p"),
+                kind: "percentile",
+                unit: "µrad",
+                measured: qy * 1e6,
+                simulated: qx * 1e6,
+                comparison: "ratio",
+                estimate: Estimate {
+                    value: ratio,
+                    lower: lo,
+                    upper: hi,
+                },
+                p_value: normal_p(ratio.ln() / sd),
+                p_holm: 1.0,
+                disagrees: false,
+                words,
+            }
+        })
+        .collect()
+}
+
+fn ks_statistic(y: &[f64], x: &[f64]) -> Statistic {
+    let mut a = y.to_vec();
+    let mut b = x.to_vec();
+    a.sort_by(f64::total_cmp);
+    b.sort_by(f64::total_cmp);
+    let (n, m) = (a.len() as f64, b.len() as f64);
+    let (mut i, mut j, mut d) = (0usize, 0usize, 0.0f64);
+    while i < a.len() && j < b.len() {
+        let v = a[i].min(b[j]);
+        while i < a.len() && a[i] <= v {
+            i += 1;
+        }
+        while j < b.len() && b[j] <= v {
+            j += 1;
+        }
+        d = d.max((i as f64 / n - j as f64 / m).abs());
+    }
+    let ne = n * m / (n + m);
+    let lambda = (ne.sqrt() + 0.12 + 0.11 / ne.sqrt()) * d;
+    let mut p = 0.0;
+    for k in 1..=100 {
+        let k = k as f64;
+        p += 2.0 * (-1f64).powf(k - 1.0) * (-2.0 * k * k * lambda * lambda).exp();
+    }
+    let p = p.clamp(0.0, 1.0);
+    Statistic {
+        id: "ks theta_p".into(),
+        kind: "ks",
+        unit: "-",
+        measured: d,
+        simulated: 0.0,
+        comparison: "statistic",
+        estimate: Estimate {
+            value: d,
+            lower: d,
+            upper: d,
+        },
+        p_value: if lambda < 0.2 { 1.0 } else { p },
+        p_holm: 1.0,
+        disagrees: false,
+        words: format!(
+            "θ_P's distribution: largest gap between the measured and predicted ECDFs {} (two-sample KS p = {})",
+            fmt(d),
+            fmt(p)
+        ),
+    }
+}
+
+/// The energy distance (U-statistic) of standardised rows and its permutation p-value.
+pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> (f64, f64) {
+    let n = (y.len() / d).min(2000);
+    let m = (x.len() / d).min(1000);
+    let total = n + m;
+    let rows: Vec<&[f64]> = y
+        .chunks_exact(d)
+        .take(n)
+        .chain(x.chunks_exact(d).take(m))
+        .collect();
+    let mut dist = vec![0.0f64; total * (total - 1) / 2];
+    let mut k = 0;
+    for a in 0..total {
+        for b in (a + 1)..total {
+            let mut s = 0.0;
+            for j in 0..d {
+                let v = (rows[a][j] - rows[b][j]) / scale[j];
+                s += v * v;
+            }
+            dist[k] = s.sqrt();
+            k += 1;
+        }
+    }
+    let statistic = |label: &[bool]| {
+        let (mut xx, mut yy, mut xy) = (0.0, 0.0, 0.0);
+        let mut k = 0;
+        for a in 0..total {
+            for b in (a + 1)..total {
+                match (label[a], label[b]) {
+                    (true, true) => xx += dist[k],
+                    (false, false) => yy += dist[k],
+                    _ => xy += dist[k],
+                }
+                k += 1;
+            }
+        }
+        let (nf, mf) = (n as f64, m as f64);
+        2.0 * xy / (nf * mf) - 2.0 * xx / (nf * (nf - 1.0)) - 2.0 * yy / (mf * (mf - 1.0))
+    };
+    let mut label: Vec<bool> = (0..total).map(|i| i < n).collect();
+    let observed = statistic(&label);
+    let replicates = 199;
+    let mut exceed = 0;
+    let mut state = 0x5eed_u64;
+    for _ in 0..replicates {
+        for i in (1..total).rev() {
+            state = state.wrapping_add(mc_merge::rng::GAMMA);
+            let j = (mix64(state) % (i as u64 + 1)) as usize;
+            label.swap(i, j);
+        }
+        if statistic(&label) >= observed {
+            exceed += 1;
+        }
+    }
+    (observed, (1 + exceed) as f64 / (replicates + 1) as f64)
+}
+
+/// Holm's step-down adjustment.
+fn holm(stats: &mut [Statistic]) {
+    let mut order: Vec<usize> = (0..stats.len()).collect();
+    order.sort_by(|&a, &b| stats[a].p_value.total_cmp(&stats[b].p_value));
+    let m = stats.len();
+    let mut running = 0.0f64;
+    for (rank, &i) in order.iter().enumerate() {
+        let adj = ((m - rank) as f64 * stats[i].p_value).min(1.0);
+        running = running.max(adj);
+        stats[i].p_holm = running;
+        stats[i].disagrees = running < 0.05;
+    }
+}
+
+/// Compares the measured data with a simulation that carries the instrument's noise.
+pub fn compare(
+    measured: &Measured,
+    sim: &Simulation,
+    top: [[usize; 3]; 3],
+    sigma_m: f64,
+) -> Comparison {
+    let d = measured.d();
+    let mut stats = Vec::new();
+    let mut columns: Vec<(Column, Vec<f64>, Vec<f64>)> = measured
+        .coords
+        .iter()
+        .enumerate()
+        .map(|(j, c)| {
+            (
+                coordinate_column(c),
+                column(&measured.y, d, j),
+                column(&sim.x_noisy, d, j),
+            )
+        })
+        .collect();
+    let piston = |x: &[f64]| -> Vec<f64> {
+        x.chunks_exact(d)
+            .map(|r| (r[top[0][2]] + r[top[1][2]] + r[top[2][2]]) / 3.0)
+            .collect()
+    };
+    let derived = |id: &str, unit, scale, subject: &str, more: &str, less: &str| Column {
+        id: id.into(),
+        unit,
+        scale,
+        subject: subject.into(),
+        more: more.into(),
+        less: less.into(),
+        tolerance: false,
+    };
+    let coords = columns.len();
+    columns.push((
+        derived("piston", "µm", 1e3, "the top surface", "higher", "lower"),
+        piston(&measured.y),
+        piston(&sim.x_noisy),
+    ));
+    columns.push((
+        derived("tan_theta_x", "µrad", 1e6, "tan θ_x", "larger", "smaller"),
+        measured.tan_x.clone(),
+        sim.tan_x.clone(),
+    ));
+    columns.push((
+        derived("tan_theta_y", "µrad", 1e6, "tan θ_y", "larger", "smaller"),
+        measured.tan_y.clone(),
+        sim.tan_y.clone(),
+    ));
+    for (col, y, x) in &columns {
+        stats.push(mean_statistic(col, y, x));
+        stats.push(sd_statistic(col, y, x));
+    }
+    for a in 0..coords {
+        for b in (a + 1)..coords {
+            let (ca, ya, xa) = &columns[a];
+            let (cb, yb, xb) = &columns[b];
+            stats.push(cov_statistic(ca, cb, ya, yb, xa, xb));
+        }
+    }
+    let t = columns.len();
+    let (ca, ya, xa) = &columns[t - 2];
+    let (cb, yb, xb) = &columns[t - 1];
+    stats.push(cov_statistic(ca, cb, ya, yb, xa, xb));
+    stats.extend(percentile_statistics(&measured.theta_p, &sim.theta_p));
+    stats.push(ks_statistic(&measured.theta_p, &sim.theta_p));
+    let floor = (sigma_m * sigma_m + crate::likelihood::RESOLUTION.powi(2)).sqrt();
+    let scale: Vec<f64> = (0..d)
+        .map(|j| moments(&columns[j].1).sd.max(floor))
+        .collect();
+    let (energy, energy_p) = energy_test(&measured.y, &sim.x_noisy, d, &scale);
+    stats.push(Statistic {
+        id: "energy displacements".into(),
+        kind: "energy",
+        unit: "-",
+        measured: energy,
+        simulated: 0.0,
+        comparison: "statistic",
+        estimate: Estimate {
+            value: energy,
+            lower: energy,
+            upper: energy,
+        },
+        p_value: energy_p,
+        p_holm: 1.0,
+        disagrees: false,
+        words: format!(
+            "the joint distribution of the displacements differs from the predicted: energy distance {} (standardised; permutation p = {})",
+            fmt(energy),
+            fmt(energy_p)
+        ),
+    });
+    holm(&mut stats);
+    // Tolerance.
+    let mut outside = Vec::new();
+    let lr = TOL_RATIO.ln();
+    for (i, (col, _, x)) in columns.iter().enumerate().take(coords) {
+        let _ = i;
+        if !col.tolerance {
+            continue;
+        }
+        let sd_pred = moments(x).sd * col.scale;
+        let mean = stats
+            .iter()
+            .find(|s| s.id == format!("mean {}", col.id))
+            .expect("computed");
+        if mean.estimate.lower < -TOL_MEAN * sd_pred || mean.estimate.upper > TOL_MEAN * sd_pred {
+            outside.push(mean.id.clone());
+        }
+        let sd = stats
+            .iter()
+            .find(|s| s.id == format!("sd {}", col.id))
+            .expect("computed");
+        if !(sd.estimate.lower.ln() >= -lr && sd.estimate.upper.ln() <= lr) {
+            outside.push(sd.id.clone());
+        }
+    }
+    for id in ["p50 theta_p", "p95 theta_p"] {
+        let s = stats.iter().find(|s| s.id == id).expect("computed");
+        if !(s.estimate.lower.ln() >= -lr && s.estimate.upper.ln() <= lr) {
+            outside.push(id.to_string());
+        }
+    }
+    Comparison {
+        specimens: measured.n(),
+        samples: sim.n,
+        statistics: stats,
+        energy,
+        energy_p,
+        tolerance: Tolerance {
+            within: outside.is_empty(),
+            outside,
+            bands: format!(
+                "every coordinate's mean within ±{TOL_MEAN} predicted SD, its SD and θ_P's median and 95th percentile within a factor {TOL_RATIO} of the prediction (95 % intervals)"
+            ),
+        },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Energy distance: zero-mean under the null (same distribution), large for a shift.
+    #[test]
+    fn energy_distance_sees_a_shift_and_not_noise() {
+        let gauss = |seed: u64, n: usize, shift: f64| -> Vec<f64> {
+            (0..n * 2)
+                .map(|i| crate::simulate::noise_normal(seed, i as u64, 0) + shift)
+                .collect()
+        };
+        let y = gauss(1, 100, 0.0);
+        let x = gauss(2, 400, 0.0);
+        let (e0, p0) = energy_test(&y, &x, 2, &[1.0, 1.0]);
+        assert!(p0 > 0.01, "null rejected: e = {e0}, p = {p0}");
+        let z = gauss(3, 100, 0.8);
+        let (e1, p1) = energy_test(&z, &x, 2, &[1.0, 1.0]);
+        assert!(
+            p1 < 0.01 && e1 > 5.0 * e0.abs(),
+            "shift missed: e = {e1}, p = {p1}"
+        );
+    }
+
+    /// KS: identical samples give D = 0; disjoint samples D = 1 and a tiny p.
+    #[test]
+    fn ks_extremes() {
+        let a: Vec<f64> = (0..50).map(f64::from).collect();
+        assert_eq!(ks_statistic(&a, &a).measured, 0.0);
+        let b: Vec<f64> = (100..150).map(f64::from).collect();
+        let s = ks_statistic(&a, &b);
+        assert_eq!(s.measured, 1.0);
+        assert!(s.p_value < 1e-10);
+    }
+}

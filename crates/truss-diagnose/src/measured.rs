@@ -1,0 +1,478 @@
+//! The measured files: parsed, checked row by row, and turned into per-specimen displacement
+//! vectors of the measured coordinates.
+//!
+//! ## Node file (`--measured`)
+//!
+//! CSV with a header naming the columns `specimen`, `node`, `x`, `y`, `z` (any order, any
+//! case, surrounding spaces ignored; other columns ignored), one row per measured node per
+//! specimen, positions in mm in the model's frame with the bottom surface at nominal. Quoted
+//! fields, CRLF line ends and a UTF-8 byte-order mark are accepted; node order does not
+//! matter. A row with a missing or non-numeric field, or a second row for the same specimen
+//! and node, is an error naming its line.
+//!
+//! Which coordinates enter the diagnosis: the nodes of the model that at least half of the
+//! specimens measured (the top-surface nodes must be among them); node ids the model does not
+//! know, and nodes measured by fewer than half of the specimens, are ignored and reported.
+//! A specimen that lacks one of the chosen nodes is left out and counted. Fixed coordinates
+//! (supports) are not compared: the model puts them at nominal by definition. The
+//! displacement of a coordinate is the measured position minus the node's nominal position.
+//!
+//! ## Member file (`--measured-members`)
+//!
+//! CSV `specimen`, `member`, `length_error` (mm; natural length minus nominal, as in the
+//! job's distributions), member ids of the model; unknown member ids are ignored and
+//! reported.
+
+use crate::errors::DiagnoseError;
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
+use truss_core::Model;
+use truss_core::measure::distortion;
+
+/// One measured coordinate: a node of the model and an axis (0 = x, 1 = y, 2 = z).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Coordinate {
+    /// Node index in the model.
+    pub node: usize,
+    /// Node id.
+    pub node_id: String,
+    /// Axis, 0 = x, 1 = y, 2 = z.
+    pub axis: usize,
+}
+
+impl Coordinate {
+    /// `n5.1 z`.
+    pub fn label(&self) -> String {
+        format!("{} {}", self.node_id, ["x", "y", "z"][self.axis])
+    }
+}
+
+/// What reading the files found and left out, for the report.
+#[derive(Debug, Clone, Default, serde::Serialize)]
+pub struct DataReport {
+    /// The node file.
+    pub file: String,
+    /// Data rows read.
+    pub rows: usize,
+    /// Specimens in the file.
+    pub specimens_in_file: usize,
+    /// Specimens used.
+    pub specimens_used: usize,
+    /// Specimens left out because a chosen node is missing: (specimen, missing node ids);
+    /// at most 50 listed.
+    pub left_out: Vec<(String, Vec<String>)>,
+    /// How many specimens were left out.
+    pub left_out_count: usize,
+    /// The nodes compared, model order.
+    pub nodes: Vec<String>,
+    /// Node ids in the file that the model does not have.
+    pub unknown_nodes: Vec<String>,
+    /// Nodes measured by fewer than half of the specimens (ignored).
+    pub rare_nodes: Vec<String>,
+    /// Measured nodes that are supports (their fixed coordinates are not compared).
+    pub supports: Vec<String>,
+    /// Member observations used, if a member file was given.
+    pub member_rows: Option<usize>,
+    /// Member ids in the member file that the model does not have.
+    pub unknown_members: Vec<String>,
+}
+
+/// Measured member length errors.
+#[derive(Debug, Clone, Default)]
+pub struct MemberData {
+    /// (member index, measured length error [mm]).
+    pub observations: Vec<(usize, f64)>,
+}
+
+/// The measured data as the diagnosis uses it.
+#[derive(Debug, Clone)]
+pub struct Measured {
+    /// Specimen ids used, in the order of first appearance.
+    pub specimens: Vec<String>,
+    /// The compared coordinates, model order (node, then axis).
+    pub coords: Vec<Coordinate>,
+    /// `n × d` displacements of the compared coordinates, row per specimen [mm].
+    pub y: Vec<f64>,
+    /// tan θ_x of each specimen's top surface [-].
+    pub tan_x: Vec<f64>,
+    /// tan θ_y [-].
+    pub tan_y: Vec<f64>,
+    /// θ_P [rad].
+    pub theta_p: Vec<f64>,
+    /// Member measurements, if given.
+    pub members: Option<MemberData>,
+    /// What was read and left out.
+    pub report: DataReport,
+}
+
+impl Measured {
+    /// Number of specimens `n`.
+    pub fn n(&self) -> usize {
+        self.specimens.len()
+    }
+
+    /// Number of compared coordinates `d`.
+    pub fn d(&self) -> usize {
+        self.coords.len()
+    }
+}
+
+/// Data rows of a CSV file with the named columns, as (line, fields in the order asked).
+fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<(u64, Vec<String>)>, DiagnoseError> {
+    let bytes = std::fs::read(path).map_err(|e| DiagnoseError::io(path, e))?;
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .flexible(true)
+        .comment(Some(b'#'))
+        .from_reader(bytes);
+    let bad = |line: u64, message: String| DiagnoseError::BadRow {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let header = reader
+        .headers()
+        .map_err(|e| bad(1, format!("cannot read the header: {e}")))?
+        .clone();
+    let index: Vec<usize> = columns
+        .iter()
+        .map(|c| {
+            header
+                .iter()
+                .position(|h| h.eq_ignore_ascii_case(c))
+                .ok_or_else(|| {
+                    bad(
+                        1,
+                        format!(
+                            "the header has no column {c:?} (expected {}; found {})",
+                            columns.join(","),
+                            header.iter().collect::<Vec<_>>().join(",")
+                        ),
+                    )
+                })
+        })
+        .collect::<Result<_, _>>()?;
+    // Line numbers from byte offsets (the csv crate does not count blank lines), counted
+    // incrementally since records come in file order.
+    let (mut counted_to, mut lines_before) = (0usize, 0u64);
+    let mut line_at = |byte: u64| {
+        // A record's position may be that of blank lines before it.
+        let mut byte = (byte as usize).min(bytes.len());
+        while byte < bytes.len() && (bytes[byte] == b'\n' || bytes[byte] == b'\r') {
+            byte += 1;
+        }
+        if byte >= counted_to {
+            lines_before += bytes[counted_to..byte]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count() as u64;
+            counted_to = byte;
+        }
+        lines_before + 1
+    };
+    let mut rows = Vec::new();
+    for record in reader.records() {
+        let record = match record {
+            Ok(r) => r,
+            Err(e) => {
+                let line = e.position().map_or(0, |p| line_at(p.byte()));
+                return Err(bad(line, format!("unreadable row: {e}")));
+            }
+        };
+        let line = record.position().map_or(0, |p| line_at(p.byte()));
+        if record.iter().all(str::is_empty) {
+            continue;
+        }
+        let fields = index
+            .iter()
+            .zip(columns)
+            .map(|(&i, c)| match record.get(i) {
+                Some(v) if !v.is_empty() => Ok(v.to_string()),
+                _ => Err(bad(line, format!("the {c} field is empty or missing"))),
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        rows.push((line, fields));
+    }
+    Ok(rows)
+}
+
+fn number(path: &Path, line: u64, column: &str, text: &str) -> Result<f64, DiagnoseError> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| DiagnoseError::BadRow {
+            path: path.to_path_buf(),
+            line,
+            message: format!("{column} = {text:?} is not a finite number [mm]"),
+        })
+}
+
+/// Reads the node file (and the member file, if given) against `model`; `min_specimens` is
+/// the fewest usable specimens accepted.
+pub fn read(
+    model: &Model,
+    nodes_path: &Path,
+    members_path: Option<&Path>,
+    min_specimens: usize,
+) -> Result<Measured, DiagnoseError> {
+    let rows = read_table(nodes_path, &["specimen", "node", "x", "y", "z"])?;
+    let mut report = DataReport {
+        file: nodes_path.display().to_string(),
+        rows: rows.len(),
+        ..DataReport::default()
+    };
+    // specimen -> node index -> (position, line)
+    let mut order: Vec<String> = Vec::new();
+    let mut by_specimen: HashMap<String, BTreeMap<usize, ([f64; 3], u64)>> = HashMap::new();
+    let mut unknown: BTreeMap<String, ()> = BTreeMap::new();
+    for (line, f) in &rows {
+        let xyz = [
+            number(nodes_path, *line, "x", &f[2])?,
+            number(nodes_path, *line, "y", &f[3])?,
+            number(nodes_path, *line, "z", &f[4])?,
+        ];
+        let entry = by_specimen.entry(f[0].clone()).or_insert_with(|| {
+            order.push(f[0].clone());
+            BTreeMap::new()
+        });
+        let Some(node) = model.node_index(&f[1]) else {
+            unknown.insert(f[1].clone(), ());
+            continue;
+        };
+        if let Some((_, first)) = entry.insert(node, (xyz, *line)) {
+            return Err(DiagnoseError::BadRow {
+                path: nodes_path.to_path_buf(),
+                line: *line,
+                message: format!(
+                    "specimen {:?} node {:?} was already measured on line {first}",
+                    f[0], f[1]
+                ),
+            });
+        }
+    }
+    report.unknown_nodes = unknown.into_keys().collect();
+    report.specimens_in_file = order.len();
+    let measured_err = |message: String| DiagnoseError::Measured {
+        path: nodes_path.to_path_buf(),
+        message,
+    };
+    // Nodes measured by at least half of the specimens.
+    let mut counts = vec![0usize; model.nodes().len()];
+    for nodes in by_specimen.values() {
+        for &node in nodes.keys() {
+            counts[node] += 1;
+        }
+    }
+    let half = order.len().div_ceil(2).max(1);
+    let chosen: Vec<usize> = (0..counts.len()).filter(|&i| counts[i] >= half).collect();
+    report.rare_nodes = (0..counts.len())
+        .filter(|&i| counts[i] > 0 && counts[i] < half)
+        .map(|i| model.nodes()[i].id.clone())
+        .collect();
+    let top = model
+        .top_surface()
+        .ok_or_else(|| measured_err("the model names no top surface".into()))?
+        .clone();
+    for &t in &top.nodes {
+        if !chosen.contains(&t) {
+            return Err(measured_err(format!(
+                "top-surface node {} is measured for {} of {} specimens; it must be measured for all",
+                model.nodes()[t].id,
+                counts[t],
+                order.len()
+            )));
+        }
+    }
+    report.nodes = chosen
+        .iter()
+        .map(|&i| model.nodes()[i].id.clone())
+        .collect();
+    let coords: Vec<Coordinate> = chosen
+        .iter()
+        .flat_map(|&node| {
+            let fixed = model.fixed(node);
+            (0..3)
+                .filter(move |&a| !fixed[a])
+                .map(move |axis| Coordinate {
+                    node,
+                    node_id: model.nodes()[node].id.clone(),
+                    axis,
+                })
+        })
+        .collect();
+    report.supports = chosen
+        .iter()
+        .filter(|&&i| model.fixed(i).iter().any(|&f| f))
+        .map(|&i| model.nodes()[i].id.clone())
+        .collect();
+    let (mut specimens, mut y) = (Vec::new(), Vec::new());
+    let (mut tan_x, mut tan_y, mut theta_p) = (Vec::new(), Vec::new(), Vec::new());
+    let nominal = |i: usize| model.nodes()[i].xyz;
+    for s in &order {
+        let nodes = &by_specimen[s];
+        let missing: Vec<String> = chosen
+            .iter()
+            .filter(|i| !nodes.contains_key(i))
+            .map(|&i| model.nodes()[i].id.clone())
+            .collect();
+        if !missing.is_empty() {
+            report.left_out_count += 1;
+            if report.left_out.len() < 50 {
+                report.left_out.push((s.clone(), missing));
+            }
+            continue;
+        }
+        let disp = |i: usize| {
+            let p = nodes[&i].0;
+            let x = nominal(i);
+            [p[0] - x[0], p[1] - x[1], p[2] - x[2]]
+        };
+        y.extend(coords.iter().map(|c| disp(c.node)[c.axis]));
+        let d = distortion(
+            top.nodes.map(nominal),
+            top.nodes.map(disp),
+            top.reference_normal,
+        );
+        tan_x.push(d.tan_theta_x);
+        tan_y.push(d.tan_theta_y);
+        theta_p.push(d.theta_p);
+        specimens.push(s.clone());
+    }
+    report.specimens_used = specimens.len();
+    if specimens.len() < min_specimens {
+        return Err(measured_err(format!(
+            "{} usable specimens ({} left out for missing nodes); at least {min_specimens} are needed",
+            specimens.len(),
+            report.left_out_count
+        )));
+    }
+    let members = match members_path {
+        None => None,
+        Some(p) => Some(read_members(model, p, &mut report)?),
+    };
+    Ok(Measured {
+        specimens,
+        coords,
+        y,
+        tan_x,
+        tan_y,
+        theta_p,
+        members,
+        report,
+    })
+}
+
+fn read_members(
+    model: &Model,
+    path: &Path,
+    report: &mut DataReport,
+) -> Result<MemberData, DiagnoseError> {
+    let rows = read_table(path, &["specimen", "member", "length_error"])?;
+    let mut seen: HashMap<(String, usize), u64> = HashMap::new();
+    let mut unknown: BTreeMap<String, ()> = BTreeMap::new();
+    let mut data = MemberData::default();
+    for (line, f) in &rows {
+        let value = number(path, *line, "length_error", &f[2])?;
+        let Some(m) = model.member_index(&f[1]) else {
+            unknown.insert(f[1].clone(), ());
+            continue;
+        };
+        if let Some(first) = seen.insert((f[0].clone(), m), *line) {
+            return Err(DiagnoseError::BadRow {
+                path: PathBuf::from(path),
+                line: *line,
+                message: format!(
+                    "specimen {:?} member {:?} was already measured on line {first}",
+                    f[0], f[1]
+                ),
+            });
+        }
+        data.observations.push((m, value));
+    }
+    report.member_rows = Some(data.observations.len());
+    report.unknown_members = unknown.into_keys().collect();
+    Ok(data)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use truss_core::prism::PrismOptions;
+
+    fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    }
+
+    /// Quoted fields, CRLF, a BOM, shuffled columns and node order, an extra unknown node and
+    /// a specimen missing a node: read as the module doc says.
+    #[test]
+    fn robust_to_csv_details_and_reports_what_it_leaves_out() {
+        let model = PrismOptions::with_stages(2).model().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let h = 380.0 * 3f64.sqrt() / 2.0;
+        let text = format!(
+            "\u{feff}Node , specimen,z,x,y,comment\r\n\
+             \"n2.1\",s1,760.001,380,0,\r\n\
+             n2.0,s1,760,0,0,\"a, quoted\"\r\n\
+             n2.2,s1,760,190,{h},\r\n\
+             marker,s1,1,2,3,\r\n\
+             n2.0,\"s2\",759.999,0.0005,0,\r\n\
+             n2.1,s2,760,380,0,\r\n\
+             n2.2,s2,760,190,{h},\r\n\
+             n2.0,s3,760,0,0,\r\n\
+             n2.1,s3,760,380,0,\r\n"
+        );
+        let p = write(dir.path(), "m.csv", &text);
+        let m = read(&model, &p, None, 1).unwrap();
+        assert_eq!(m.specimens, vec!["s1", "s2"]);
+        assert_eq!(m.report.left_out_count, 1);
+        assert_eq!(
+            m.report.left_out[0],
+            ("s3".to_string(), vec!["n2.2".into()])
+        );
+        assert_eq!(m.report.unknown_nodes, vec!["marker"]);
+        assert_eq!(m.d(), 9);
+        // s1: n2.1 z displaced by +0.001; s2: n2.0 z by -0.001 and x by +0.0005.
+        let z21 = m.coords.iter().position(|c| c.label() == "n2.1 z").unwrap();
+        assert!((m.y[z21] - 0.001).abs() < 1e-12);
+        let x20 = m.coords.iter().position(|c| c.label() == "n2.0 x").unwrap();
+        assert!((m.y[9 + x20] - 0.0005).abs() < 1e-12);
+        // tan θ_x = (z₂ − z₁)/l (paper eq. 17) for s1.
+        assert!((m.tan_x[0] - 0.001 / 380.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bad_rows_name_their_line() {
+        let model = PrismOptions::with_stages(1).model().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let p = write(
+            dir.path(),
+            "m.csv",
+            "specimen,node,x,y,z\ns1,n1.0,0,0,380\ns1,n1.1,abc,0,380\n",
+        );
+        let e = read(&model, &p, None, 1).unwrap_err().to_string();
+        assert!(
+            e.ends_with("m.csv:3: x = \"abc\" is not a finite number [mm]"),
+            "{e}"
+        );
+        let p = write(
+            dir.path(),
+            "d.csv",
+            "specimen,node,x,y,z\ns1,n1.0,0,0,380\n\ns1,n1.0,0,0,380\n",
+        );
+        let e = read(&model, &p, None, 1).unwrap_err().to_string();
+        assert!(
+            e.contains("d.csv:4: specimen \"s1\" node \"n1.0\" was already measured on line 2"),
+            "{e}"
+        );
+        let p = write(dir.path(), "h.csv", "specimen,node,x,y\ns1,n1.0,0,0\n");
+        let e = read(&model, &p, None, 1).unwrap_err().to_string();
+        assert!(e.contains("h.csv:1: the header has no column \"z\""), "{e}");
+        let p = write(dir.path(), "e.csv", "specimen,node,x,y,z\ns1,n1.0,0,,380\n");
+        let e = read(&model, &p, None, 1).unwrap_err().to_string();
+        assert!(e.contains("e.csv:2: the y field is empty"), "{e}");
+    }
+}

@@ -1,0 +1,172 @@
+//! Running a derived case: `N` samples solved by mc-shard's own [`Worker`] (the same draws
+//! and solver as a shard run), each sample's displacements at the measured coordinates
+//! collected, and, when asked, the instrument's noise added and the top surface's angles
+//! computed from the noisy positions, exactly as they are from a measured specimen.
+//!
+//! ## Measurement noise
+//!
+//! The value added to coordinate `j` of sample `k` is `σ_m·z` with `z` a standard normal
+//! from the Box–Muller transform of two counter-based uniforms
+//! (`mc_merge::rng`, stream `Synthetic`, key `(noise seed, k)`, counters `2j`, `2j + 1`):
+//! a pure function of (seed, k, j), so every derived case sees the same noise (common random
+//! numbers here too) and the result does not depend on the thread count.
+
+use crate::errors::DiagnoseError;
+use crate::measured::Coordinate;
+use mc_merge::rng::{Stream, bits, open01, replicate_key};
+use mc_shard::Job;
+use mc_shard::worker::Worker;
+use shard_record::Status;
+use truss_core::measure::distortion;
+
+/// The simulated samples of one case.
+#[derive(Debug, Clone, Default)]
+pub struct Simulation {
+    /// Converged samples `N`.
+    pub n: usize,
+    /// Coordinates per sample `d`.
+    pub d: usize,
+    /// `N × d` displacements at the coordinates, noise-free [mm].
+    pub x: Vec<f64>,
+    /// `N × d` with the instrument's noise (empty unless asked) [mm].
+    pub x_noisy: Vec<f64>,
+    /// tan θ_x of the noisy positions (empty unless asked).
+    pub tan_x: Vec<f64>,
+    /// tan θ_y of the noisy positions.
+    pub tan_y: Vec<f64>,
+    /// θ_P of the noisy positions [rad].
+    pub theta_p: Vec<f64>,
+    /// Samples whose solve failed (left out).
+    pub failed: usize,
+    /// The first failure's reason.
+    pub first_failure: Option<String>,
+}
+
+/// What to simulate besides the noise-free displacements.
+#[derive(Debug, Clone, Copy)]
+pub struct Noise {
+    /// Instrument standard deviation σ_m [mm].
+    pub sigma: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+}
+
+/// A standard normal from (seed, k, j); see the module doc.
+pub fn noise_normal(seed: u64, k: u64, j: u64) -> f64 {
+    let key = replicate_key(seed, Stream::Synthetic, k);
+    let u1 = open01(bits(key, 2 * j));
+    let u2 = open01(bits(key, 2 * j + 1));
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+/// Worker threads to use.
+pub fn threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+/// Index of each top-surface node's x, y, z in `coords`, if they are all there.
+pub fn top_indices(coords: &[Coordinate], top: [usize; 3]) -> Option<[[usize; 3]; 3]> {
+    let find =
+        |node: usize, axis: usize| coords.iter().position(|c| c.node == node && c.axis == axis);
+    let mut out = [[0; 3]; 3];
+    for (row, &node) in out.iter_mut().zip(top.iter()) {
+        for (axis, slot) in row.iter_mut().enumerate() {
+            *slot = find(node, axis)?;
+        }
+    }
+    Some(out)
+}
+
+struct Row {
+    x: Vec<f64>,
+    failure: Option<String>,
+}
+
+/// Simulates samples `0..samples` of the job's only case at `coords`; with `noise`, also the
+/// noisy coordinates and the top surface's angles (`top` gives each top node's x, y, z index
+/// in `coords`).
+pub fn simulate(
+    job: &Job,
+    coords: &[Coordinate],
+    samples: usize,
+    noise: Option<(Noise, [[usize; 3]; 3])>,
+) -> Result<Simulation, DiagnoseError> {
+    let d = coords.len();
+    let threads = threads().clamp(1, samples.max(1));
+    let chunk = samples.div_ceil(threads).max(1);
+    let mut rows: Vec<Row> = Vec::with_capacity(samples);
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| {
+                scope.spawn(move || {
+                    let mut worker = Worker::new(job);
+                    let range = (t * chunk)..((t + 1) * chunk).min(samples);
+                    range
+                        .map(|k| {
+                            let s = worker.sample(k as u64);
+                            if s.status != Status::Converged {
+                                return Row {
+                                    x: Vec::new(),
+                                    failure: Some(s.reason.unwrap_or_default()),
+                                };
+                            }
+                            let solver = worker.solver(0).expect("the case was solved");
+                            Row {
+                                x: coords
+                                    .iter()
+                                    .map(|c| solver.displacement(c.node)[c.axis])
+                                    .collect(),
+                                failure: None,
+                            }
+                        })
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        for h in handles {
+            rows.extend(h.join().expect("a simulation thread panicked"));
+        }
+    });
+    let case = &job.cases[0];
+    let model = &case.model;
+    let mut sim = Simulation {
+        d,
+        ..Simulation::default()
+    };
+    for (k, row) in rows.into_iter().enumerate() {
+        if let Some(reason) = row.failure {
+            sim.failed += 1;
+            sim.first_failure.get_or_insert(reason);
+            continue;
+        }
+        if let Some((noise, top)) = &noise {
+            let noisy: Vec<f64> = row
+                .x
+                .iter()
+                .enumerate()
+                .map(|(j, v)| v + noise.sigma * noise_normal(noise.seed, k as u64, j as u64))
+                .collect();
+            let t = model.top_surface().expect("checked when reading the data");
+            let nominal = t.nodes.map(|i| model.nodes()[i].xyz);
+            let u = top.map(|ix| ix.map(|j| noisy[j]));
+            let dist = distortion(nominal, u, t.reference_normal);
+            sim.tan_x.push(dist.tan_theta_x);
+            sim.tan_y.push(dist.tan_theta_y);
+            sim.theta_p.push(dist.theta_p);
+            sim.x_noisy.extend(noisy);
+        }
+        sim.x.extend(row.x);
+        sim.n += 1;
+    }
+    if sim.n < 2 || sim.failed * 20 > samples {
+        return Err(DiagnoseError::Simulation {
+            what: case.name.clone(),
+            message: format!(
+                "{} of {samples} samples failed (first: {})",
+                sim.failed,
+                sim.first_failure.as_deref().unwrap_or("-")
+            ),
+        });
+    }
+    Ok(sim)
+}

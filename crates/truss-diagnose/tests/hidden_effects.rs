@@ -1,0 +1,226 @@
+//! Hidden-effect checks (issue 7, "Test it on data in which the effect is hidden"): measured
+//! data made by `synth` from the baseline case of `jobs/diagnose-baseline.json` (the paper's
+//! 5-stage prism, σ = 6.3 µm on battens and longerons, section 3.1) with an effect the
+//! diagnosis is not told, under a seed independent of the job's, with 1 µm instrument noise;
+//! the diagnosis must name the effect, recover its parameters within their intervals and cut
+//! the discrepancy by at least half; data without an effect must give `none`; too few
+//! specimens must say `cannot_tell`.
+//!
+//! These are the fast versions (80 specimens where the effect is strong, N = 1200 simulated
+//! samples; a scale needs the issue's 200 specimens for a tight interval);
+//! `scripts/diagnose-check.sh` runs the full 200-specimen checks with the release build.
+
+use std::path::{Path, PathBuf};
+use truss_diagnose::diagnose::Settings;
+use truss_diagnose::synth::{SynthOptions, synth};
+use truss_diagnose::{DiagnoseOptions, run};
+
+fn job() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../jobs/diagnose-baseline.json")
+}
+
+fn make(dir: &Path, name: &str, effect: &str, specimens: usize, seed: u64) -> PathBuf {
+    let mut out = Vec::new();
+    synth(
+        &SynthOptions {
+            job: job(),
+            case: "as-built".into(),
+            specimens,
+            seed,
+            effect: effect.into(),
+            measurement_sigma: 0.001,
+            all_nodes: false,
+            members_out: None,
+        },
+        &mut out,
+    )
+    .unwrap();
+    let p = dir.join(format!("{name}.csv"));
+    std::fs::write(&p, out).unwrap();
+    p
+}
+
+fn diagnose(dir: &Path, measured: &Path) -> serde_json::Value {
+    let out = dir.join("out");
+    let s = run(&DiagnoseOptions {
+        job: job(),
+        case: "as-built".into(),
+        measured: measured.to_path_buf(),
+        measured_members: None,
+        out: out.clone(),
+        settings: Settings {
+            samples: Some(1200),
+            measurement_sigma: 0.001,
+            quiet: true,
+            ..Settings::default()
+        },
+        plots: false,
+    })
+    .unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("diagnosis.json")).unwrap())
+            .unwrap();
+    assert_eq!(v["named_effect"], s.named_effect.as_str());
+    v
+}
+
+/// The named effect, each true parameter inside its interval, the discrepancy at least halved.
+fn check_recovered(v: &serde_json::Value, effect: &str, truth: &[(&str, f64)]) {
+    assert_eq!(v["verdict"], "named", "{}", v["reason"]);
+    assert_eq!(v["named_effect"], effect, "{}", v["reason"]);
+    for (name, value) in truth {
+        let p = v["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["name"] == *name)
+            .unwrap();
+        let (lo, hi) = (
+            p["interval"]["lower"].as_f64().unwrap(),
+            p["interval"]["upper"].as_f64().unwrap(),
+        );
+        assert!(
+            lo <= *value && *value <= hi,
+            "{name}: truth {value} outside [{lo}, {hi}] (fit {})",
+            p["value"]
+        );
+    }
+    let (before, after) = (
+        v["discrepancy_before"].as_f64().unwrap(),
+        v["discrepancy_after"].as_f64().unwrap(),
+    );
+    assert!(after <= 0.5 * before, "discrepancy {before} → {after}");
+}
+
+#[test]
+fn hidden_thermal_gradient_is_named_and_recovered() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = make(
+        dir.path(),
+        "thermal",
+        "thermal_gradient:gradient_x=0.002,offset=2",
+        80,
+        21,
+    );
+    let v = diagnose(dir.path(), &m);
+    check_recovered(
+        &v,
+        "thermal_gradient",
+        &[
+            ("gradient_x", 0.002),
+            ("gradient_y", 0.0),
+            ("gradient_z", 0.0),
+            ("offset", 2.0),
+        ],
+    );
+}
+
+#[test]
+fn hidden_diagonal_pretension_is_named_and_recovered() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = make(
+        dir.path(),
+        "pretension",
+        "diagonal_pretension:length_error=-0.05",
+        80,
+        24,
+    );
+    let v = diagnose(dir.path(), &m);
+    check_recovered(&v, "diagonal_pretension", &[("length_error", -0.05)]);
+}
+
+#[test]
+fn hidden_length_sigma_is_named_and_recovered() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = make(
+        dir.path(),
+        "sigma",
+        "length_sigma:sigma.longeron=0.012",
+        200,
+        23,
+    );
+    let v = diagnose(dir.path(), &m);
+    check_recovered(
+        &v,
+        "length_sigma",
+        &[("sigma.longeron", 0.012), ("sigma.batten", 0.0063)],
+    );
+}
+
+#[test]
+fn no_hidden_effect_gives_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = make(dir.path(), "none", "none", 150, 1);
+    let v = diagnose(dir.path(), &m);
+    assert_eq!(v["verdict"], "none", "{}", v["reason"]);
+    assert_eq!(v["named_effect"], "none");
+    assert_eq!(v["discrepancy_before"], v["discrepancy_after"]);
+}
+
+/// A small temperature gradient on 12 specimens: the data can neither show it nor show that
+/// the baseline agrees within tolerance.
+#[test]
+fn too_few_specimens_cannot_tell() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = make(
+        dir.path(),
+        "few",
+        "thermal_gradient:gradient_x=0.0005",
+        12,
+        25,
+    );
+    let v = diagnose(dir.path(), &m);
+    assert_eq!(v["verdict"], "cannot_tell", "{}", v["reason"]);
+    assert_eq!(v["named_effect"], "none");
+}
+
+/// The same measurements written as other software might (rows shuffled, columns reordered,
+/// quoted fields, CRLF, an extra marker node and a specimen missing a node) give the same
+/// diagnosis, with the incomplete specimen counted.
+#[test]
+fn csv_details_and_row_order_do_not_change_the_diagnosis() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = make(
+        dir.path(),
+        "plain",
+        "diagonal_pretension:length_error=-0.05",
+        80,
+        24,
+    );
+    let text = std::fs::read_to_string(&m).unwrap();
+    let mut rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    // A deterministic shuffle: reverse, then interleave halves.
+    rows.reverse();
+    let half = rows.len() / 2;
+    let (a, b) = rows.split_at(half);
+    let mut shuffled: Vec<&Vec<&str>> = a.iter().zip(b).flat_map(|(x, y)| [x, y]).collect();
+    shuffled.extend(b.iter().skip(a.len()));
+    let mut other = String::from("\"z\",\"x\",\"y\",\"node\",\"specimen\"\r\n");
+    for r in &shuffled {
+        other.push_str(&format!(
+            "{},{},{},\"{}\",\"{}\"\r\n",
+            r[4], r[2], r[3], r[1], r[0]
+        ));
+        if r[1] == "n5.0" {
+            other.push_str(&format!("1,2,3,\"marker\",\"{}\"\r\n", r[0]));
+        }
+    }
+    other.push_str("1900,0,0,n5.0,EXTRA\r\n1900,380,0,n5.1,EXTRA\r\n");
+    let p = dir.path().join("other.csv");
+    std::fs::write(&p, other).unwrap();
+    let d1 = dir.path().join("1");
+    let d2 = dir.path().join("2");
+    std::fs::create_dir_all(&d1).unwrap();
+    std::fs::create_dir_all(&d2).unwrap();
+    let v1 = diagnose(&d1, &m);
+    let v2 = diagnose(&d2, &p);
+    assert_eq!(v2["data"]["left_out_count"], 1);
+    assert_eq!(v2["data"]["unknown_nodes"][0], "marker");
+    assert_eq!(v1["named_effect"], v2["named_effect"]);
+    let value = |v: &serde_json::Value| v["parameters"][0]["value"].as_f64().unwrap();
+    assert!((value(&v1) - value(&v2)).abs() < 1e-9 * value(&v1).abs());
+}
