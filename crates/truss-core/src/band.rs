@@ -226,7 +226,7 @@ impl BandMatrix {
 
 /// Inner product with four interleaved partial sums, summed in a fixed order.
 #[inline]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     debug_assert_eq!(a.len(), b.len());
     let mut s = [0.0f64; 4];
     let ca = a.chunks_exact(4);

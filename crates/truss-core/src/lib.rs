@@ -62,6 +62,7 @@
 
 pub mod band;
 pub mod block;
+mod capacitance;
 pub mod element;
 mod errors;
 mod linearised;

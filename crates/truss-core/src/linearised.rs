@@ -23,7 +23,7 @@
 //! exactly when `K_S` is; the same factor then applies `K_S⁻¹` to any vector at the cost of a
 //! banded solve, which is the chord operator of the Newton iterations that follow.
 
-use crate::band::BandMatrix;
+use crate::capacitance::Capacitance;
 use crate::structure::Structure;
 
 /// Woodbury data for one model: `Z = K₀⁻¹B` and `G = BᵀK₀⁻¹B` over its cables.
@@ -84,25 +84,49 @@ impl CableBasis {
 }
 
 /// Adds `scale·b_m` to `v` (`v` has the zero slot at index `free`).
-#[inline]
+#[inline(always)]
 pub(crate) fn scatter_b(s: &Structure, m: usize, scale: f64, v: &mut [f64]) {
     let c = &s.members[m];
     let n = &c.unit;
-    for k in 0..3 {
-        v[c.dofs[k]] -= scale * n[k];
-        v[c.dofs[3 + k]] += scale * n[k];
+    if c.masked {
+        for k in 0..3 {
+            v[c.dofs[k]] -= scale * n[k];
+            v[c.dofs[3 + k]] += scale * n[k];
+        }
+        v[s.free] = 0.0;
+        return;
     }
-    v[s.free] = 0.0;
+    let f = [scale * n[0], scale * n[1], scale * n[2]];
+    let (blocks, _) = v[..s.free].as_chunks_mut::<3>();
+    if let Some(x) = blocks.get_mut(c.ends[0]) {
+        for (x, f) in x.iter_mut().zip(&f) {
+            *x -= f;
+        }
+    }
+    if let Some(x) = blocks.get_mut(c.ends[1]) {
+        for (x, f) in x.iter_mut().zip(&f) {
+            *x += f;
+        }
+    }
 }
 
 /// `b_mᵀ v` (`v` may omit the zero slot).
-#[inline]
+#[inline(always)]
 pub(crate) fn gather_b(s: &Structure, m: usize, v: &[f64]) -> f64 {
     let c = &s.members[m];
-    let at = |d: usize| if d < s.free { v[d] } else { 0.0 };
     let mut sum = 0.0;
+    if c.masked {
+        let at = |d: usize| if d < s.free { v[d] } else { 0.0 };
+        for k in 0..3 {
+            sum += c.unit[k] * (at(c.dofs[3 + k]) - at(c.dofs[k]));
+        }
+        return sum;
+    }
+    let (blocks, _) = v[..s.free].as_chunks::<3>();
+    let vi = blocks.get(c.ends[0]).copied().unwrap_or([0.0; 3]);
+    let vj = blocks.get(c.ends[1]).copied().unwrap_or([0.0; 3]);
     for k in 0..3 {
-        sum += c.unit[k] * (at(c.dofs[3 + k]) - at(c.dofs[k]));
+        sum += c.unit[k] * (vj[k] - vi[k]);
     }
     sum
 }
@@ -113,12 +137,14 @@ pub(crate) fn gather_b(s: &Structure, m: usize, v: &[f64]) -> f64 {
 pub(crate) struct ActiveSet {
     /// Positions (into `CableBasis::cables`) of the slack cables, increasing.
     pub slack: Vec<usize>,
-    /// Cholesky factor of `W⁻¹ − G_SS` (dense, as a full band).
-    capacitance: BandMatrix,
+    /// Cholesky factor of `W⁻¹ − G_SS`.
+    capacitance: Capacitance,
     /// Scratch: a right-hand side over the slack set, solved in place.
     z: Vec<f64>,
     /// Scratch: linearised elongations of the cables without slack corrections.
     e_lin: Vec<f64>,
+    /// Scratch: linearised elongations of the cables of the current piece.
+    e: Vec<f64>,
 }
 
 /// The active-set method met a piece whose stiffness is not positive definite (a mechanism
@@ -136,31 +162,26 @@ impl ActiveSet {
     pub fn new(nc: usize) -> Self {
         Self {
             slack: Vec::with_capacity(nc),
-            capacitance: BandMatrix::new(0, 0),
+            capacitance: Capacitance::new(nc),
             z: Vec::with_capacity(nc),
             e_lin: Vec::with_capacity(nc),
+            e: Vec::with_capacity(nc),
         }
     }
 
     /// Factorises `W⁻¹ − G_SS` for the current `slack`.
     pub fn factor(&mut self, basis: &CableBasis) -> Result<(), ActiveSetFailure> {
-        let m = self.slack.len();
         let nc = basis.cables.len();
-        if self.capacitance.size() != m {
-            self.capacitance = BandMatrix::new(m, m.saturating_sub(1));
-        } else {
-            self.capacitance.clear();
-        }
-        for (i, &a) in self.slack.iter().enumerate() {
-            for (j, &b) in self.slack[..=i].iter().enumerate() {
-                let mut v = -basis.g[a * nc + b];
-                if i == j {
-                    v += basis.w_inv[a];
-                }
-                self.capacitance.add(i, j, v);
+        let slack = &self.slack;
+        self.capacitance.set(slack.len(), |i, row| {
+            let a = slack[i];
+            let g = &basis.g[a * nc..(a + 1) * nc];
+            for (x, &b) in row.iter_mut().zip(slack) {
+                *x = -g[b];
             }
-        }
-        if m == 0 {
+            row[i] += basis.w_inv[a];
+        });
+        if slack.is_empty() {
             return Ok(());
         }
         self.capacitance
@@ -221,9 +242,8 @@ impl ActiveSet {
         let nc = basis.cables.len();
         // u_lin = K₀⁻¹ (f − Σ k_m s_m b_m), with nominal k_m.
         u.copy_from_slice(loads);
-        for (m, c) in s.members.iter().enumerate() {
-            let k = c.rigidity / c.natural_length;
-            scatter_b(s, m, -k * stretch[m], u);
+        for (m, (c, st)) in s.members.iter().zip(stretch).enumerate() {
+            scatter_b(s, m, -c.stiffness * st, u);
         }
         s.nominal.solve_in_place(&mut u[..n]);
         self.e_lin.clear();
@@ -243,13 +263,14 @@ impl ActiveSet {
             }
             // e = e_lin + G_{:,S} z_S; the slack set of this solution.
             let (slack, z, e_lin) = (&self.slack, &self.z, &self.e_lin);
-            let elongation = |a: usize| {
-                let row = &basis.g[a * nc..(a + 1) * nc];
-                e_lin[a] + slack.iter().zip(z).map(|(&b, zb)| row[b] * zb).sum::<f64>()
-            };
-            let settled = (0..nc)
-                .filter(|&c| elongation(c) < 0.0)
-                .eq(slack.iter().copied());
+            self.e.clear();
+            self.e.extend(
+                basis.g.chunks_exact(nc).zip(e_lin).map(|(row, e)| {
+                    e + slack.iter().zip(z).map(|(&b, zb)| row[b] * zb).sum::<f64>()
+                }),
+            );
+            let e = &self.e;
+            let settled = (0..nc).filter(|&c| e[c] < 0.0).eq(slack.iter().copied());
             if settled {
                 for (&c, zc) in self.slack.iter().zip(&self.z) {
                     for (ui, zi) in u[..n].iter_mut().zip(&basis.z[c * n..(c + 1) * n]) {
@@ -262,9 +283,8 @@ impl ActiveSet {
             if pieces >= 50 {
                 return Err(ActiveSetFailure::NoFixedPoint);
             }
-            let next: Vec<usize> = (0..nc).filter(|&c| elongation(c) < 0.0).collect();
             self.slack.clear();
-            self.slack.extend(next);
+            self.slack.extend((0..nc).filter(|&c| self.e[c] < 0.0));
         }
     }
 }

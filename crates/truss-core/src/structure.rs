@@ -30,12 +30,16 @@ pub(crate) struct CompiledMember {
     pub reference: [f64; 3],
     /// Nominal unit direction `(X_j − X_i)/L_r`.
     pub unit: [f64; 3],
+    /// Nominal length `L_r = |X_j − X_i|` \[mm\].
+    pub reference_length: f64,
     /// Nominal natural length \[mm\].
     pub natural_length: f64,
     /// Nominal `L_r − L₀` \[mm\].
     pub nominal_stretch: f64,
     /// `E·A` \[N\].
     pub rigidity: f64,
+    /// Nominal axial stiffness `k = E·A/L₀` \[N/mm\].
+    pub stiffness: f64,
     /// 1 for bars; the compression ratio for cables.
     pub compression_ratio: f64,
     /// Whether the member is a cable.
@@ -131,9 +135,11 @@ impl Structure {
                     dofs,
                     reference,
                     unit: reference.map(|x| x / length),
+                    reference_length: length,
                     natural_length: member.natural_length,
                     nominal_stretch: model.nominal_length(m) - member.natural_length,
                     rigidity: member.youngs_modulus * member.area,
+                    stiffness: member.youngs_modulus * member.area / member.natural_length,
                     compression_ratio,
                     is_cable,
                     slots: [slot(bi, bi), slot(bj, bj), slot(bi, bj)],
@@ -262,13 +268,15 @@ impl Structure {
     /// The member's constants for a sample with length error `error` \[mm\].
     #[inline]
     pub(crate) fn nominal_member(&self, m: &CompiledMember, error: f64) -> AxialMember {
-        AxialMember::new(
-            m.reference,
-            m.natural_length + error,
-            m.nominal_stretch - error,
-            m.rigidity,
-            m.compression_ratio,
-        )
+        // `AxialMember::new` with the nominal length computed once.
+        AxialMember {
+            reference: m.reference,
+            reference_length: m.reference_length,
+            natural_length: m.natural_length + error,
+            initial_stretch: m.nominal_stretch - error,
+            rigidity: m.rigidity,
+            compression_ratio: m.compression_ratio,
+        }
     }
 
     /// Number of rows of the stiffness matrix (3 per node with a free direction).
@@ -279,6 +287,14 @@ impl Structure {
     /// Block (node) half-bandwidth of the stiffness matrix in the chosen numbering.
     pub fn bandwidth(&self) -> usize {
         self.nominal.bandwidth()
+    }
+
+    /// Nominal length of the shortest member \[mm\].
+    pub(crate) fn shortest_member(&self) -> f64 {
+        self.members
+            .iter()
+            .map(|m| m.reference_length)
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Number of members.

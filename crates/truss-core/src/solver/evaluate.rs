@@ -79,15 +79,16 @@ pub(super) fn evaluate_with(
 }
 
 /// Largest absolute value; NaN if any entry is NaN (`f64::max` alone would drop it).
+/// Branch-free: a comparison that a NaN fails, and a flag for NaNs.
 pub(super) fn max_abs(x: &[f64]) -> f64 {
     let mut m = 0.0f64;
+    let mut nan = false;
     for v in x {
-        if v.is_nan() {
-            return f64::NAN;
-        }
-        m = m.max(v.abs());
+        let a = v.abs();
+        nan |= a.is_nan();
+        m = if a > m { a } else { m };
     }
-    m
+    if nan { f64::NAN } else { m }
 }
 
 pub(super) fn dot_n(a: &[f64], b: &[f64]) -> f64 {

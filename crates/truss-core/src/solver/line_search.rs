@@ -174,9 +174,6 @@ impl Solver {
     }
 
     pub(super) fn shortest_member(&self) -> f64 {
-        self.members
-            .iter()
-            .map(|m| m.reference_length)
-            .fold(f64::INFINITY, f64::min)
+        self.shortest
     }
 }

@@ -187,6 +187,8 @@ pub struct Solver {
     last: Option<SolveReport>,
     evaluations: u32,
     breakpoints: Vec<(f64, f64)>,
+    /// Nominal length of the shortest member \[mm\] (caps a line search's steps).
+    shortest: f64,
 }
 
 /// Result of evaluating the out-of-balance force at a point.
@@ -242,6 +244,7 @@ impl Solver {
             last: None,
             evaluations: 0,
             breakpoints: Vec::with_capacity(m),
+            shortest: structure.shortest_member(),
             structure,
         }
     }
