@@ -16,13 +16,13 @@ pub struct DiagnoseArgs {
     /// The case of the job the measurements are compared with.
     #[arg(long)]
     pub case: String,
-    /// Measured node positions: CSV `specimen,node,x,y,z` [mm].
+    /// Measured node positions: CSV `specimen,node,x,y,z` \[mm\].
     #[arg(long)]
     pub measured: PathBuf,
-    /// Measured member length errors: CSV `specimen,member,length_error` [mm].
+    /// Measured member length errors: CSV `specimen,member,length_error` \[mm\].
     #[arg(long)]
     pub measured_members: Option<PathBuf>,
-    /// The instrument's standard deviation per coordinate [mm].
+    /// The instrument's standard deviation per coordinate \[mm\].
     #[arg(long, default_value_t = 0.0)]
     pub measurement_sigma: f64,
     /// Simulated samples per evaluation (default max(2000, 20 × specimens), at most 10 000).
@@ -58,7 +58,7 @@ pub struct SynthArgs {
     /// baseline values), e.g. `thermal_gradient:gradient_x=0.002`.
     #[arg(long)]
     pub effect: String,
-    /// The instrument's standard deviation per coordinate [mm].
+    /// The instrument's standard deviation per coordinate \[mm\].
     #[arg(long, default_value_t = 0.0)]
     pub measurement_sigma: f64,
     /// Write every node, not only the top surface.

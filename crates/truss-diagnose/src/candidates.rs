@@ -3,11 +3,11 @@
 //!
 //! | name | parameters | what it does to the case |
 //! |---|---|---|
-//! | `gravity` | `g_x`, `g_y`, `g_z` [g], the self-weight vector in units of standard gravity, \|g\| ≤ 1 | `effects.gravity` with direction g/\|g\| and acceleration 9.806 65·\|g\| m/s² (aluminium 2700 kg/m³, each member's weight lumped half to each end). Its direction is the test orientation's gravity direction; \|g\| < 1 is a partly off-loaded ground test |
-//! | `thermal_gradient` | `gradient_x`, `gradient_y`, `gradient_z` [K/mm] in ±0.01, `offset` [K] in ±20 | `effects.thermal_gradient`: ΔT(x) = offset + gradient·(x − c), c the centroid of the model's nodes, α = 23e-6 /K; each member lengthens by α·ΔT(midpoint)·L |
-//! | `length_bias` | `bias.GROUP` [mm] in ±0.1 for each bar group | adds the bias to the group's length-error mean (a constant if it has none) |
-//! | `length_sigma` | `sigma.GROUP` [mm] from 1/5 to 5 times the stated σ, for each group with a stated spread | scales the group's spread about its mean to the new σ |
-//! | `diagonal_pretension` | `length_error` [mm] in [−0.2, 0] | adds a common length error to every cable group: diagonals made short, so pretensioned (lengthening them instead would make them slack, a different mechanism whose likelihood is not smooth at the null) |
+//! | `gravity` | `g_x`, `g_y`, `g_z` \[g\], the self-weight vector in units of standard gravity, \|g\| ≤ 1 | `effects.gravity` with direction g/\|g\| and acceleration 9.806 65·\|g\| m/s² (aluminium 2700 kg/m³, each member's weight lumped half to each end). Its direction is the test orientation's gravity direction; \|g\| < 1 is a partly off-loaded ground test |
+//! | `thermal_gradient` | `gradient_x`, `gradient_y`, `gradient_z` \[K/mm\] in ±0.01, `offset` \[K\] in ±20 | `effects.thermal_gradient`: ΔT(x) = offset + gradient·(x − c), c the centroid of the model's nodes, α = 23e-6 /K; each member lengthens by α·ΔT(midpoint)·L |
+//! | `length_bias` | `bias.GROUP` \[mm\] in ±0.1 for each bar group | adds the bias to the group's length-error mean (a constant if it has none) |
+//! | `length_sigma` | `sigma.GROUP` \[mm\] from 1/5 to 5 times the stated σ, for each group with a stated spread | scales the group's spread about its mean to the new σ |
+//! | `diagonal_pretension` | `length_error` \[mm\] in \[−0.2, 0\] | adds a common length error to every cable group: diagonals made short, so pretensioned (lengthening them instead would make them slack, a different mechanism whose likelihood is not smooth at the null) |
 //! | `backlash` | (not yet: waits for joint clearances in truss-core and the job format) | |
 //!
 //! Every candidate reduces to the baseline at its *null* parameters (zero, or the stated σ),

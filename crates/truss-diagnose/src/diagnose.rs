@@ -28,7 +28,7 @@ pub const NOISE_SEED: u64 = 0x006e_6f69_7365;
 pub struct Settings {
     /// Simulated samples per evaluation; `None`: max(2000, 20·n), at most 10 000.
     pub samples: Option<usize>,
-    /// The instrument's standard deviation σ_m [mm].
+    /// The instrument's standard deviation σ_m \[mm\].
     pub measurement_sigma: f64,
     /// Family-wise significance level of the likelihood-ratio tests (Bonferroni over the
     /// candidates).
@@ -124,7 +124,7 @@ pub struct CandidateScore {
     pub delta_bic: f64,
     /// Likelihood evaluations (each a simulation of N samples).
     pub evaluations: usize,
-    /// Wall time of the fit [s].
+    /// Wall time of the fit \[s\].
     pub seconds: f64,
     /// Why the fit failed, if it did.
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -34,7 +34,7 @@ use crate::measured::MemberData;
 use crate::simulate::Simulation;
 use nalgebra::{DMatrix, DVector};
 
-/// The floor τ of the predicted standard deviation of every coordinate [mm]: 0.1 µm, below
+/// The floor τ of the predicted standard deviation of every coordinate \[mm\]: 0.1 µm, below
 /// any instrument's resolution for trusses of this size, and large against the solver's
 /// error (1e-12 relative).
 pub const RESOLUTION: f64 = 1e-4;
@@ -44,9 +44,9 @@ pub const RESOLUTION: f64 = 1e-4;
 pub struct DataSummary {
     /// Specimens n.
     pub n: usize,
-    /// Mean ȳ [mm].
+    /// Mean ȳ \[mm\].
     pub mean: DVector<f64>,
-    /// Covariance S_y, divisor n [mm²].
+    /// Covariance S_y, divisor n \[mm²\].
     pub cov: DMatrix<f64>,
 }
 
@@ -93,16 +93,16 @@ impl DataSummary {
 /// A case's Gaussian predictive distribution of one specimen.
 #[derive(Debug, Clone)]
 pub struct Gaussian {
-    /// μ [mm].
+    /// μ \[mm\].
     pub mean: DVector<f64>,
-    /// Σ [mm²].
+    /// Σ \[mm²\].
     pub cov: DMatrix<f64>,
     chol: nalgebra::Cholesky<f64, nalgebra::Dyn>,
     log_det: f64,
 }
 
 impl Gaussian {
-    /// From a simulation; `sigma_m` the instrument's standard deviation [mm].
+    /// From a simulation; `sigma_m` the instrument's standard deviation \[mm\].
     pub fn from_simulation(sim: &Simulation, sigma_m: f64) -> Result<Self, DiagnoseError> {
         let (mean, mut cov) = moments(&sim.x, sim.n, sim.d, 1);
         let extra = sigma_m * sigma_m + RESOLUTION * RESOLUTION;

@@ -80,7 +80,7 @@ pub struct DataReport {
 /// Measured member length errors.
 #[derive(Debug, Clone, Default)]
 pub struct MemberData {
-    /// (member index, measured length error [mm]).
+    /// (member index, measured length error \[mm\]).
     pub observations: Vec<(usize, f64)>,
 }
 
@@ -91,13 +91,13 @@ pub struct Measured {
     pub specimens: Vec<String>,
     /// The compared coordinates, model order (node, then axis).
     pub coords: Vec<Coordinate>,
-    /// `n × d` displacements of the compared coordinates, row per specimen [mm].
+    /// `n × d` displacements of the compared coordinates, row per specimen \[mm\].
     pub y: Vec<f64>,
-    /// tan θ_x of each specimen's top surface [-].
+    /// tan θ_x of each specimen's top surface \[-\].
     pub tan_x: Vec<f64>,
-    /// tan θ_y [-].
+    /// tan θ_y \[-\].
     pub tan_y: Vec<f64>,
-    /// θ_P [rad].
+    /// θ_P \[rad\].
     pub theta_p: Vec<f64>,
     /// Member measurements, if given.
     pub members: Option<MemberData>,

@@ -1,10 +1,10 @@
 //! SVG plots of the measured against the simulated distributions, before and after the
 //! effect is added:
 //!
-//! - `theta_p-ecdf-before.svg`, `theta_p-ecdf-after.svg`: the empirical CDFs of θ_P [µrad]
+//! - `theta_p-ecdf-before.svg`, `theta_p-ecdf-after.svg`: the empirical CDFs of θ_P \[µrad\]
 //!   (simulated with the instrument's noise).
 //! - `top-scatter-before.svg`, `top-scatter-after.svg`: per top-surface node, the x–y and
-//!   x–z displacement scatter [µm] of the specimens over up to 1000 simulated samples.
+//!   x–z displacement scatter \[µm\] of the specimens over up to 1000 simulated samples.
 
 use crate::errors::DiagnoseError;
 use crate::measured::Measured;

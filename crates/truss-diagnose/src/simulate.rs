@@ -26,15 +26,15 @@ pub struct Simulation {
     pub n: usize,
     /// Coordinates per sample `d`.
     pub d: usize,
-    /// `N × d` displacements at the coordinates, noise-free [mm].
+    /// `N × d` displacements at the coordinates, noise-free \[mm\].
     pub x: Vec<f64>,
-    /// `N × d` with the instrument's noise (empty unless asked) [mm].
+    /// `N × d` with the instrument's noise (empty unless asked) \[mm\].
     pub x_noisy: Vec<f64>,
     /// tan θ_x of the noisy positions (empty unless asked).
     pub tan_x: Vec<f64>,
     /// tan θ_y of the noisy positions.
     pub tan_y: Vec<f64>,
-    /// θ_P of the noisy positions [rad].
+    /// θ_P of the noisy positions \[rad\].
     pub theta_p: Vec<f64>,
     /// Samples whose solve failed (left out).
     pub failed: usize,
@@ -45,7 +45,7 @@ pub struct Simulation {
 /// What to simulate besides the noise-free displacements.
 #[derive(Debug, Clone, Copy)]
 pub struct Noise {
-    /// Instrument standard deviation σ_m [mm].
+    /// Instrument standard deviation σ_m \[mm\].
     pub sigma: f64,
     /// Seed of the noise.
     pub seed: u64,

@@ -30,7 +30,7 @@ pub struct SynthOptions {
     pub seed: u64,
     /// `none` or `NAME:P=V,…`.
     pub effect: String,
-    /// Instrument σ_m [mm].
+    /// Instrument σ_m \[mm\].
     pub measurement_sigma: f64,
     /// Write every node (not only the top surface).
     pub all_nodes: bool,
