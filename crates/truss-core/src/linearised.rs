@@ -35,6 +35,8 @@ pub(crate) struct CableBasis {
     pub z: Vec<f64>,
     /// `G`, row-major `n_c × n_c`.
     pub g: Vec<f64>,
+    /// `Gᵀ`, row-major (the columns of `G`, which rounding leaves not quite symmetric).
+    pub g_t: Vec<f64>,
     /// `1/((1 − r_c)·k_c)` per cable, with nominal `k_c` \[mm/N\].
     pub w_inv: Vec<f64>,
 }
@@ -74,10 +76,17 @@ impl CableBasis {
                 g[a * nc + b] = gather_b(s, ma, &z[b * n..(b + 1) * n]);
             }
         }
+        let mut g_t = vec![0.0; nc * nc];
+        for a in 0..nc {
+            for b in 0..nc {
+                g_t[b * nc + a] = g[a * nc + b];
+            }
+        }
         Self {
             cables,
             z,
             g,
+            g_t,
             w_inv,
         }
     }
@@ -262,13 +271,18 @@ impl ActiveSet {
                 self.capacitance.solve_in_place(&mut self.z);
             }
             // e = e_lin + G_{:,S} z_S; the slack set of this solution.
+            // Column by column (rows of Gᵀ), each sum in the order of the slack set.
             let (slack, z, e_lin) = (&self.slack, &self.z, &self.e_lin);
             self.e.clear();
-            self.e.extend(
-                basis.g.chunks_exact(nc).zip(e_lin).map(|(row, e)| {
-                    e + slack.iter().zip(z).map(|(&b, zb)| row[b] * zb).sum::<f64>()
-                }),
-            );
+            self.e.resize(nc, -0.0);
+            for (&b, zb) in slack.iter().zip(z) {
+                for (e, g) in self.e.iter_mut().zip(&basis.g_t[b * nc..(b + 1) * nc]) {
+                    *e += g * zb;
+                }
+            }
+            for (e, el) in self.e.iter_mut().zip(e_lin) {
+                *e += el;
+            }
             let e = &self.e;
             let settled = (0..nc).filter(|&c| e[c] < 0.0).eq(slack.iter().copied());
             if settled {

@@ -48,6 +48,9 @@ pub(crate) struct CompiledMember {
     pub slots: [usize; 3],
     /// Whether the coupling block's rows belong to node `i` (else to node `j`).
     pub coupling_rows_i: bool,
+    /// Whether this member is the first, in member order, to add to each of `slots`: it
+    /// then writes the block instead of adding to it, so assembly needs no clearing.
+    pub first: [bool; 3],
     /// 1 for a free direction, 0 for a fixed one, of node `i` then node `j`.
     pub masks: [[f64; 3]; 2],
     /// Blocks of node `i` and node `j` (rows `3b .. 3b + 3`), or [`NONE`] for a node with
@@ -72,6 +75,9 @@ pub struct Structure {
     pub(crate) members: Vec<CompiledMember>,
     /// Block slots and directions of fixed directions of active nodes (identity rows).
     pub(crate) identity_rows: Vec<(usize, usize)>,
+    /// Slots of the band (within it, not its padding) that no member adds to: zeroed at
+    /// the start of each assembly (a factorisation fills them in).
+    pub(crate) untouched: Vec<usize>,
     /// External load per row (plus the zero slot) \[N\].
     pub(crate) loads: Vec<f64>,
     /// `K₀`, factorised.
@@ -105,7 +111,7 @@ impl Structure {
                 }
             }
         }
-        let members = model
+        let mut members: Vec<CompiledMember> = model
             .members()
             .iter()
             .enumerate()
@@ -144,12 +150,27 @@ impl Structure {
                     is_cable,
                     slots: [slot(bi, bi), slot(bj, bj), slot(bi, bj)],
                     coupling_rows_i: bi > bj,
+                    first: [false; 3],
                     masks: [mask(i), mask(j)],
                     ends: [bi.unwrap_or(NONE), bj.unwrap_or(NONE)],
                     masked: (bi.is_some() && fixed[i].iter().any(|&f| f))
                         || (bj.is_some() && fixed[j].iter().any(|&f| f)),
                 }
             })
+            .collect();
+        let mut touched = vec![false; k.blocks() * (k.bandwidth() + 1)];
+        for c in &mut members {
+            for (first, &slot) in c.first.iter_mut().zip(&c.slots) {
+                if slot != NONE && !touched[slot] {
+                    touched[slot] = true;
+                    *first = true;
+                }
+            }
+        }
+        let untouched = (0..k.blocks())
+            .flat_map(|i| (i.saturating_sub(k.bandwidth())..=i).map(move |j| (i, j)))
+            .map(|(i, j)| k.slot(i, j))
+            .filter(|&slot| !touched[slot])
             .collect();
         let mut loads = vec![0.0; free + 1];
         for (node, dofs) in node_dofs.iter().enumerate() {
@@ -168,6 +189,7 @@ impl Structure {
             free,
             members,
             identity_rows,
+            untouched,
             loads,
             nominal: BlockBandMatrix::new(0, 0),
             basis: None,
@@ -190,7 +212,7 @@ impl Structure {
     /// and directions, `f(m)` a per-member factor such as a slack cable's compression
     /// ratio) into `k`, identity rows included.
     pub(crate) fn assemble_material(&self, k: &mut BlockBandMatrix, factor: impl Fn(usize) -> f64) {
-        k.clear();
+        self.begin_assembly(k);
         for (m, c) in self.members.iter().enumerate() {
             let kk = factor(m) * c.rigidity / c.natural_length;
             let n = c.unit;
@@ -207,33 +229,57 @@ impl Structure {
         self.set_identity_rows(k);
     }
 
+    /// Prepares `k` for [`Structure::add_member`] of every member in order: zeroes the
+    /// blocks that no member writes (the first member to reach a block writes it).
+    #[inline]
+    pub(crate) fn begin_assembly(&self, k: &mut BlockBandMatrix) {
+        let storage = k.storage_mut();
+        for &slot in &self.untouched {
+            storage[slot] = [[0.0; 3]; 3];
+        }
+    }
+
     /// Adds a member's contribution `[[K, −K], [−K, K]]` (from the six distinct entries of
-    /// the symmetric 3×3 `K`, order `[xx, yx, yy, zx, zy, zz]`), fixed directions masked.
-    /// Only the lower triangles of diagonal blocks are written (the only part read).
+    /// the symmetric 3×3 `K`, order `[xx, yx, yy, zx, zy, zz]`), fixed directions masked;
+    /// called for every member in order after [`Structure::begin_assembly`]. Only the lower
+    /// triangles of diagonal blocks are written (the only part read).
     #[inline]
     pub(crate) fn add_member(&self, k: &mut BlockBandMatrix, c: &CompiledMember, e: &[f64; 6]) {
         let [sii, sjj, sij] = c.slots;
         let storage = k.storage_mut();
         if !c.masked {
             // Masks of ones: `x·1·1` is `x` exactly, so this is the masked sum without the
-            // multiplications.
-            for slot in [sii, sjj] {
+            // multiplications; a block's first member writes it (`0 + x` is `x`).
+            for (slot, first) in [(sii, c.first[0]), (sjj, c.first[1])] {
                 if slot != NONE {
                     let b = &mut storage[slot];
-                    b[0][0] += e[0];
-                    b[1][0] += e[1];
-                    b[1][1] += e[2];
-                    b[2][0] += e[3];
-                    b[2][1] += e[4];
-                    b[2][2] += e[5];
+                    if first {
+                        b[0][0] = e[0];
+                        b[1][0] = e[1];
+                        b[1][1] = e[2];
+                        b[2][0] = e[3];
+                        b[2][1] = e[4];
+                        b[2][2] = e[5];
+                    } else {
+                        b[0][0] += e[0];
+                        b[1][0] += e[1];
+                        b[1][1] += e[2];
+                        b[2][0] += e[3];
+                        b[2][1] += e[4];
+                        b[2][2] += e[5];
+                    }
                 }
             }
             if sij != NONE {
                 let b = &mut storage[sij];
                 let full = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
-                for (row, f) in b.iter_mut().zip(&full) {
-                    for (x, y) in row.iter_mut().zip(f) {
-                        *x -= y;
+                if c.first[2] {
+                    *b = full.map(|row| row.map(|x| -x));
+                } else {
+                    for (row, f) in b.iter_mut().zip(&full) {
+                        for (x, y) in row.iter_mut().zip(f) {
+                            *x -= y;
+                        }
                     }
                 }
             }
@@ -241,6 +287,11 @@ impl Structure {
         }
         let full: Block = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
         let [mi, mj] = c.masks;
+        for (&slot, &first) in c.slots.iter().zip(&c.first) {
+            if slot != NONE && first {
+                storage[slot] = [[0.0; 3]; 3];
+            }
+        }
         if sii != NONE {
             add_masked(&mut storage[sii], &full, &mi, &mi, 1.0);
         }

@@ -238,8 +238,8 @@ impl Solver {
     /// Assembles into `self.k` the model stiffness `K(S)` of the module doc at the current
     /// point, for `S = self.factor_slack`: the true tangent when `S` is the current slack set.
     pub(super) fn assemble_model(&mut self) {
-        self.k.clear();
         let s = &*self.structure;
+        s.begin_assembly(&mut self.k);
         for (m, (c, st)) in s.members.iter().zip(&self.states).enumerate() {
             let stiffness = if c.is_cable && self.factor_slack[m] != st.slack {
                 let k = self.tension[m];
