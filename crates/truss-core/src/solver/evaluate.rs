@@ -45,7 +45,9 @@ pub(super) fn evaluate_with(
         let uj = ub.get(b).copied().unwrap_or([0.0; 3]);
         *st = m.state_with([uj[0] - ua[0], uj[1] - ua[1], uj[2] - ua[2]], k);
         let f = st.force;
-        force_scale = force_scale.max(f.abs());
+        // `force_scale.max(|f|)` (a NaN force is skipped) without its NaN handling.
+        let abs = f.abs();
+        force_scale = if abs > force_scale { abs } else { force_scale };
         let fk = [
             f * st.direction[0],
             f * st.direction[1],

@@ -7,7 +7,8 @@ use crate::SolveError;
 
 impl Solver {
     /// Line search along `self.d` from `self.u` (see the module doc); moves `self.u`,
-    /// `self.r` and `self.states` to the accepted point and returns α and its evaluation.
+    /// `self.r` and `self.states` to the accepted point and returns α, its evaluation and
+    /// `max |d|`.
     ///
     /// Keeps a bracket: `a`, the largest α seen with `φ' < 0`, and `b`, the smallest with
     /// `φ' > 0` (or a non-finite force, where a member would collapse). The trials are: the
@@ -21,12 +22,13 @@ impl Solver {
         iteration: u32,
         current: Evaluation,
         expand: bool,
-    ) -> Result<(f64, Evaluation), SolveError> {
+    ) -> Result<(f64, Evaluation, f64), SolveError> {
         const ETA: f64 = 0.5;
         let n = self.structure.free;
         let phi0 = dot_n(&self.r[..n], &self.d[..n]);
         // Never let one step move a node by more than a fifth of the shortest member.
-        let cap = 0.2 * self.shortest_member() / max_abs(&self.d[..n]).max(f64::MIN_POSITIVE);
+        let d_max = max_abs(&self.d[..n]);
+        let cap = 0.2 * self.shortest_member() / d_max.max(f64::MIN_POSITIVE);
         let (mut a, mut phi_a) = (0.0, phi0);
         let (mut b, mut phi_b) = (f64::INFINITY, f64::INFINITY);
         let mut steepest = phi0.min(0.0);
@@ -67,7 +69,7 @@ impl Solver {
                     || phi0 >= 0.0 && !expand);
             if accept {
                 self.accept();
-                return Ok((alpha, eval));
+                return Ok((alpha, eval, d_max));
             }
             if descending {
                 (a, phi_a) = (alpha, phi);
@@ -89,7 +91,7 @@ impl Solver {
         Err(SolveError::NotConverged {
             iterations: iteration,
             residual: current.residual,
-            step: a * max_abs(&self.d[..n]),
+            step: a * d_max,
         })
     }
 

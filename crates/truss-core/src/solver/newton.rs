@@ -130,9 +130,9 @@ impl Solver {
             }
 
             let residual_before = eval.residual;
-            let (alpha, new_eval) = self.line_search(iterations, eval, curved)?;
+            let (alpha, new_eval, d_max) = self.line_search(iterations, eval, curved)?;
             eval = new_eval;
-            step = alpha * max_abs(&self.d[..n]);
+            step = alpha * d_max;
             if opts.record_iterations {
                 let slack = self.slack_indices();
                 self.log.push(IterationRecord {
