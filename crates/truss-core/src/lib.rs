@@ -91,6 +91,6 @@ pub use structure::Structure;
 /// 0.16 % of the 1e-7 limit at 1e-4 (0.024 % at 1e-5). Below about 1e-4, though, a slack
 /// panel's compressed frame (whose geometric stiffness is about −N/L ≈ −0.05 N/mm at
 /// σ = 6.3 µm) outweighs its cables' `r·k` and must rack until a diagonal engages, which the
-/// solver resolves with extra factorisations: at 1e-5 a solve costs twice the instructions
-/// of one at 1e-4 (409k against 211k, 5-stage prism). 1e-4 keeps the physics and the speed.
+/// solver resolves with extra factorisations: at 1e-5 a solve costs about twice the instructions
+/// of one at 1e-4 (295k against 152k, 5-stage prism). 1e-4 keeps the physics and the speed.
 pub const DEFAULT_COMPRESSION_RATIO: f64 = 1e-4;
