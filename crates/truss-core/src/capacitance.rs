@@ -82,7 +82,7 @@ impl Capacitance {
         self.min_pivot_ratio
     }
 
-    /// Solves `C·x = b` in place with the factor (`b` of length [`Capacitance::size`]):
+    /// Solves `C·x = b` in place with the factor (`b` of the order of the matrix):
     /// `L·y = b`, then `Lᵀ·x = y`.
     pub fn solve_in_place(&self, b: &mut [f64]) {
         let (m, w) = (self.m, self.stride);

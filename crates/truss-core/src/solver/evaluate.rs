@@ -19,7 +19,8 @@ pub(super) fn evaluate(
     evaluate_with(s, members, k, loads, u, r, states)
 }
 
-/// [`evaluate`] with each member's `k = E·A/L₀` given, in member order.
+/// `r = g(u) − f` and the member states at `u`, with each member's `k = E·A/L₀` given (in
+/// member order); returns max |r| and max |N|.
 ///
 /// Member by member: gather `d = u_j − u_i` by node blocks (a node without a block is
 /// fixed: zero), the state, then scatter `∓N·n` into the rows of the two nodes. A member
