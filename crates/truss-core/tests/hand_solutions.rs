@@ -90,7 +90,9 @@ fn pre_shortened_cable_is_taut_and_in_tension() {
 }
 
 /// A cable made too long beside a bar that holds the node: the cable is slack and, with a
-/// compression ratio of zero, carries exactly nothing and moves nothing.
+/// compression ratio of zero, carries exactly nothing; the bar carries nothing and the node
+/// stays put, to rounding (1e-12 N, where the cable's 0.05 mm misfit would make 28 N if it
+/// were taut).
 #[test]
 fn slack_cable_carries_nothing() {
     let model = Model::new(file(
@@ -105,8 +107,16 @@ fn slack_cable_carries_nothing() {
     let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
     let report = solver.solve(&[0.0, 0.0]).unwrap();
     assert_eq!(solver.member_force(1), 0.0);
-    assert_eq!(solver.member_force(0), 0.0);
-    assert_eq!(solver.displacement(1), [0.0; 3]);
+    assert!(
+        solver.member_force(0).abs() < 1e-12,
+        "{}",
+        solver.member_force(0)
+    );
+    assert!(
+        solver.displacement(1)[0].abs() < 1e-15,
+        "{:?}",
+        solver.displacement(1)
+    );
     assert!(solver.is_slack(1));
     assert_eq!(report.slack_cables, 1);
 }

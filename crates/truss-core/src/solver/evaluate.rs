@@ -40,12 +40,14 @@ pub(super) fn evaluate_with(
     }
     let (ub, _) = u[..n].as_chunks::<3>();
     let mut force_scale = 0.0f64;
+    let mut strain = 0.0f64;
     for (((c, m), st), k) in s.members.iter().zip(members).zip(states.iter_mut()).zip(k) {
         let [a, b] = c.ends;
         let ua = ub.get(a).copied().unwrap_or([0.0; 3]);
         let uj = ub.get(b).copied().unwrap_or([0.0; 3]);
         *st = m.state_with([uj[0] - ua[0], uj[1] - ua[1], uj[2] - ua[2]], k);
         let f = st.force;
+        strain += 0.5 * f * st.elongation;
         // `force_scale.max(|f|)` (a NaN force is skipped) without its NaN handling.
         let abs = f.abs();
         force_scale = if abs > force_scale { abs } else { force_scale };
@@ -78,6 +80,7 @@ pub(super) fn evaluate_with(
     Evaluation {
         residual: max_abs(&r[..n]),
         force_scale,
+        strain,
     }
 }
 

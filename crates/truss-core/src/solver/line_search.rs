@@ -1,5 +1,6 @@
-//! The line search: a bracket on the directional derivative of the energy, seeded by an
-//! exact minimiser of the piecewise quadratic model along the line.
+//! The line search: a bracket on the directional derivative of the energy with a
+//! sufficient-decrease test, seeded by an exact minimiser of the piecewise quadratic model
+//! along the line.
 
 use super::evaluate::{dot_n, evaluate_with, max_abs};
 use super::{Evaluation, Solver};
@@ -10,13 +11,26 @@ impl Solver {
     /// `self.r` and `self.states` to the accepted point and returns α, its evaluation and
     /// `max |d|`.
     ///
-    /// Keeps a bracket: `a`, the largest α seen with `φ' < 0`, and `b`, the smallest with
-    /// `φ' > 0` (or a non-finite force, where a member would collapse). The trials are: the
-    /// full step (unless `expand`), then the minimiser predicted by [`Solver::predict_alpha`],
-    /// then false position or bisection inside the bracket, or fourfold growth while there
-    /// is no upper end. A trial is accepted when `|φ'(α)| ≤ η·|φ'_min|`, `φ'_min` the
-    /// steepest descent rate seen (φ'(0) for a Newton step; larger along a direction of
-    /// negative curvature, whose `φ'(0)` may be near zero).
+    /// Keeps a bracket: `a`, the largest α seen with `φ' < 0` and sufficient decrease, and
+    /// `b`, the smallest α seen with `φ' > 0`, or without sufficient decrease, or a
+    /// non-finite force (where a member would collapse). The trials are: the full step
+    /// (unless `expand`), then the minimiser predicted by [`Solver::predict_alpha`], then
+    /// false position or bisection inside the bracket, or fourfold growth while there is no
+    /// upper end. A trial is accepted when `|φ'(α)| ≤ η·|φ'_min|`, `φ'_min` the steepest
+    /// descent rate seen (φ'(0) for a Newton step; larger along a direction of negative
+    /// curvature, whose `φ'(0)` may be near zero), and the energy has fallen enough:
+    ///
+    /// ```text
+    /// Π(u + α·d) ≤ Π(u) + c₁·α·φ'(0) + τ,    c₁ = 1e-4,
+    /// τ = 1e-11·(|Σ W| + |fᵀu|)   (the rounding noise of Π at the floor)
+    /// ```
+    ///
+    /// (Armijo's condition, blind below the noise τ, where φ' alone decides): without it a
+    /// long step could cross a ridge of the energy and land on a worse point where φ' is
+    /// small again. The step is also capped at a trust length, `4·max(‖u‖∞, s)` with `s`
+    /// the sample's largest initial stretch, and a fifth of the shortest member. Returns an
+    /// error, for the caller to damp its steps, when the direction does not descend
+    /// (`φ'(0) ≥ 0`) or no acceptable α is found.
     pub(super) fn line_search(
         &mut self,
         iteration: u32,
@@ -24,11 +38,25 @@ impl Solver {
         expand: bool,
     ) -> Result<(f64, Evaluation, f64), SolveError> {
         const ETA: f64 = 0.5;
+        const C1: f64 = 1e-4;
         let n = self.structure.free;
         let phi0 = dot_n(&self.r[..n], &self.d[..n]);
-        // Never let one step move a node by more than a fifth of the shortest member.
         let d_max = max_abs(&self.d[..n]);
-        let cap = 0.2 * self.shortest_member() / d_max.max(f64::MIN_POSITIVE);
+        let u_max = max_abs(&self.u[..n]);
+        let trust = (4.0 * u_max.max(self.scale)).min(0.2 * self.shortest_member());
+        let cap = trust / d_max.max(f64::MIN_POSITIVE);
+        let work0 = dot_n(&self.loads[..n], &self.u[..n]);
+        let energy0 = current.strain - work0;
+        let noise = 1e-11 * (current.strain.abs() + work0.abs());
+        if !(phi0 < 0.0) && !expand {
+            // Not a descent direction (a model step whose switched cables point it
+            // uphill): the caller damps its steps, which makes the direction descend.
+            return Err(SolveError::NotConverged {
+                iterations: iteration,
+                residual: current.residual,
+                step: 0.0,
+            });
+        }
         let (mut a, mut phi_a) = (0.0, phi0);
         let (mut b, mut phi_b) = (f64::INFINITY, f64::INFINITY);
         let mut steepest = phi0.min(0.0);
@@ -55,18 +83,20 @@ impl Solver {
             };
             let eval = self.try_step(alpha);
             let phi = dot_n(&self.trial_r[..n], &self.d[..n]);
-            if phi.is_finite() {
+            let energy = eval.strain - dot_n(&self.loads[..n], &self.trial_u[..n]);
+            let decrease = energy <= energy0 + C1 * alpha * phi0.min(0.0) + noise;
+            if phi.is_finite() && decrease {
                 steepest = steepest.min(phi);
             }
-            let descending = phi.is_finite() && phi < 0.0;
+            let descending = phi.is_finite() && phi < 0.0 && decrease;
             // Accept: close enough to a root; or a Newton step still descending (the next
-            // iteration goes on from there); or the cap reached while still descending; or
-            // not a descent direction at all (rounding at the floor).
+            // iteration goes on from there); or the cap reached while still descending.
+            // Always with sufficient decrease.
             let accept = phi.is_finite()
+                && decrease
                 && (phi.abs() <= ETA * steepest.abs()
                     || (trial == 0 && !expand && phi <= 0.0)
-                    || (descending && alpha >= cap)
-                    || phi0 >= 0.0 && !expand);
+                    || (descending && alpha >= cap));
             if accept {
                 self.accept();
                 return Ok((alpha, eval, d_max));
@@ -78,7 +108,9 @@ impl Solver {
                 }
                 side = -1;
             } else {
-                (b, phi_b) = (alpha, phi);
+                // Past the minimum, over a ridge (no sufficient decrease: bisect), or a
+                // collapsed member.
+                (b, phi_b) = (alpha, if decrease { phi } else { f64::INFINITY });
                 if side == 1 {
                     phi_a *= 0.5;
                 }

@@ -76,7 +76,7 @@ pub struct SolveOptions {
 impl Default for SolveOptions {
     fn default() -> Self {
         Self {
-            max_iterations: 60,
+            max_iterations: 120,
             step_tolerance: 1e-12,
             residual_floor: 1e-13,
             reuse_factorisation: true,
@@ -189,6 +189,21 @@ pub struct Solver {
     breakpoints: Vec<(f64, f64)>,
     /// Nominal length of the shortest member \[mm\] (caps a line search's steps).
     shortest: f64,
+    /// The sample's largest |initial stretch| \[mm\]: the scale of its displacements
+    /// (with the shortest member's 1e-6, for samples driven by loads alone).
+    scale: f64,
+    /// The sample's force scale \[N\]: the largest `k·|s₀|` of its members and of its
+    /// loads, so that a solution whose forces all vanish still has a rounding floor.
+    force_ref: f64,
+    /// Levenberg damping μ of model steps (`K + μ·diag(K)`): 0, until steps stall.
+    damping: f64,
+    /// The next model step keeps the current slack set (the last one's switching did not
+    /// come true).
+    plain_step: bool,
+    /// The slack set when the current step was chosen.
+    step_slack: Vec<bool>,
+    /// Cables pinned at their kink for the next model step.
+    pinned: Vec<bool>,
 }
 
 /// Result of evaluating the out-of-balance force at a point.
@@ -198,6 +213,8 @@ struct Evaluation {
     residual: f64,
     /// Max |N| over members \[N\].
     force_scale: f64,
+    /// Strain energy Σ ½·k_e·e² \[N·mm\].
+    strain: f64,
 }
 
 impl Solver {
@@ -245,6 +262,12 @@ impl Solver {
             evaluations: 0,
             breakpoints: Vec::with_capacity(m),
             shortest: structure.shortest_member(),
+            scale: 0.0,
+            force_ref: 0.0,
+            damping: 0.0,
+            plain_step: false,
+            step_slack: vec![false; m],
+            pinned: vec![false; m],
             structure,
         }
     }
@@ -306,6 +329,21 @@ impl Solver {
             self.members[i] = s.nominal_member(c, e);
             self.tension[i] = self.members[i].tension_stiffness();
         }
+        self.scale = self
+            .members
+            .iter()
+            .map(|m| m.initial_stretch.abs())
+            .fold(1e-6 * self.shortest, f64::max);
+        self.force_ref = self
+            .members
+            .iter()
+            .zip(&self.tension)
+            .map(|(m, k)| k * m.initial_stretch.abs())
+            .chain(self.loads.iter().map(|f| f.abs()))
+            .fold(0.0, f64::max);
+        self.damping = 0.0;
+        self.plain_step = false;
+        self.pinned.fill(false);
         self.loads.copy_from_slice(&s.loads);
         for (node, f) in p.extra_loads.iter().enumerate() {
             if f.iter().any(|x| !x.is_finite()) {

@@ -54,7 +54,9 @@ impl Solver {
                         .into(),
                 });
             }
-            if eval.residual == 0.0 || eval.residual <= opts.residual_floor * eval.force_scale {
+            if eval.residual == 0.0
+                || eval.residual <= opts.residual_floor * eval.force_scale.max(self.force_ref)
+            {
                 break;
             }
             // At the rounding floor of an ill-conditioned structure (a tall tower, whose
@@ -66,7 +68,9 @@ impl Solver {
             } else {
                 stalled += 1;
             }
-            if stalled >= 3 && eval.residual <= 1e3 * opts.residual_floor * eval.force_scale {
+            if stalled >= 3
+                && eval.residual <= 1e3 * opts.residual_floor * eval.force_scale.max(self.force_ref)
+            {
                 break;
             }
             if iterations >= opts.max_iterations {
@@ -79,6 +83,7 @@ impl Solver {
             iterations += 1;
 
             // Choose the step.
+            self.step_slack.copy_from_slice(&self.slack);
             let mut fresh = false;
             let mut shift = 0.0;
             let mut curved = false;
@@ -130,9 +135,45 @@ impl Solver {
             }
 
             let residual_before = eval.residual;
-            let (alpha, new_eval, d_max) = self.line_search(iterations, eval, curved)?;
+            let (alpha, new_eval, d_max) = match self.line_search(iterations, eval, curved) {
+                Ok(found) => found,
+                Err(e) => {
+                    // No step along this direction lowers the energy: damp the model steps
+                    // (towards steepest descent) and try again from the same point.
+                    if !self.raise_damping() {
+                        return Err(e);
+                    }
+                    mode = Mode::Tangent;
+                    k_valid = false;
+                    prev_step = f64::INFINITY;
+                    continue;
+                }
+            };
             eval = new_eval;
             step = alpha * d_max;
+            let u_max = max_abs(&self.u[..n]);
+            let far_from_floor =
+                eval.residual > 1e3 * opts.residual_floor * eval.force_scale.max(self.force_ref);
+            if far_from_floor && step <= 1e-10 * u_max.max(self.scale) {
+                // A step that no longer moves while the force is far from balanced: damp.
+                if !self.raise_damping() {
+                    return Err(SolveError::NotConverged {
+                        iterations,
+                        residual: eval.residual,
+                        step,
+                    });
+                }
+                mode = Mode::Tangent;
+                k_valid = false;
+            } else if self.damping > 0.0 && alpha >= 0.5 {
+                // Full steps again: relax the damping back towards Newton's method.
+                self.damping = if self.damping < 1e-8 {
+                    0.0
+                } else {
+                    self.damping * 0.1
+                };
+                k_valid = false;
+            }
             if opts.record_iterations {
                 let slack = self.slack_indices();
                 self.log.push(IterationRecord {
@@ -146,12 +187,27 @@ impl Solver {
                     evaluations: self.evaluations,
                 });
             }
+            // A model step that switched cables but whose switch did not come true (the line
+            // search stopped short and the slack set is unchanged) is followed by a plain
+            // step on the current piece.
             self.update_slack();
+            let switched = fresh && self.factor_slack != self.step_slack;
+            self.plain_step = switched && alpha < 0.5 && self.slack == self.step_slack;
+            // Pin the cables whose switch failed for the next (plain) step, release the rest.
+            for ((p, f), s) in self
+                .pinned
+                .iter_mut()
+                .zip(&self.factor_slack)
+                .zip(&self.step_slack)
+            {
+                *p = self.plain_step && f != s;
+            }
 
             // Convergence on the step.
             let contraction = step / prev_step;
-            let small = step <= opts.step_tolerance * max_abs(&self.u[..n]);
-            if small && !curved && (fresh || contraction <= 0.5) {
+            let small = step <= opts.step_tolerance * u_max;
+            let undamped = self.damping == 0.0;
+            if small && !curved && undamped && (fresh || contraction <= 0.5) {
                 break;
             }
             poor = !fresh && !curved && contraction > opts.reuse_contraction;
@@ -165,6 +221,16 @@ impl Solver {
             slack_cables: self.slack.iter().filter(|&&s| s).count() as u32,
             evaluations: self.evaluations,
         })
+    }
+
+    /// Raises the Levenberg damping of model steps tenfold (from 1e-6); false once it is
+    /// beyond 1e8, where a model step is a scaled steepest descent and still does not move.
+    fn raise_damping(&mut self) -> bool {
+        self.damping = (self.damping * 10.0).max(1e-6);
+        // A damped step is a plain descent step: no cable pinned or switched.
+        self.pinned.fill(false);
+        self.plain_step = false;
+        self.damping <= 1e8
     }
 
     /// `d = −r` (the zero slot kept zero).

@@ -15,6 +15,13 @@
 //! the active-set iteration (take as the next `S` the cables with `e + nᵀΔδ < 0` until it
 //! repeats), so a step changes the state of any number of cables at once, instead of one
 //! line search per change.
+//!
+//! When such a switch does not come true (the line search stops at the cable's kink,
+//! `e = 0`, and no cable changes state), the equilibrium lies on that kink, where neither
+//! piece's own minimiser is: the next step is *plain* (the current set, no switching) with
+//! the cables that failed to switch *pinned*, stiffened a thousandfold in the model, so the
+//! step keeps their elongations at zero (the Newton step of the equality-constrained
+//! problem `e_c = 0`). The line search still judges every step on the true energy.
 
 use super::Solver;
 use super::evaluate::{dot_n, max_abs};
@@ -22,6 +29,10 @@ use crate::SolveError;
 
 /// Most slack sets tried for one model step; the last step is used if none settles.
 const MAX_MODEL_PIECES: u32 = 8;
+
+/// A cable pinned at its kink gets this many times its tension stiffness in the model: the
+/// step then keeps its elongation at zero, where an equilibrium on the kink lies.
+const PIN_FACTOR: f64 = 1e3;
 
 /// What a model step produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,11 +80,17 @@ impl Solver {
         let mut engagements = 0;
         while pieces < MAX_MODEL_PIECES {
             self.assemble_model();
+            if self.damping > 0.0 {
+                self.k.scale_diagonal(1.0 + self.damping);
+            }
             *factorisations += 1;
             self.k.factor_collecting(&mut self.failures, 1);
-            let mut shift = 0.0;
+            let mut shift = self.damping;
+            // Plain steps (the current slack set, no switching): while damped, and after a
+            // switching step that did not come true.
+            let damped = self.damping > 0.0 || self.plain_step;
             if let Some(&first) = self.failures.first() {
-                if first.pivot < 0.0 && engagements < self.structure.members.len() {
+                if !damped && first.pivot < 0.0 && engagements < self.structure.members.len() {
                     self.k
                         .failed_pivot_direction(first.index, &mut self.scratch);
                     if self.engage_first_cable() {
@@ -98,13 +115,7 @@ impl Solver {
             self.d[n] = 0.0;
             let s = &*self.structure;
             for (m, c) in s.members.iter().enumerate() {
-                if c.is_cable && self.factor_slack[m] != self.slack[m] {
-                    let k = self.tension[m];
-                    let k_model = if self.factor_slack[m] {
-                        c.compression_ratio * k
-                    } else {
-                        k
-                    };
+                if let Some(k_model) = self.model_stiffness(m) {
                     let st = &self.states[m];
                     let extra = (k_model - st.stiffness) * st.elongation;
                     for d in 0..3 {
@@ -116,6 +127,13 @@ impl Solver {
             }
             self.d[n] = 0.0;
             self.k.solve_in_place(&mut self.d[..n]);
+            if damped {
+                // Plain steps keep the current slack set: with no switched cables the
+                // direction −(K + μ·diag K)⁻¹·r descends, whatever the model says, and
+                // converges to the minimum of the current piece (or the line search takes it
+                // to the piece's edge).
+                return Ok(Step::Newton { shift });
+            }
             // The slack set the model predicts at the step.
             let mut settled = true;
             for (m, c) in s.members.iter().enumerate() {
@@ -152,9 +170,10 @@ impl Solver {
         Ok(Step::Newton { shift })
     }
 
-    /// Assembles the model's `K(S)` for `S = self.factor_slack` and factorises it; where it
-    /// is not positive definite, retries with a Levenberg shift `K + μ·diag(K)`, μ = 1e-9,
-    /// 1e-7, …, 1. Returns `Some(μ)` (the `Option` is for callers that stop at a curvature;
+    /// Assembles the model's `K(S)` for `S = self.factor_slack` and factorises it (with the
+    /// solver's current damping μ₀ as a Levenberg shift `K + μ·diag(K)`); where it is not
+    /// positive definite, retries with μ = 1e-9 (or 100·μ₀), ×100 each time, up to
+    /// max(1, 1000·μ₀). Returns `Some(μ)` (the `Option` is for callers that stop at a curvature;
     /// this one never does unless `allow_curvature`, which leaves the direction of the first
     /// negative pivot in `self.d` and returns `None`).
     pub(super) fn factor_model(
@@ -163,7 +182,8 @@ impl Solver {
         factorisations: &mut u32,
         allow_curvature: bool,
     ) -> Result<Option<f64>, SolveError> {
-        let mut shift = 0.0;
+        let mut shift = self.damping;
+        let limit = (1e3 * self.damping).max(1.0);
         loop {
             self.assemble_model();
             let s = &*self.structure;
@@ -180,7 +200,7 @@ impl Solver {
                         return Ok(None);
                     }
                     shift = if shift == 0.0 { 1e-9 } else { shift * 100.0 };
-                    if shift > 1.0 {
+                    if shift > limit {
                         let (node, dof) = s.describe_dof(e.index);
                         return Err(SolveError::Mechanism {
                             iteration,
@@ -241,19 +261,33 @@ impl Solver {
         let s = &*self.structure;
         s.begin_assembly(&mut self.k);
         for (m, (c, st)) in s.members.iter().zip(&self.states).enumerate() {
-            let stiffness = if c.is_cable && self.factor_slack[m] != st.slack {
-                let k = self.tension[m];
-                if self.factor_slack[m] {
-                    c.compression_ratio * k
-                } else {
-                    k
-                }
-            } else {
-                st.stiffness
-            };
+            let stiffness = self.model_stiffness(m).unwrap_or(st.stiffness);
             s.add_member(&mut self.k, c, &st.tangent_block_with(stiffness));
         }
         s.set_identity_rows(&mut self.k);
+    }
+
+    /// A cable's axial stiffness in the model when it differs from its present one: pinned
+    /// at its kink ([`PIN_FACTOR`] times its tension stiffness), or switched in `S`; `None`
+    /// otherwise.
+    #[inline]
+    fn model_stiffness(&self, m: usize) -> Option<f64> {
+        let c = &self.structure.members[m];
+        if !c.is_cable {
+            return None;
+        }
+        let k = self.tension[m];
+        if self.pinned[m] {
+            Some(PIN_FACTOR * k)
+        } else if self.factor_slack[m] != self.states[m].slack {
+            Some(if self.factor_slack[m] {
+                c.compression_ratio * k
+            } else {
+                k
+            })
+        } else {
+            None
+        }
     }
 
     /// Turns the direction left in `self.d` by a failed factorisation (whose curvature
