@@ -48,7 +48,7 @@ impl Solver {
         let work0 = dot_n(&self.loads[..n], &self.u[..n]);
         let energy0 = current.strain - work0;
         let noise = 1e-11 * (current.strain.abs() + work0.abs());
-        if !(phi0 < 0.0) && !expand {
+        if !expand && (phi0 >= 0.0 || phi0.is_nan()) {
             // Not a descent direction (a model step whose switched cables point it
             // uphill): the caller damps its steps, which makes the direction descend.
             return Err(SolveError::NotConverged {
