@@ -1,8 +1,8 @@
 //! Running a shard: samples computed on T threads, written in index order to the shard file.
 //!
-//! Workers take chunks of consecutive indices from a shared counter and send each finished
-//! line to the writer (this thread), which keeps a small reordering buffer and appends every
-//! run of lines that is complete and next in order. Memory stays flat in the sample count:
+//! Workers take chunks of consecutive indices from a shared counter, write the chunk's lines
+//! into one buffer and send it to the writer (this thread), which keeps a small reordering
+//! buffer and appends every chunk that is next in order, in one write. Memory stays flat in the sample count:
 //! the buffer holds at most the lines in flight. Each sample's line depends only on the job
 //! and its index, so the file is the same bytes for any thread count.
 
@@ -85,7 +85,10 @@ pub fn run_shard(
     let threads = options.threads.max(1);
     let next = AtomicU64::new(first);
     let stop = AtomicBool::new(false);
-    let (tx, rx) = sync_channel::<(u64, String, bool)>(4096);
+    // One message per chunk: its first index, its lines' bytes, and each line's length and
+    // whether it failed.
+    type Chunk = (u64, Vec<u8>, Vec<(usize, bool)>);
+    let (tx, rx) = sync_channel::<Chunk>(64 * threads);
     let result = std::thread::scope(|scope| {
         for _ in 0..threads {
             let tx = tx.clone();
@@ -97,32 +100,29 @@ pub fn run_shard(
                     if start >= range.end || stop.load(Ordering::Relaxed) {
                         break;
                     }
-                    for index in start..(start + CHUNK).min(range.end) {
+                    let end = (start + CHUNK).min(range.end);
+                    let mut bytes = Vec::with_capacity(300 * (end - start) as usize);
+                    let mut lines = Vec::with_capacity((end - start) as usize);
+                    for index in start..end {
                         let sample = worker.sample(index);
-                        let failed = sample.status == Status::Failed;
-                        if tx.send((index, sample.to_line(), failed)).is_err() {
-                            return;
-                        }
+                        let before = bytes.len();
+                        sample.write_line(&mut bytes);
+                        lines.push((bytes.len() - before, sample.status == Status::Failed));
+                    }
+                    if tx.send((start, bytes, lines)).is_err() {
+                        return;
                     }
                 }
             });
         }
         drop(tx);
-        // The writer: append runs of lines in index order as they complete.
-        let mut pending: BTreeMap<u64, (String, bool)> = BTreeMap::new();
+        // The writer: append runs of chunks in index order as they complete.
+        let mut pending: BTreeMap<u64, (Vec<u8>, Vec<(usize, bool)>)> = BTreeMap::new();
         let mut expect = first;
-        let mut bytes = Vec::with_capacity(1 << 16);
-        let mut lines = Vec::with_capacity(256);
-        for (index, line, failed) in rx {
-            pending.insert(index, (line, failed));
-            bytes.clear();
-            lines.clear();
-            while let Some((line, failed)) = pending.remove(&expect) {
-                bytes.extend_from_slice(line.as_bytes());
-                lines.push((line.len(), failed));
-                expect += 1;
-            }
-            if !lines.is_empty() {
+        for (start, bytes, lines) in rx {
+            pending.insert(start, (bytes, lines));
+            while let Some((bytes, lines)) = pending.remove(&expect) {
+                expect += lines.len() as u64;
                 if let Err(e) = writer.append(&bytes, &lines) {
                     stop.store(true, Ordering::Relaxed);
                     return Err(e);

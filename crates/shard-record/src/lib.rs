@@ -88,6 +88,13 @@ pub enum Record {
     End(End),
 }
 
+/// A sample record borrowed for writing: serialises exactly as `Record::Sample`.
+#[derive(Serialize)]
+#[serde(tag = "record", rename_all = "snake_case")]
+enum RecordRef<'a> {
+    Sample(&'a Sample),
+}
+
 /// The header line of a shard.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Begin {
@@ -232,7 +239,17 @@ impl Sample {
 
     /// The line this sample is written as, with its terminating `\n`.
     pub fn to_line(&self) -> String {
-        to_line(&Record::Sample(self.clone()))
+        let mut out = Vec::with_capacity(256);
+        self.write_line(&mut out);
+        String::from_utf8(out).expect("serde_json writes UTF-8")
+    }
+
+    /// Appends the line this sample is written as (the bytes of [`Sample::to_line`]) to
+    /// `out`, without copying the sample.
+    pub fn write_line(&self, out: &mut Vec<u8>) {
+        serde_json::to_writer(&mut *out, &RecordRef::Sample(self))
+            .expect("records always serialise");
+        out.push(b'\n');
     }
 }
 
