@@ -49,6 +49,10 @@ pub struct RunOptions {
     pub quiet: bool,
 }
 
+/// A finished chunk: its record lines back to back, and per line its length
+/// in bytes and whether the sample failed.
+type ChunkLines = (Vec<u8>, Vec<(usize, bool)>);
+
 /// Runs (or resumes, or verifies as complete) the shard `range` of `job` in `dir`.
 pub fn run_shard(
     job: &Job,
@@ -87,8 +91,7 @@ pub fn run_shard(
     let stop = AtomicBool::new(false);
     // One message per chunk: its first index, its lines' bytes, and each line's length and
     // whether it failed.
-    type Chunk = (u64, Vec<u8>, Vec<(usize, bool)>);
-    let (tx, rx) = sync_channel::<Chunk>(64 * threads);
+    let (tx, rx) = sync_channel::<(u64, ChunkLines)>(64 * threads);
     let result = std::thread::scope(|scope| {
         for _ in 0..threads {
             let tx = tx.clone();
@@ -109,7 +112,7 @@ pub fn run_shard(
                         sample.write_line(&mut bytes);
                         lines.push((bytes.len() - before, sample.status == Status::Failed));
                     }
-                    if tx.send((start, bytes, lines)).is_err() {
+                    if tx.send((start, (bytes, lines))).is_err() {
                         return;
                     }
                 }
@@ -117,10 +120,10 @@ pub fn run_shard(
         }
         drop(tx);
         // The writer: append runs of chunks in index order as they complete.
-        let mut pending: BTreeMap<u64, (Vec<u8>, Vec<(usize, bool)>)> = BTreeMap::new();
+        let mut pending: BTreeMap<u64, ChunkLines> = BTreeMap::new();
         let mut expect = first;
-        for (start, bytes, lines) in rx {
-            pending.insert(start, (bytes, lines));
+        for (start, chunk) in rx {
+            pending.insert(start, chunk);
             while let Some((bytes, lines)) = pending.remove(&expect) {
                 expect += lines.len() as u64;
                 if let Err(e) = writer.append(&bytes, &lines) {
