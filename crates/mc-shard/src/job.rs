@@ -19,12 +19,13 @@
 //!
 //! | field | meaning |
 //! |---|---|
-//! | `model` | `{"prism": {...}}` (the paper's truss: `stages` and any of `side`, `height`, `batten_area`, `batten_modulus`, `longeron_area`, `longeron_modulus`, `diagonal_area`, `diagonal_modulus`, `diagonal_length` (mm, or `"exact"`), `compression_ratio`), or a model file: `"path.json"` or `{"file": "path.json"}`, relative to the job file |
+//! | `model` | `{"prism": {...}}` (the paper's truss: `stages` and any of `side`, `height`, `batten_area`, `batten_modulus`, `longeron_area`, `longeron_modulus`, `diagonal_area`, `diagonal_modulus`, `diagonal_length` (mm, or `"exact"`), `compression_ratio`, `backlash`: `true` or `{"clearance", "tension_factor", "compression_ratio"}` for pin joints with clearance, see [`truss_core::prism::BacklashOptions`]), or a model file: `"path.json"` or `{"file": "path.json"}`, relative to the job file |
 //! | `seed` | a u64; with the case name and sample index it keys every random draw |
 //! | `cases[].name` | unique; names the case in shard files and reports |
 //! | `cases[].samples` | ≥ 1 |
 //! | `cases[].model` | optional: this case's own model, same forms as `model` |
 //! | `cases[].length_errors` | per member group, a distribution of the length error (natural length minus nominal, mm): `{"normal": {"sigma": s}}` (optional `"mean"`), `{"uniform": {"low": a, "high": b}}`, `{"constant": {"value": v}}`. Groups not named get none. |
+//! | `cases[].backlash` | optional: `{"clearance": distribution}`, each joint's clearance (mm, ≥ 0), drawn per joint and sample; needs a model with joints (`{"prism": {"stages": 5, "backlash": true}}`) |
 //! | `cases[].effects` | optional deterministic effects: `gravity` (self-weight) and `thermal_gradient` (a linear temperature field); see [`crate::effects`] |
 //!
 //! Unknown fields are refused. Every fault is reported with its JSON path
@@ -48,7 +49,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use truss_core::model_file::ModelFile;
-use truss_core::prism::PrismOptions;
+use truss_core::prism::{BacklashOptions, PrismOptions};
 use truss_core::{Model, Structure};
 
 /// Version of the numerics: bumped whenever the solver or the sampling would give different
@@ -84,6 +85,9 @@ pub struct CaseSpec {
     /// Deterministic effects: self-weight, a temperature field (see [`crate::effects`]).
     #[serde(default)]
     pub effects: EffectsSpec,
+    /// Joint clearances drawn per joint and sample; needs a model with joints.
+    #[serde(default)]
+    pub backlash: Option<CaseBacklash>,
 }
 
 /// The prism generator's options as a job writes them; absent fields take Table 1's values.
@@ -101,6 +105,35 @@ pub struct PrismSpec {
     diagonal_modulus: Option<f64>,
     diagonal_length: Option<DiagonalLength>,
     compression_ratio: Option<f64>,
+    backlash: Option<BacklashSpec>,
+}
+
+/// The prism's backlash joints as a job writes them: `true` for the defaults, or an object
+/// overriding some of `clearance` (mm, the model's own clearance, used when a case draws
+/// none), `tension_factor` (contact stiffness over a longeron's `E·A/h`) and
+/// `compression_ratio` (centring stiffness of a loose joint over its contact stiffness).
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(untagged)]
+enum BacklashSpec {
+    Enabled(bool),
+    Options(BacklashFields),
+}
+
+#[derive(Debug, Clone, Copy, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BacklashFields {
+    clearance: Option<f64>,
+    tension_factor: Option<f64>,
+    compression_ratio: Option<f64>,
+}
+
+/// A case's backlash: the distribution of each joint's clearance \[mm\], drawn per joint
+/// and sample (`{"clearance": {"uniform": {"low": 0.004, "high": 0.017}}}`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CaseBacklash {
+    /// Clearance distribution \[mm\]; its support must not go below zero.
+    pub clearance: DistributionSpec,
 }
 
 /// A diagonal natural length: a number of mm, or `"exact"`.
@@ -136,6 +169,18 @@ impl PrismSpec {
                 Some(DiagonalLength::Word(Exact::Exact)) => None,
             },
             compression_ratio: self.compression_ratio.unwrap_or(d.compression_ratio),
+            backlash: match self.backlash {
+                None | Some(BacklashSpec::Enabled(false)) => None,
+                Some(BacklashSpec::Enabled(true)) => Some(BacklashOptions::default()),
+                Some(BacklashSpec::Options(f)) => {
+                    let b = BacklashOptions::default();
+                    Some(BacklashOptions {
+                        clearance: f.clearance.unwrap_or(b.clearance),
+                        tension_factor: f.tension_factor.unwrap_or(b.tension_factor),
+                        compression_ratio: f.compression_ratio.unwrap_or(b.compression_ratio),
+                    })
+                }
+            },
         }
     }
 }
@@ -163,6 +208,8 @@ pub struct Case {
     pub effects: EffectsSpec,
     /// What the effects do: extra loads per node, extra length errors per member.
     pub applied: Applied,
+    /// Joint clearances drawn per joint and sample, if the case draws them.
+    pub backlash: Option<CaseBacklash>,
 }
 
 /// A validated job (see the module doc).
@@ -248,6 +295,30 @@ impl Job {
             c.effects
                 .check()
                 .map_err(|(field, m)| JobError::at(&at(&format!("effects.{field}")), &m))?;
+            if let Some(b) = &c.backlash {
+                let path = at("backlash.clearance");
+                if model.joints().is_empty() {
+                    return Err(JobError::at(
+                        &at("backlash"),
+                        "the model has no joints to give clearances to \
+                         (use {\"prism\": {\"stages\": N, \"backlash\": true}} or a model file with joints)",
+                    ));
+                }
+                b.clearance.check().map_err(|m| JobError::at(&path, &m))?;
+                let lowest = match b.clearance {
+                    DistributionSpec::Normal { sigma, .. } if sigma > 0.0 => f64::NEG_INFINITY,
+                    DistributionSpec::Normal { mean, .. } => mean,
+                    DistributionSpec::Uniform { low, .. } => low,
+                    DistributionSpec::Constant { value } => value,
+                };
+                if lowest < 0.0 {
+                    return Err(JobError::at(
+                        &path,
+                        "a clearance cannot be negative: give a distribution whose values are \
+                         all ≥ 0 (uniform with low ≥ 0, or a constant)",
+                    ));
+                }
+            }
             let applied = c.effects.apply(&model);
             let member_errors = model
                 .members()
@@ -270,6 +341,9 @@ impl Job {
             {
                 parameters.insert("uniform".to_string(), 1.0);
             }
+            if !model.joints().is_empty() {
+                parameters.insert("backlash".to_string(), 1.0);
+            }
             cases.push(Case {
                 name: c.name.clone(),
                 samples: c.samples,
@@ -281,6 +355,7 @@ impl Job {
                 parameters,
                 effects: c.effects.clone(),
                 applied,
+                backlash: c.backlash,
             });
             start = start.checked_add(c.samples).ok_or_else(|| {
                 JobError::at(&at("samples"), "the job has more than 2^64 samples")
@@ -406,6 +481,8 @@ struct CanonicalCase<'a> {
     samples: u64,
     length_errors: &'a BTreeMap<String, DistributionSpec>,
     effects: &'a EffectsSpec,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    backlash: Option<CaseBacklash>,
     model: ModelFile,
 }
 
@@ -423,6 +500,7 @@ fn job_id(seed: u64, cases: &[Case]) -> String {
                 samples: c.samples,
                 length_errors: &c.length_errors,
                 effects: &c.effects,
+                backlash: c.backlash,
                 model: c.model.to_file(),
             })
             .collect(),

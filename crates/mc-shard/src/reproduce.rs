@@ -4,7 +4,8 @@
 //! ## Detail (JSON)
 //!
 //! `line` (the shard's line, byte for byte, without its newline), `length_errors` (mm per
-//! member id, model order, as drawn), `iterations` (per Newton iteration: out-of-balance
+//! member id, model order, as drawn), `clearances` (mm per joint id, when the case draws
+//! backlash clearances), `iterations` (per Newton iteration: out-of-balance
 //! force \[N\], step \[mm\], line-search α, whether the tangent was factorised afresh, the slack
 //! cables), and, when it converged, `displacements` (mm per node id), `forces` (N per member
 //! id, tension positive) and `slack_cables`.
@@ -43,6 +44,8 @@ struct Detail<'a> {
     line: &'a str,
     units: serde_json::Value,
     length_errors: Ordered<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    clearances: Option<Ordered<f64>>,
     iterations: Vec<Iteration>,
     #[serde(skip_serializing_if = "Option::is_none")]
     displacements: Option<Ordered<[f64; 3]>>,
@@ -80,6 +83,16 @@ pub fn reproduce(job: &Job, c: usize, k: u64, detail: bool) -> String {
                 .map(|(m, &e)| (member_id(m), e))
                 .collect(),
         ),
+        clearances: (!worker.last_clearances().is_empty()).then(|| {
+            Ordered(
+                worker
+                    .last_clearances()
+                    .iter()
+                    .zip(model.joints())
+                    .map(|(&g, j)| (j.id.clone(), g))
+                    .collect(),
+            )
+        }),
         iterations: solver
             .iteration_log()
             .iter()

@@ -13,8 +13,9 @@
 //! and takes its 64-bit words (`next_u64`) in this order: two words for each member of the
 //! case's model, in model order, whether or not its group has a distribution (a member
 //! without one leaves its two words unused, so that adding a distribution to one group never
-//! changes another group's draws). [`crate::distribution`] says how two words become a
-//! number. So a sample's draws depend on the seed, the case name, `k` and the model, and on
+//! changes another group's draws); then, if the case draws backlash clearances, two words
+//! for each joint of the model, in model order. [`crate::distribution`] says how two words
+//! become a number. So a sample's draws depend on the seed, the case name, `k` and the model, and on
 //! nothing else: not the shard split, the thread count, the other cases, or the machine.
 
 use crate::job::Case;
@@ -45,10 +46,31 @@ pub fn sample_stream(key: &[u8; 32], k: u64) -> ChaCha20Rng {
 /// Draws the length errors \[mm\] of sample `k` of `case` into `errors` (one per member,
 /// model order; zero where the member's group has no distribution).
 pub fn draw_length_errors(key: &[u8; 32], case: &Case, k: u64, errors: &mut Vec<f64>) {
+    let mut clearances = Vec::new();
+    draw_sample(key, case, k, errors, &mut clearances);
+}
+
+/// Draws everything sample `k` of `case` draws: the length errors \[mm\] (one per member,
+/// model order) into `errors`, then the joint clearances \[mm\] (one per joint, model order;
+/// left empty when the case draws none, so the model's own apply) into `clearances`.
+pub fn draw_sample(
+    key: &[u8; 32],
+    case: &Case,
+    k: u64,
+    errors: &mut Vec<f64>,
+    clearances: &mut Vec<f64>,
+) {
     let mut rng = sample_stream(key, k);
     errors.clear();
     errors.extend(case.member_errors.iter().map(|dist| {
         let (w1, w2) = (rng.next_u64(), rng.next_u64());
         dist.map_or(0.0, |d| d.from_words(w1, w2))
     }));
+    clearances.clear();
+    if let Some(b) = &case.backlash {
+        clearances.extend(case.model.joints().iter().map(|_| {
+            let (w1, w2) = (rng.next_u64(), rng.next_u64());
+            b.clearance.from_words(w1, w2)
+        }));
+    }
 }

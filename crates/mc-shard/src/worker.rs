@@ -2,7 +2,7 @@
 //! runner and `reproduce` use the same code, so a reproduced line is the shard's line.
 
 use crate::job::Job;
-use crate::sampler::{draw_length_errors, stream_key};
+use crate::sampler::{draw_sample, stream_key};
 use shard_record::{Sample, Status};
 use truss_core::solver::Perturbation;
 use truss_core::{SolveOptions, Solver};
@@ -13,6 +13,7 @@ pub struct Worker<'j> {
     keys: Vec<[u8; 32]>,
     solvers: Vec<Option<Solver>>,
     errors: Vec<f64>,
+    clearances: Vec<f64>,
     options: SolveOptions,
 }
 
@@ -33,6 +34,7 @@ impl<'j> Worker<'j> {
                 .collect(),
             solvers: job.cases.iter().map(|_| None).collect(),
             errors: Vec::new(),
+            clearances: Vec::new(),
             options,
         }
     }
@@ -45,7 +47,13 @@ impl<'j> Worker<'j> {
     pub fn sample(&mut self, index: u64) -> Sample {
         let (c, k) = self.job.case_of(index).expect("index within the job");
         let case = &self.job.cases[c];
-        draw_length_errors(&self.keys[c], case, k, &mut self.errors);
+        draw_sample(
+            &self.keys[c],
+            case,
+            k,
+            &mut self.errors,
+            &mut self.clearances,
+        );
         for (e, t) in self.errors.iter_mut().zip(&case.applied.length_changes) {
             *e += t;
         }
@@ -55,7 +63,9 @@ impl<'j> Worker<'j> {
         let result = solver.solve_perturbed(Perturbation {
             length_errors: &self.errors,
             extra_loads: &case.applied.loads,
+            clearances: &self.clearances,
         });
+        let has_joints = !case.model.joints().is_empty();
         let base = Sample {
             index,
             case: case.name.clone(),
@@ -79,6 +89,7 @@ impl<'j> Worker<'j> {
                     tan_theta_y: Some(d.tan_theta_y),
                     residual: Some(report.residual),
                     slack_cables: Some(report.slack_cables),
+                    loose_joints: has_joints.then_some(report.loose_joints),
                     ..base
                 },
                 Some(_) => Sample {
@@ -112,6 +123,12 @@ impl<'j> Worker<'j> {
     /// thermal length change.
     pub fn last_errors(&self) -> &[f64] {
         &self.errors
+    }
+
+    /// The joint clearances the last sample drew \[mm\], model order (empty when its case
+    /// draws none).
+    pub fn last_clearances(&self) -> &[f64] {
+        &self.clearances
     }
 
     /// The solver of case `c`, after it solved a sample of that case.

@@ -29,7 +29,7 @@ pub mod solve;
 use clap::{Args, Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
-use truss_core::prism::{PrismOptions, TABLE1_DIAGONAL_LENGTH};
+use truss_core::prism::{BacklashOptions, PrismOptions, TABLE1_DIAGONAL_LENGTH};
 
 /// Exit code: the solve failed.
 pub const EXIT_SOLVE_FAILED: u8 = 1;
@@ -118,6 +118,19 @@ pub struct PrismArgs {
     /// Cables' compression stiffness / tension stiffness.
     #[arg(long, default_value_t = truss_core::DEFAULT_COMPRESSION_RATIO)]
     pub compression_ratio: f64,
+    /// Model the batten–longeron pin joints with backlash (paper section 4): each joint
+    /// gets a shaft node and a hole node joined by a virtual cable.
+    #[arg(long)]
+    pub backlash: bool,
+    /// Clearance of every joint \[mm\] (with `--backlash`).
+    #[arg(long, default_value_t = truss_core::prism::PAPER_CLEARANCE, requires = "backlash")]
+    pub clearance: f64,
+    /// Joint contact stiffness over a longeron's axial stiffness E·A/h (with `--backlash`).
+    #[arg(long, default_value_t = truss_core::joint::DEFAULT_JOINT_TENSION_FACTOR, requires = "backlash")]
+    pub joint_tension_factor: f64,
+    /// Loose joint's centring stiffness over its contact stiffness (with `--backlash`).
+    #[arg(long, default_value_t = truss_core::joint::DEFAULT_JOINT_COMPRESSION_RATIO, requires = "backlash")]
+    pub joint_compression_ratio: f64,
 }
 
 impl PrismArgs {
@@ -135,6 +148,11 @@ impl PrismArgs {
             diagonal_modulus: self.diagonal_modulus,
             diagonal_length: (!self.exact_diagonals).then_some(self.diagonal_length),
             compression_ratio: self.compression_ratio,
+            backlash: self.backlash.then_some(BacklashOptions {
+                clearance: self.clearance,
+                tension_factor: self.joint_tension_factor,
+                compression_ratio: self.joint_compression_ratio,
+            }),
         }
     }
 }

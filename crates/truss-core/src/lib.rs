@@ -65,6 +65,7 @@ pub mod block;
 mod capacitance;
 pub mod element;
 mod errors;
+pub mod joint;
 mod linearised;
 pub mod measure;
 pub mod model;
@@ -76,7 +77,7 @@ mod structure;
 
 pub use errors::{ModelError, SolveError};
 pub use measure::{Distortion, distortion};
-pub use model::{Behaviour, Member, Model, Node, TopSurface};
+pub use model::{Behaviour, Joint, Member, Model, Node, TopSurface};
 pub use model_file::ModelFile;
 pub use solver::{Equilibrium, IterationRecord, SolveOptions, SolveReport, Solver};
 pub use structure::Structure;

@@ -97,22 +97,22 @@ impl CableBasis {
 pub(crate) fn scatter_b(s: &Structure, m: usize, scale: f64, v: &mut [f64]) {
     let c = &s.members[m];
     let n = &c.unit;
-    if c.masked {
+    if c.link.masked {
         for k in 0..3 {
-            v[c.dofs[k]] -= scale * n[k];
-            v[c.dofs[3 + k]] += scale * n[k];
+            v[c.link.dofs[k]] -= scale * n[k];
+            v[c.link.dofs[3 + k]] += scale * n[k];
         }
         v[s.free] = 0.0;
         return;
     }
     let f = [scale * n[0], scale * n[1], scale * n[2]];
     let (blocks, _) = v[..s.free].as_chunks_mut::<3>();
-    if let Some(x) = blocks.get_mut(c.ends[0]) {
+    if let Some(x) = blocks.get_mut(c.link.ends[0]) {
         for (x, f) in x.iter_mut().zip(&f) {
             *x -= f;
         }
     }
-    if let Some(x) = blocks.get_mut(c.ends[1]) {
+    if let Some(x) = blocks.get_mut(c.link.ends[1]) {
         for (x, f) in x.iter_mut().zip(&f) {
             *x += f;
         }
@@ -124,16 +124,16 @@ pub(crate) fn scatter_b(s: &Structure, m: usize, scale: f64, v: &mut [f64]) {
 pub(crate) fn gather_b(s: &Structure, m: usize, v: &[f64]) -> f64 {
     let c = &s.members[m];
     let mut sum = 0.0;
-    if c.masked {
+    if c.link.masked {
         let at = |d: usize| if d < s.free { v[d] } else { 0.0 };
         for k in 0..3 {
-            sum += c.unit[k] * (at(c.dofs[3 + k]) - at(c.dofs[k]));
+            sum += c.unit[k] * (at(c.link.dofs[3 + k]) - at(c.link.dofs[k]));
         }
         return sum;
     }
     let (blocks, _) = v[..s.free].as_chunks::<3>();
-    let vi = blocks.get(c.ends[0]).copied().unwrap_or([0.0; 3]);
-    let vj = blocks.get(c.ends[1]).copied().unwrap_or([0.0; 3]);
+    let vi = blocks.get(c.link.ends[0]).copied().unwrap_or([0.0; 3]);
+    let vj = blocks.get(c.link.ends[1]).copied().unwrap_or([0.0; 3]);
     for k in 0..3 {
         sum += c.unit[k] * (vj[k] - vi[k]);
     }

@@ -2,11 +2,13 @@
 //!
 //! A [`Model`] is built only by validating a [`ModelFile`]; from then on its invariants hold:
 //! ids are unique, every reference resolves to an index, every number is finite, areas,
-//! moduli and natural lengths are positive, no member has zero length, and the nominal
-//! structure is not a mechanism.
+//! moduli and natural lengths are positive, no member has zero length, a joint's two nodes
+//! coincide, and the nominal structure (its joints loose) is not a mechanism.
 
+use crate::joint::{DEFAULT_JOINT_COMPRESSION_RATIO, DEFAULT_JOINT_TENSION_FACTOR, JointElement};
 use crate::model_file::{
-    BehaviourSpec, LoadSpec, MemberSpec, ModelFile, NodeSpec, SupportSpec, TopSurfaceSpec,
+    BehaviourSpec, JointSpec, LoadSpec, MemberSpec, ModelFile, NodeSpec, SupportSpec,
+    TopSurfaceSpec,
 };
 use crate::{DEFAULT_COMPRESSION_RATIO, ModelError};
 use std::collections::HashMap;
@@ -76,6 +78,40 @@ pub struct TopSurface {
     pub reference_normal: [f64; 3],
 }
 
+/// A pin joint with backlash between a shaft node and a hole node (see [`crate::joint`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Joint {
+    /// Unique id.
+    pub id: String,
+    /// Index of the shaft-centre node (batten end).
+    pub shaft: usize,
+    /// Index of the hole-centre node (longeron end).
+    pub hole: usize,
+    /// Unit shaft axis, or `None` for backlash in every direction.
+    pub axis: Option<[f64; 3]>,
+    /// Nominal clearance `g` \[mm\].
+    pub clearance: f64,
+    /// Contact stiffness `k_t` \[N/mm\].
+    pub tension_stiffness: f64,
+    /// `k_c/k_t`, the loose joint's centring stiffness over the contact stiffness.
+    pub compression_ratio: f64,
+    /// Stiffness along the axis `k_a` \[N/mm\].
+    pub axial_stiffness: f64,
+}
+
+impl Joint {
+    /// The joint's element with clearance `clearance` \[mm\].
+    pub fn element(&self, clearance: f64) -> JointElement {
+        JointElement {
+            axis: self.axis,
+            clearance,
+            tension_stiffness: self.tension_stiffness,
+            compression_stiffness: self.compression_ratio * self.tension_stiffness,
+            axial_stiffness: self.axial_stiffness,
+        }
+    }
+}
+
 /// A validated truss model (see the module doc for its invariants).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
@@ -84,6 +120,7 @@ pub struct Model {
     fixed: Vec<[bool; 3]>,
     loads: Vec<[f64; 3]>,
     top_surface: Option<TopSurface>,
+    joints: Vec<Joint>,
     node_index: HashMap<String, usize>,
 }
 
@@ -162,12 +199,20 @@ impl Model {
             .as_ref()
             .map(|t| check_top_surface(t, &nodes, &lookup))
             .transpose()?;
+        unique_ids("joint", file.joints.iter().map(|j| j.id.as_str()))?;
+        let joints = file
+            .joints
+            .iter()
+            .enumerate()
+            .map(|(i, j)| check_joint(i, j, &nodes, &members, &lookup))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             nodes,
             members,
             fixed,
             loads,
             top_surface,
+            joints,
             node_index,
         })
     }
@@ -195,6 +240,11 @@ impl Model {
     /// The measured surface, if the model has one.
     pub fn top_surface(&self) -> Option<&TopSurface> {
         self.top_surface.as_ref()
+    }
+
+    /// The pin joints with backlash.
+    pub fn joints(&self) -> &[Joint] {
+        &self.joints
     }
 
     /// Index of the node with id `id`.
@@ -287,6 +337,20 @@ impl Model {
                 nodes: t.nodes.map(|n| self.nodes[n].id.clone()),
                 reference_normal: t.reference_normal,
             }),
+            joints: self
+                .joints
+                .iter()
+                .map(|j| JointSpec {
+                    id: j.id.clone(),
+                    shaft: self.nodes[j.shaft].id.clone(),
+                    hole: self.nodes[j.hole].id.clone(),
+                    axis: j.axis,
+                    clearance: j.clearance,
+                    tension_stiffness: Some(j.tension_stiffness),
+                    compression_ratio: Some(j.compression_ratio),
+                    axial_stiffness: Some(j.axial_stiffness),
+                })
+                .collect(),
         }
     }
 }
@@ -469,5 +533,98 @@ fn check_top_surface(
     Ok(TopSurface {
         nodes: idx,
         reference_normal: r.map(|x| x / norm),
+    })
+}
+
+fn check_joint(
+    i: usize,
+    j: &JointSpec,
+    nodes: &[Node],
+    members: &[Member],
+    lookup: &NodeLookup<'_>,
+) -> Result<Joint, ModelError> {
+    let item = || format!("joints[{i}] (id {:?})", j.id);
+    let shaft = lookup(&item, &j.shaft)?;
+    let hole = lookup(&item, &j.hole)?;
+    if shaft == hole {
+        return Err(ModelError::Invalid {
+            item: item(),
+            message: "shaft and hole must be two different nodes".into(),
+        });
+    }
+    if nodes[shaft].xyz != nodes[hole].xyz {
+        return Err(ModelError::Invalid {
+            item: item(),
+            message: format!(
+                "shaft {:?} at {:?} and hole {:?} at {:?} must have the same xyz (a joint's \
+                 nodes coincide nominally)",
+                j.shaft, nodes[shaft].xyz, j.hole, nodes[hole].xyz
+            ),
+        });
+    }
+    let axis = match j.axis {
+        None => None,
+        Some(a) => {
+            finite(&item(), "axis", &a)?;
+            let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            if n == 0.0 {
+                return Err(ModelError::Invalid {
+                    item: item(),
+                    message: "axis must not be zero".into(),
+                });
+            }
+            Some(a.map(|x| x / n))
+        }
+    };
+    finite(&item(), "clearance", &[j.clearance])?;
+    if j.clearance < 0.0 {
+        return Err(ModelError::Invalid {
+            item: item(),
+            message: format!("clearance must be at least 0 mm, got {}", j.clearance),
+        });
+    }
+    let tension_stiffness = match j.tension_stiffness {
+        Some(k) => positive(&item(), "tension_stiffness", k)?,
+        None => {
+            let stiffest = members
+                .iter()
+                .filter(|m| m.nodes.iter().any(|&n| n == shaft || n == hole))
+                .map(Member::axial_stiffness)
+                .fold(0.0, f64::max);
+            if stiffest == 0.0 {
+                return Err(ModelError::Invalid {
+                    item: item(),
+                    message: "no member meets its nodes: give tension_stiffness".into(),
+                });
+            }
+            DEFAULT_JOINT_TENSION_FACTOR * stiffest
+        }
+    };
+    let compression_ratio = j
+        .compression_ratio
+        .unwrap_or(DEFAULT_JOINT_COMPRESSION_RATIO);
+    finite(&item(), "compression_ratio", &[compression_ratio])?;
+    if !(compression_ratio > 0.0 && compression_ratio <= 1.0) {
+        return Err(ModelError::Invalid {
+            item: item(),
+            message: format!(
+                "compression_ratio must be in (0, 1] (a loose joint needs some stiffness to \
+                 have a position), got {compression_ratio}"
+            ),
+        });
+    }
+    let axial_stiffness = match j.axial_stiffness {
+        Some(k) => positive(&item(), "axial_stiffness", k)?,
+        None => tension_stiffness,
+    };
+    Ok(Joint {
+        id: j.id.clone(),
+        shaft,
+        hole,
+        axis,
+        clearance: j.clearance,
+        tension_stiffness,
+        compression_ratio,
+        axial_stiffness,
     })
 }

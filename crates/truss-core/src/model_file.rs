@@ -13,7 +13,10 @@
 //!                "behaviour": "cable", "compression_ratio": 1e-4}, …],
 //!   "supports": [{"node": "n0.0", "fixed": "xyz"}, …],
 //!   "loads":    [{"node": "n5.0", "force": [0.0, 0.0, -1.0]}],
-//!   "top_surface": {"nodes": ["n5.0", "n5.1", "n5.2"], "reference_normal": [0.0, 0.0, 1.0]}
+//!   "top_surface": {"nodes": ["n5.0", "n5.1", "n5.2"], "reference_normal": [0.0, 0.0, 1.0]},
+//!   "joints":   [{"id": "joint.5.0", "shaft": "n5.0", "hole": "n5.0.h",
+//!                 "axis": [-0.866, -0.5, 0.0], "clearance": 0.01,
+//!                 "tension_stiffness": 2.745e8, "compression_ratio": 1e-5}]
 //! }
 //! ```
 //!
@@ -33,6 +36,13 @@
 //! | `loads[].node`, `loads[].force` | a nodal force | N |
 //! | `top_surface.nodes` | three nodes whose plane is measured (paper Fig. 5 order 1, 2, 3); optional | |
 //! | `top_surface.reference_normal` | the normal θ_P is measured against, default `[0, 0, 1]` | |
+//! | `joints[].id` | unique joint name; optional section (see [`crate::joint`]) | |
+//! | `joints[].shaft`, `joints[].hole` | the shaft-centre node (batten end) and hole-centre node (longeron end); they must have the same `xyz` | |
+//! | `joints[].axis` | the shaft's axis (any length, normalised); optional: without it the clearance acts in every direction | |
+//! | `joints[].clearance` | nominal clearance `g` ≥ 0, the virtual cable's natural length; a job may draw it per sample | mm |
+//! | `joints[].tension_stiffness` | contact stiffness `k_t` > 0; default 10⁵ × the largest `E·A/L₀` of the members at the joint's nodes | N/mm |
+//! | `joints[].compression_ratio` | `k_c/k_t` in (0, 1], the centring stiffness of a loose joint; default 1e-5 | |
+//! | `joints[].axial_stiffness` | `k_a` > 0 along the axis; default `k_t` | N/mm |
 //!
 //! Unknown fields are refused, so a misspelt field name is an error rather than a silently
 //! ignored value.
@@ -56,6 +66,9 @@ pub struct ModelFile {
     /// The surface whose tilt is measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub top_surface: Option<TopSurfaceSpec>,
+    /// Pin joints with backlash.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joints: Vec<JointSpec>,
 }
 
 /// A node as written.
@@ -131,6 +144,32 @@ pub struct TopSurfaceSpec {
     /// Reference normal; default +z.
     #[serde(default = "default_normal")]
     pub reference_normal: [f64; 3],
+}
+
+/// A pin joint with backlash as written (see [`crate::joint`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    /// Unique id.
+    pub id: String,
+    /// The shaft-centre node id (batten end).
+    pub shaft: String,
+    /// The hole-centre node id (longeron end).
+    pub hole: String,
+    /// The shaft's axis; none for backlash in every direction.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<[f64; 3]>,
+    /// Nominal clearance \[mm\].
+    pub clearance: f64,
+    /// Contact stiffness \[N/mm\]; default 10⁵ × the stiffest member at the joint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tension_stiffness: Option<f64>,
+    /// Centring stiffness of a loose joint / contact stiffness; default 1e-5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression_ratio: Option<f64>,
+    /// Stiffness along the axis \[N/mm\]; default the contact stiffness.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_stiffness: Option<f64>,
 }
 
 fn default_normal() -> [f64; 3] {

@@ -17,10 +17,28 @@
 //! is the order in which a Monte Carlo sample draws length errors. Level 0 is fully fixed.
 //! The top surface is `n{N}.0`, `n{N}.1`, `n{N}.2` against the normal (0, 0, 1).
 //!
+//! With [`PrismOptions::backlash`] every node is a pin joint with backlash (section 4 of the
+//! paper; see [`crate::joint`]): the node `n{k}.{j}` above becomes the *shaft* node, where
+//! the battens and the diagonals attach, and a *hole* node `n{k}.{j}.h` at the same place
+//! carries the longerons' ends (the longeron `longeron.{s}.{j}` joins `n{s-1}.{j}.h` to
+//! `n{s}.{j}.h`), joined to it by the joint `joint.{k}.{j}`. The diagonals attach on the
+//! batten side because the batten-end fitting, which carries the shaft, is where a
+//! deployable truss anchors its diagonals; it is also what the paper's Fig. 13 shows: the
+//! shortened diagonals pull the battens towards each other, and each shaft comes to rest
+//! against the edge of its hole along the longeron, shortening the truss by the clearances.
+//! The shaft's axis is horizontal and radial (from the prism's axis through the vertex), the
+//! bisector of the normals of the two side faces that meet there, so that the clearance
+//! acts in each face's plane as in the paper's two-dimensional panel (Fig. 12). The bottom
+//! shaft nodes are fixed; the top surface is the top shaft nodes (the battens' plane). Hole
+//! nodes are listed after all shaft nodes, joints level by level; members keep the order
+//! above, so a sample's length errors are drawn alike with and without backlash.
+//!
 //! Table 1's diagonal natural length, 537.4 mm, is 1.15 µm shorter than the face diagonal
 //! 380·√2 = 537.401 15 mm, so the diagonals start slightly in tension (0.46 N) and the frame
 //! slightly in compression; [`PrismOptions::diagonal_length`] `None` gives the exact length.
 
+use crate::joint::{DEFAULT_JOINT_COMPRESSION_RATIO, DEFAULT_JOINT_TENSION_FACTOR};
+use crate::model_file::JointSpec;
 use crate::model_file::{
     BehaviourSpec, MemberSpec, ModelFile, NodeSpec, SupportSpec, TopSurfaceSpec,
 };
@@ -54,6 +72,32 @@ pub struct PrismOptions {
     pub diagonal_length: Option<f64>,
     /// Diagonals' compression stiffness ratio (they are tension-only cables).
     pub compression_ratio: f64,
+    /// Pin joints with backlash at every node (see the module doc); `None` for rigid nodes.
+    pub backlash: Option<BacklashOptions>,
+}
+
+/// The joints of a prism with backlash.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BacklashOptions {
+    /// Nominal clearance of every joint \[mm\] (a job may draw one per joint and sample).
+    pub clearance: f64,
+    /// Contact stiffness over the longeron's axial stiffness `E·A/h`.
+    pub tension_factor: f64,
+    /// Centring stiffness of a loose joint over its contact stiffness.
+    pub compression_ratio: f64,
+}
+
+/// The paper's size of the backlash at a node, "about 0.01 mm" (section 4.1) \[mm\].
+pub const PAPER_CLEARANCE: f64 = 0.01;
+
+impl Default for BacklashOptions {
+    fn default() -> Self {
+        Self {
+            clearance: PAPER_CLEARANCE,
+            tension_factor: DEFAULT_JOINT_TENSION_FACTOR,
+            compression_ratio: DEFAULT_JOINT_COMPRESSION_RATIO,
+        }
+    }
 }
 
 impl Default for PrismOptions {
@@ -70,6 +114,7 @@ impl Default for PrismOptions {
             diagonal_modulus: 70_000.0,
             diagonal_length: Some(TABLE1_DIAGONAL_LENGTH),
             compression_ratio: DEFAULT_COMPRESSION_RATIO,
+            backlash: None,
         }
     }
 }
@@ -105,6 +150,21 @@ impl PrismOptions {
                     id: node(k, j),
                     xyz: vertex(j, k),
                 });
+            }
+        }
+        // With backlash, the longerons' ends are the hole nodes.
+        let hole = |k: usize, j: usize| match self.backlash {
+            Some(_) => format!("n{k}.{j}.h"),
+            None => node(k, j),
+        };
+        if self.backlash.is_some() {
+            for k in 0..=self.stages {
+                for j in 0..3 {
+                    nodes.push(NodeSpec {
+                        id: hole(k, j),
+                        xyz: vertex(j, k),
+                    });
+                }
             }
         }
         let position = |id: &str| nodes.iter().find(|n| n.id == id).map(|n| n.xyz);
@@ -161,8 +221,8 @@ impl PrismOptions {
             for j in 0..3 {
                 push(
                     format!("longeron.{s}.{j}"),
-                    node(s - 1, j),
-                    node(s, j),
+                    hole(s - 1, j),
+                    hole(s, j),
                     "longeron",
                 );
             }
@@ -193,12 +253,34 @@ impl PrismOptions {
             nodes: [0, 1, 2].map(|j| node(self.stages, j)),
             reference_normal: [0.0, 0.0, 1.0],
         });
+        let mut joints = Vec::new();
+        if let Some(b) = &self.backlash {
+            let tension = b.tension_factor * self.longeron_modulus * self.longeron_area / h;
+            // Horizontal unit vectors from the prism's axis through each vertex.
+            let half = 3f64.sqrt() / 2.0;
+            let radial = [[-half, -0.5, 0.0], [half, -0.5, 0.0], [0.0, 1.0, 0.0]];
+            for k in 0..=self.stages {
+                for (j, axis) in radial.iter().enumerate() {
+                    joints.push(JointSpec {
+                        id: format!("joint.{k}.{j}"),
+                        shaft: node(k, j),
+                        hole: hole(k, j),
+                        axis: Some(*axis),
+                        clearance: b.clearance,
+                        tension_stiffness: Some(tension),
+                        compression_ratio: Some(b.compression_ratio),
+                        axial_stiffness: Some(tension),
+                    });
+                }
+            }
+        }
         Ok(ModelFile {
             nodes,
             members,
             supports,
             loads: Vec::new(),
             top_surface,
+            joints,
         })
     }
 

@@ -9,6 +9,7 @@
 
 use crate::block::{Block, BlockBandMatrix};
 use crate::element::{AxialMember, norm, sub};
+use crate::joint::JointElement;
 use crate::linearised::{CableBasis, MAX_WOODBURY_CABLES};
 use crate::model::{Behaviour, Model};
 use crate::ordering::number_nodes;
@@ -23,9 +24,8 @@ pub(crate) const NONE: usize = usize::MAX;
 /// One member, compiled.
 #[derive(Debug, Clone)]
 pub(crate) struct CompiledMember {
-    /// Row numbers of (`i`x, `i`y, `i`z, `j`x, `j`y, `j`z); a fixed direction points at the
-    /// zero slot (index `free`), whose value is always zero.
-    pub dofs: [usize; 6],
+    /// Where its stiffness and forces go.
+    pub link: Link,
     /// Nominal vector `X_j − X_i` \[mm\].
     pub reference: [f64; 3],
     /// Nominal unit direction `(X_j − X_i)/L_r`.
@@ -44,21 +44,40 @@ pub(crate) struct CompiledMember {
     pub compression_ratio: f64,
     /// Whether the member is a cable.
     pub is_cable: bool,
+}
+
+/// Where a two-node element (a member or a joint, from node `i` to node `j`) puts its
+/// stiffness blocks and forces.
+#[derive(Debug, Clone)]
+pub(crate) struct Link {
+    /// Row numbers of (`i`x, `i`y, `i`z, `j`x, `j`y, `j`z); a fixed direction points at the
+    /// zero slot (index `free`), whose value is always zero.
+    pub dofs: [usize; 6],
     /// Block slots of (`i`,`i`), (`j`,`j`) and the coupling block, or [`NONE`].
     pub slots: [usize; 3],
     /// Whether the coupling block's rows belong to node `i` (else to node `j`).
     pub coupling_rows_i: bool,
-    /// Whether this member is the first, in member order, to add to each of `slots`: it
-    /// then writes the block instead of adding to it, so assembly needs no clearing.
+    /// Whether this element is the first, in assembly order (members, then joints), to add
+    /// to each of `slots`: it then writes the block instead of adding to it, so assembly
+    /// needs no clearing.
     pub first: [bool; 3],
     /// 1 for a free direction, 0 for a fixed one, of node `i` then node `j`.
     pub masks: [[f64; 3]; 2],
     /// Blocks of node `i` and node `j` (rows `3b .. 3b + 3`), or [`NONE`] for a node with
     /// no free direction.
     pub ends: [usize; 2],
-    /// Whether a node of the member has a block and a fixed direction, so that its rows
+    /// Whether a node of the element has a block and a fixed direction, so that its rows
     /// need the masks (never for a node fixed in all or no directions).
     pub masked: bool,
+}
+
+/// One joint, compiled: node `i` is the shaft, node `j` the hole.
+#[derive(Debug, Clone)]
+pub(crate) struct CompiledJoint {
+    /// Where its stiffness and forces go.
+    pub link: Link,
+    /// Its element with the nominal clearance.
+    pub nominal: JointElement,
 }
 
 /// A model compiled for solving (see the module doc).
@@ -73,6 +92,8 @@ pub struct Structure {
     /// Number of rows (3 per active node); vectors have one more entry, the zero slot.
     pub(crate) free: usize,
     pub(crate) members: Vec<CompiledMember>,
+    /// The joints, in model order.
+    pub(crate) joints: Vec<CompiledJoint>,
     /// Block slots and directions of fixed directions of active nodes (identity rows).
     pub(crate) identity_rows: Vec<(usize, usize)>,
     /// Slots of the band (within it, not its padding) that no member adds to: zeroed at
@@ -92,7 +113,12 @@ impl Structure {
     pub fn new(model: &Model) -> Result<Self, ModelError> {
         let nodes = model.nodes();
         let fixed: Vec<[bool; 3]> = (0..nodes.len()).map(|i| model.fixed(i)).collect();
-        let edges: Vec<[usize; 2]> = model.members().iter().map(|m| m.nodes).collect();
+        let edges: Vec<[usize; 2]> = model
+            .members()
+            .iter()
+            .map(|m| m.nodes)
+            .chain(model.joints().iter().map(|j| [j.shaft, j.hole]))
+            .collect();
         let numbering = number_nodes(&fixed, &edges);
         let free = 3 * numbering.blocks;
         let mut k = BlockBandMatrix::new(numbering.blocks, numbering.bandwidth);
@@ -111,26 +137,38 @@ impl Structure {
                 }
             }
         }
+        let link = |i: usize, j: usize| {
+            let mut dofs = [free; 6];
+            for d in 0..3 {
+                for (side, node) in [i, j].into_iter().enumerate() {
+                    if node_dofs[node][d] != FIXED {
+                        dofs[3 * side + d] = node_dofs[node][d] as usize;
+                    }
+                }
+            }
+            let (bi, bj) = (numbering.block[i], numbering.block[j]);
+            let slot = |a: Option<usize>, b: Option<usize>| match (a, b) {
+                (Some(a), Some(b)) => k.slot(a.max(b), a.min(b)),
+                _ => NONE,
+            };
+            let mask = |node: usize| fixed[node].map(|f| if f { 0.0 } else { 1.0 });
+            Link {
+                dofs,
+                slots: [slot(bi, bi), slot(bj, bj), slot(bi, bj)],
+                coupling_rows_i: bi > bj,
+                first: [false; 3],
+                masks: [mask(i), mask(j)],
+                ends: [bi.unwrap_or(NONE), bj.unwrap_or(NONE)],
+                masked: (bi.is_some() && fixed[i].iter().any(|&f| f))
+                    || (bj.is_some() && fixed[j].iter().any(|&f| f)),
+            }
+        };
         let mut members: Vec<CompiledMember> = model
             .members()
             .iter()
             .enumerate()
             .map(|(m, member)| {
                 let [i, j] = member.nodes;
-                let mut dofs = [free; 6];
-                for d in 0..3 {
-                    for (side, node) in [i, j].into_iter().enumerate() {
-                        if node_dofs[node][d] != FIXED {
-                            dofs[3 * side + d] = node_dofs[node][d] as usize;
-                        }
-                    }
-                }
-                let (bi, bj) = (numbering.block[i], numbering.block[j]);
-                let slot = |a: Option<usize>, b: Option<usize>| match (a, b) {
-                    (Some(a), Some(b)) => k.slot(a.max(b), a.min(b)),
-                    _ => NONE,
-                };
-                let mask = |node: usize| fixed[node].map(|f| if f { 0.0 } else { 1.0 });
                 let reference = sub(nodes[j].xyz, nodes[i].xyz);
                 let length = norm(reference);
                 let (is_cable, compression_ratio) = match member.behaviour {
@@ -138,7 +176,7 @@ impl Structure {
                     Behaviour::Cable { compression_ratio } => (true, compression_ratio),
                 };
                 CompiledMember {
-                    dofs,
+                    link: link(i, j),
                     reference,
                     unit: reference.map(|x| x / length),
                     reference_length: length,
@@ -148,19 +186,24 @@ impl Structure {
                     stiffness: member.youngs_modulus * member.area / member.natural_length,
                     compression_ratio,
                     is_cable,
-                    slots: [slot(bi, bi), slot(bj, bj), slot(bi, bj)],
-                    coupling_rows_i: bi > bj,
-                    first: [false; 3],
-                    masks: [mask(i), mask(j)],
-                    ends: [bi.unwrap_or(NONE), bj.unwrap_or(NONE)],
-                    masked: (bi.is_some() && fixed[i].iter().any(|&f| f))
-                        || (bj.is_some() && fixed[j].iter().any(|&f| f)),
                 }
             })
             .collect();
+        let mut joints: Vec<CompiledJoint> = model
+            .joints()
+            .iter()
+            .map(|j| CompiledJoint {
+                link: link(j.shaft, j.hole),
+                nominal: j.element(j.clearance),
+            })
+            .collect();
         let mut touched = vec![false; k.blocks() * (k.bandwidth() + 1)];
-        for c in &mut members {
-            for (first, &slot) in c.first.iter_mut().zip(&c.slots) {
+        let links = members
+            .iter_mut()
+            .map(|c| &mut c.link)
+            .chain(joints.iter_mut().map(|j| &mut j.link));
+        for link in links {
+            for (first, &slot) in link.first.iter_mut().zip(&link.slots) {
                 if slot != NONE && !touched[slot] {
                     touched[slot] = true;
                     *first = true;
@@ -188,6 +231,7 @@ impl Structure {
             dof_owner,
             free,
             members,
+            joints,
             identity_rows,
             untouched,
             loads,
@@ -210,7 +254,8 @@ impl Structure {
 
     /// Assembles the linearised material stiffness `Σ f(m)·k_m·b_m b_mᵀ` (nominal `k_m`
     /// and directions, `f(m)` a per-member factor such as a slack cable's compression
-    /// ratio) into `k`, identity rows included.
+    /// ratio), plus every joint's loose stiffness with its nominal constants, into `k`,
+    /// identity rows included.
     pub(crate) fn assemble_material(&self, k: &mut BlockBandMatrix, factor: impl Fn(usize) -> f64) {
         self.begin_assembly(k);
         for (m, c) in self.members.iter().enumerate() {
@@ -224,13 +269,16 @@ impl Structure {
                 kk * n[2] * n[1],
                 kk * n[2] * n[2],
             ];
-            self.add_member(k, c, &block);
+            self.add_block(k, &c.link, &block);
+        }
+        for j in &self.joints {
+            self.add_block(k, &j.link, &j.nominal.loose_tangent());
         }
         self.set_identity_rows(k);
     }
 
-    /// Prepares `k` for [`Structure::add_member`] of every member in order: zeroes the
-    /// blocks that no member writes (the first member to reach a block writes it).
+    /// Prepares `k` for [`Structure::add_block`] of every member then every joint, in
+    /// order: zeroes the blocks that none writes (the first to reach a block writes it).
     #[inline]
     pub(crate) fn begin_assembly(&self, k: &mut BlockBandMatrix) {
         let storage = k.storage_mut();
@@ -239,12 +287,13 @@ impl Structure {
         }
     }
 
-    /// Adds a member's contribution `[[K, −K], [−K, K]]` (from the six distinct entries of
-    /// the symmetric 3×3 `K`, order `[xx, yx, yy, zx, zy, zz]`), fixed directions masked;
-    /// called for every member in order after [`Structure::begin_assembly`]. Only the lower
-    /// triangles of diagonal blocks are written (the only part read).
+    /// Adds a member's or joint's contribution `[[K, −K], [−K, K]]` (from the six distinct
+    /// entries of the symmetric 3×3 `K`, order `[xx, yx, yy, zx, zy, zz]`), fixed
+    /// directions masked; called for every member then every joint, in order, after
+    /// [`Structure::begin_assembly`]. Only the lower triangles of diagonal blocks are
+    /// written (the only part read).
     #[inline]
-    pub(crate) fn add_member(&self, k: &mut BlockBandMatrix, c: &CompiledMember, e: &[f64; 6]) {
+    pub(crate) fn add_block(&self, k: &mut BlockBandMatrix, c: &Link, e: &[f64; 6]) {
         let [sii, sjj, sij] = c.slots;
         let storage = k.storage_mut();
         if !c.masked {

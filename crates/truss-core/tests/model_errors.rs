@@ -125,3 +125,54 @@ fn cable_fields_are_checked() {
 fn triangle_json() -> String {
     triangle().to_json()
 }
+
+/// The triangle with node `c` split into a shaft `c` and a hole `c.h` (member `ca` on the
+/// hole), joined by a joint with clearance 0.01 mm.
+fn jointed() -> truss_core::ModelFile {
+    let mut f = triangle();
+    f.nodes.push(node("c.h", [0.0, 100.0, 0.0]));
+    f.members[2].nodes[0] = "c.h".into();
+    f.supports.push(support("c.h", "z"));
+    f.joints.push(truss_core::model_file::JointSpec {
+        id: "joint.c".into(),
+        shaft: "c".into(),
+        hole: "c.h".into(),
+        axis: Some([0.0, 0.0, 1.0]),
+        clearance: 0.01,
+        tension_stiffness: None,
+        compression_ratio: None,
+        axial_stiffness: None,
+    });
+    f
+}
+
+#[test]
+fn joint_faults_are_named() {
+    Model::new(jointed()).unwrap();
+    type Change = fn(&mut truss_core::model_file::JointSpec);
+    let cases: Vec<(Change, &str)> = vec![
+        (|j| j.hole = "nowhere".into(), "\"nowhere\""),
+        (|j| j.hole = "c".into(), "two different nodes"),
+        (|j| j.hole = "b".into(), "same xyz"),
+        (|j| j.axis = Some([0.0; 3]), "axis must not be zero"),
+        (|j| j.clearance = -0.001, "clearance"),
+        (|j| j.clearance = f64::NAN, "clearance"),
+        (|j| j.tension_stiffness = Some(0.0), "tension_stiffness"),
+        (|j| j.compression_ratio = Some(2.0), "compression_ratio"),
+    ];
+    for (change, expected) in cases {
+        let mut f = jointed();
+        change(&mut f.joints[0]);
+        let m = message(f);
+        assert!(
+            m.contains("joints[0]") && m.contains("\"joint.c\"") && m.contains(expected),
+            "{expected}: {m}"
+        );
+    }
+    let mut f = jointed();
+    let mut twin = f.joints[0].clone();
+    twin.shaft = "c".into();
+    f.joints.push(twin);
+    let m = message(f);
+    assert!(m.contains("\"joint.c\" is used twice"), "{m}");
+}

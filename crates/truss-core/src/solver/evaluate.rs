@@ -3,7 +3,16 @@
 
 use super::Evaluation;
 use crate::element::{AxialMember, AxialState};
-use crate::structure::Structure;
+use crate::joint::{JointElement, JointState};
+use crate::structure::{Link, Structure};
+
+/// A sample's joints and the buffer of their states.
+pub(super) struct Joints<'a> {
+    /// Each joint's element for the sample, model order.
+    pub elements: &'a [JointElement],
+    /// Their states, written by the evaluation.
+    pub states: &'a mut [JointState],
+}
 
 /// `r = g(u) − f` and the member states at `u`; returns max |r| and max |N|.
 #[cfg(test)]
@@ -14,17 +23,20 @@ pub(super) fn evaluate(
     u: &[f64],
     r: &mut [f64],
     states: &mut [AxialState],
+    joints: Joints<'_>,
 ) -> Evaluation {
     let k = members.iter().map(AxialMember::tension_stiffness);
-    evaluate_with(s, members, k, loads, u, r, states)
+    evaluate_with(s, members, k, loads, u, r, states, joints)
 }
 
-/// `r = g(u) − f` and the member states at `u`, with each member's `k = E·A/L₀` given (in
-/// member order); returns max |r| and max |N|.
+/// `r = g(u) − f` and the member and joint states at `u`, with each member's `k = E·A/L₀`
+/// given (in member order); returns max |r|, the largest member or joint force and the
+/// strain energy.
 ///
 /// Member by member: gather `d = u_j − u_i` by node blocks (a node without a block is
 /// fixed: zero), the state, then scatter `∓N·n` into the rows of the two nodes. A member
 /// with a partly fixed node scatters row by row, skipping the fixed ones.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn evaluate_with(
     s: &Structure,
     members: &[AxialMember],
@@ -33,6 +45,7 @@ pub(super) fn evaluate_with(
     u: &[f64],
     r: &mut [f64],
     states: &mut [AxialState],
+    joints: Joints<'_>,
 ) -> Evaluation {
     let n = s.free;
     for (ri, f) in r.iter_mut().zip(loads) {
@@ -42,7 +55,7 @@ pub(super) fn evaluate_with(
     let mut force_scale = 0.0f64;
     let mut strain = 0.0f64;
     for (((c, m), st), k) in s.members.iter().zip(members).zip(states.iter_mut()).zip(k) {
-        let [a, b] = c.ends;
+        let [a, b] = c.link.ends;
         let ua = ub.get(a).copied().unwrap_or([0.0; 3]);
         let uj = ub.get(b).copied().unwrap_or([0.0; 3]);
         *st = m.state_with([uj[0] - ua[0], uj[1] - ua[1], uj[2] - ua[2]], k);
@@ -56,31 +69,55 @@ pub(super) fn evaluate_with(
             f * st.direction[1],
             f * st.direction[2],
         ];
-        if c.masked {
-            let dof = c.dofs;
-            for k in 0..3 {
-                r[dof[k]] -= fk[k];
-                r[dof[3 + k]] += fk[k];
-            }
-        } else {
-            let (rb, _) = r[..n].as_chunks_mut::<3>();
-            if let Some(ra) = rb.get_mut(a) {
-                for (x, y) in ra.iter_mut().zip(&fk) {
-                    *x -= y;
-                }
-            }
-            if let Some(rj) = rb.get_mut(b) {
-                for (x, y) in rj.iter_mut().zip(&fk) {
-                    *x += y;
-                }
-            }
-        }
+        scatter(r, n, &c.link, fk);
+    }
+    // Joints: node `i` the shaft, `j` the hole, `Δ = u_j − u_i`, `∂W/∂u_j = ∂W/∂Δ`.
+    for ((c, j), st) in s
+        .joints
+        .iter()
+        .zip(joints.elements)
+        .zip(joints.states.iter_mut())
+    {
+        let [a, b] = c.link.ends;
+        let ua = ub.get(a).copied().unwrap_or([0.0; 3]);
+        let uj = ub.get(b).copied().unwrap_or([0.0; 3]);
+        *st = j.state([uj[0] - ua[0], uj[1] - ua[1], uj[2] - ua[2]]);
+        strain += st.energy;
+        let f = st.force;
+        let abs = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+        force_scale = if abs > force_scale { abs } else { force_scale };
+        scatter(r, n, &c.link, f);
     }
     r[n] = 0.0;
     Evaluation {
         residual: max_abs(&r[..n]),
         force_scale,
         strain,
+    }
+}
+
+/// `r_i −= f`, `r_j += f` for an element from node `i` to node `j` (fixed rows skipped).
+#[inline(always)]
+fn scatter(r: &mut [f64], n: usize, c: &Link, fk: [f64; 3]) {
+    if c.masked {
+        let dof = c.dofs;
+        for k in 0..3 {
+            r[dof[k]] -= fk[k];
+            r[dof[3 + k]] += fk[k];
+        }
+    } else {
+        let [a, b] = c.ends;
+        let (rb, _) = r[..n].as_chunks_mut::<3>();
+        if let Some(ra) = rb.get_mut(a) {
+            for (x, y) in ra.iter_mut().zip(&fk) {
+                *x -= y;
+            }
+        }
+        if let Some(rj) = rb.get_mut(b) {
+            for (x, y) in rj.iter_mut().zip(&fk) {
+                *x += y;
+            }
+        }
     }
 }
 

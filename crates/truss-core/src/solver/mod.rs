@@ -27,7 +27,9 @@
 //!    `|φ'(α)| ≤ η·|φ'(0)|`. `φ'` is continuous because `Π` is continuously differentiable
 //!    where cables go slack.
 //! 5. **Convergence** when either the out-of-balance force is at the rounding floor,
-//!    `‖r‖∞ ≤ residual_floor·F` with `F` the largest member force, or the last step
+//!    `‖r‖∞ ≤ residual_floor·F + 16·ε·k_j·‖u‖∞` with `F` the largest member or joint
+//!    force and `k_j` the stiffest backlash joint's contact stiffness (zero without joints:
+//!    a joint's force is `k_j` times a difference of displacements), or the last step
 //!    satisfies `‖α·d‖∞ ≤ step_tolerance·‖u‖∞` and the error it leaves is no larger than the
 //!    step (a fresh tangent's quadratic convergence, or a measured contraction ≤ ½), or the
 //!    force has stopped falling within a thousand times the floor (an ill-conditioned tall
@@ -43,6 +45,7 @@
 
 use crate::block::BlockBandMatrix;
 use crate::element::{AxialMember, AxialState};
+use crate::joint::{JointElement, JointState};
 use crate::linearised::ActiveSet;
 use crate::measure::{Distortion, distortion};
 use crate::structure::Structure;
@@ -86,7 +89,8 @@ impl Default for SolveOptions {
     }
 }
 
-/// What a sample changes in the model: per-member length errors and extra nodal loads.
+/// What a sample changes in the model: per-member length errors, extra nodal loads, and
+/// per-joint clearances.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Perturbation<'a> {
     /// Length error per member, in model order \[mm\] (natural length = model's + error);
@@ -94,6 +98,8 @@ pub struct Perturbation<'a> {
     pub length_errors: &'a [f64],
     /// Extra nodal force per node, in model order \[N\]; empty for none.
     pub extra_loads: &'a [[f64; 3]],
+    /// Clearance per joint, in model order \[mm\] (≥ 0); empty for the model's own.
+    pub clearances: &'a [f64],
 }
 
 /// How a solve went.
@@ -111,6 +117,9 @@ pub struct SolveReport {
     pub slack_cables: u32,
     /// Evaluations of the out-of-balance force (line-search trials included).
     pub evaluations: u32,
+    /// Number of joints whose shaft does not touch its hole's edge: their position is set
+    /// by the centring stiffness (see [`crate::joint`]).
+    pub loose_joints: u32,
 }
 
 /// One Newton iteration, recorded when [`SolveOptions::record_iterations`] is set.
@@ -147,6 +156,13 @@ pub struct Equilibrium {
     pub slack: Vec<usize>,
     /// The top surface's tilt, if the model names a top surface.
     pub distortion: Option<Distortion>,
+    /// Each joint's hole-centre offset from its shaft centre across the axis, model order
+    /// \[mm\].
+    pub joint_offsets: Vec<[f64; 3]>,
+    /// Each joint's contact force (zero when loose), model order \[N\].
+    pub joint_contacts: Vec<f64>,
+    /// Indices of the loose joints.
+    pub loose_joints: Vec<usize>,
 }
 
 /// Which operator approximates `K⁻¹` for the next step.
@@ -169,8 +185,16 @@ pub struct Solver {
     tension: Vec<f64>,
     states: Vec<AxialState>,
     trial_states: Vec<AxialState>,
+    /// Each joint's element for the current sample (its clearance drawn).
+    joints: Vec<JointElement>,
+    joint_states: Vec<JointState>,
+    trial_joint_states: Vec<JointState>,
     slack: Vec<bool>,
     factor_slack: Vec<bool>,
+    /// Which joints were in contact when `self.k` was last factorised by a model step: a
+    /// factorisation is reused only while this holds (a joint's stiffness jumps from `k_c`
+    /// to `k_t` at contact, so a stale factorisation gives wild steps).
+    factor_engaged: Vec<bool>,
     locked: Vec<bool>,
     failures: Vec<crate::block::PivotFailure>,
     stretch: Vec<f64>,
@@ -189,6 +213,10 @@ pub struct Solver {
     breakpoints: Vec<(f64, f64)>,
     /// Nominal length of the shortest member \[mm\] (caps a line search's steps).
     shortest: f64,
+    /// The stiffest joint's contact plus axial stiffness \[N/mm\] (zero without joints): the
+    /// out-of-balance force cannot fall below about `ε·k·‖u‖∞` once a joint this stiff is in
+    /// contact, whatever the member forces.
+    joint_stiffness: f64,
     /// The sample's largest |initial stretch| \[mm\]: the scale of its displacements
     /// (with the shortest member's 1e-6, for samples driven by loads alone).
     scale: f64,
@@ -237,6 +265,8 @@ impl Solver {
             .collect();
         let cables = structure.members.iter().filter(|c| c.is_cable).count();
         let zero_state = members[0].state([0.0; 3]);
+        let joints: Vec<JointElement> = structure.joints.iter().map(|j| j.nominal).collect();
+        let joint_states: Vec<JointState> = joints.iter().map(|j| j.state([0.0; 3])).collect();
         Self {
             k: BlockBandMatrix::new(structure.nominal.blocks(), structure.bandwidth()),
             options,
@@ -244,8 +274,12 @@ impl Solver {
             members,
             states: vec![zero_state; m],
             trial_states: vec![zero_state; m],
+            trial_joint_states: joint_states.clone(),
+            joint_states,
+            joints,
             slack: vec![false; m],
             factor_slack: vec![false; m],
+            factor_engaged: vec![false; structure.joints.len()],
             locked: vec![false; m],
             failures: Vec::with_capacity(64),
             stretch: vec![0.0; m],
@@ -262,6 +296,11 @@ impl Solver {
             evaluations: 0,
             breakpoints: Vec::with_capacity(m),
             shortest: structure.shortest_member(),
+            joint_stiffness: structure
+                .joints
+                .iter()
+                .map(|j| j.nominal.tension_stiffness + j.nominal.axial_stiffness)
+                .fold(0.0, f64::max),
             scale: 0.0,
             force_ref: 0.0,
             damping: 0.0,
@@ -286,7 +325,7 @@ impl Solver {
     pub fn solve(&mut self, length_errors: &[f64]) -> Result<SolveReport, SolveError> {
         self.solve_perturbed(Perturbation {
             length_errors,
-            extra_loads: &[],
+            ..Perturbation::default()
         })
     }
 
@@ -319,6 +358,25 @@ impl Solver {
                 s.node_ids.len()
             )));
         }
+        if !p.clearances.is_empty() && p.clearances.len() != s.joints.len() {
+            return Err(SolveError::Input(format!(
+                "{} clearances for {} joints",
+                p.clearances.len(),
+                s.joints.len()
+            )));
+        }
+        for (i, (j, c)) in self.joints.iter_mut().zip(&s.joints).enumerate() {
+            let g = p.clearances.get(i).copied().unwrap_or(c.nominal.clearance);
+            if !(g.is_finite() && g >= 0.0) {
+                return Err(SolveError::Input(format!(
+                    "joint {i}: clearance {g} mm is not a finite number ≥ 0"
+                )));
+            }
+            *j = JointElement {
+                clearance: g,
+                ..c.nominal
+            };
+        }
         for (i, c) in s.members.iter().enumerate() {
             let e = p.length_errors.get(i).copied().unwrap_or(0.0);
             if !e.is_finite() || c.natural_length + e <= 0.0 {
@@ -333,6 +391,7 @@ impl Solver {
             .members
             .iter()
             .map(|m| m.initial_stretch.abs())
+            .chain(self.joints.iter().map(|j| j.clearance))
             .fold(1e-6 * self.shortest, f64::max);
         self.force_ref = self
             .members
@@ -383,6 +442,11 @@ impl Solver {
         self.states[m].force
     }
 
+    /// The state of joint `j` at the last equilibrium.
+    pub fn joint_state(&self, j: usize) -> JointState {
+        self.joint_states[j]
+    }
+
     /// Whether member `m` is a slack cable at the last equilibrium.
     pub fn is_slack(&self, m: usize) -> bool {
         self.states[m].slack
@@ -414,6 +478,11 @@ impl Solver {
                 .filter(|&m| self.states[m].slack)
                 .collect(),
             distortion: self.distortion(),
+            joint_offsets: self.joint_states.iter().map(|s| s.offset).collect(),
+            joint_contacts: self.joint_states.iter().map(|s| s.contact).collect(),
+            loose_joints: (0..self.joint_states.len())
+                .filter(|&j| !self.joint_states[j].engaged)
+                .collect(),
         })
     }
 
@@ -424,6 +493,7 @@ impl Solver {
             .states
             .iter()
             .map(|s| 0.5 * s.stiffness * s.elongation * s.elongation)
+            .chain(self.joint_states.iter().map(|s| s.energy))
             .sum();
         strain
             - dot_n(

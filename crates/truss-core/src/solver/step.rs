@@ -120,8 +120,8 @@ impl Solver {
                     let extra = (k_model - st.stiffness) * st.elongation;
                     for d in 0..3 {
                         let f = extra * st.direction[d];
-                        self.d[c.dofs[d]] += f;
-                        self.d[c.dofs[3 + d]] -= f;
+                        self.d[c.link.dofs[d]] += f;
+                        self.d[c.link.dofs[3 + d]] -= f;
                     }
                 }
             }
@@ -142,9 +142,9 @@ impl Solver {
                 }
                 let st = &self.states[m];
                 let dv = [
-                    self.d[c.dofs[3]] - self.d[c.dofs[0]],
-                    self.d[c.dofs[4]] - self.d[c.dofs[1]],
-                    self.d[c.dofs[5]] - self.d[c.dofs[2]],
+                    self.d[c.link.dofs[3]] - self.d[c.link.dofs[0]],
+                    self.d[c.link.dofs[4]] - self.d[c.link.dofs[1]],
+                    self.d[c.link.dofs[5]] - self.d[c.link.dofs[2]],
                 ];
                 let e = st.elongation
                     + st.direction[0] * dv[0]
@@ -233,9 +233,9 @@ impl Solver {
                 }
                 let st = &self.states[m];
                 let dv = [
-                    v[c.dofs[3]] - v[c.dofs[0]],
-                    v[c.dofs[4]] - v[c.dofs[1]],
-                    v[c.dofs[5]] - v[c.dofs[2]],
+                    v[c.link.dofs[3]] - v[c.link.dofs[0]],
+                    v[c.link.dofs[4]] - v[c.link.dofs[1]],
+                    v[c.link.dofs[5]] - v[c.link.dofs[2]],
                 ];
                 let rate = sign
                     * (st.direction[0] * dv[0] + st.direction[1] * dv[1] + st.direction[2] * dv[2]);
@@ -262,7 +262,10 @@ impl Solver {
         s.begin_assembly(&mut self.k);
         for (m, (c, st)) in s.members.iter().zip(&self.states).enumerate() {
             let stiffness = self.model_stiffness(m).unwrap_or(st.stiffness);
-            s.add_member(&mut self.k, c, &st.tangent_block_with(stiffness));
+            s.add_block(&mut self.k, &c.link, &st.tangent_block_with(stiffness));
+        }
+        for (c, st) in s.joints.iter().zip(&self.joint_states) {
+            s.add_block(&mut self.k, &c.link, &st.tangent);
         }
         s.set_identity_rows(&mut self.k);
     }

@@ -3,13 +3,16 @@
 
 use super::evaluate::evaluate;
 use super::*;
-use crate::prism::PrismOptions;
+use crate::prism::{BacklashOptions, PrismOptions};
 
 /// A solver for the 3-stage prism (exact diagonals, so some cables go slack and some stay
-/// taut under the errors below) with its state set at a displacement `u` of a few µm.
-fn solver_at(seed: u64) -> (Solver, Vec<f64>) {
+/// taut under the errors below) with its state set at a displacement `u` of a few µm; with
+/// backlash joints if given (a clearance of 4 µm against displacements of ±2.5 µm puts some
+/// joints in contact and leaves some loose).
+fn solver_with(seed: u64, backlash: Option<BacklashOptions>) -> (Solver, Vec<f64>) {
     let model = PrismOptions {
         diagonal_length: None,
+        backlash,
         ..PrismOptions::with_stages(3)
     }
     .model()
@@ -26,7 +29,7 @@ fn solver_at(seed: u64) -> (Solver, Vec<f64>) {
     solver
         .set_sample(Perturbation {
             length_errors: &errors,
-            extra_loads: &[],
+            ..Perturbation::default()
         })
         .unwrap();
     let n = solver.structure.free;
@@ -52,16 +55,41 @@ fn residual_and_energy(solver: &mut Solver, u: &[f64]) -> (Vec<f64>, f64) {
         u,
         &mut r,
         &mut solver.states,
+        super::evaluate::Joints {
+            elements: &solver.joints,
+            states: &mut solver.joint_states,
+        },
     );
     solver.u.copy_from_slice(u);
     (r, solver.potential_energy())
 }
 
+/// Backlash joints with a clearance that some joints' offsets exceed and some do not.
+fn joints() -> Option<BacklashOptions> {
+    Some(BacklashOptions {
+        clearance: 0.002,
+        ..BacklashOptions::default()
+    })
+}
+
 #[test]
 fn residual_is_the_energy_gradient() {
-    for seed in 1..4 {
-        let (mut solver, u) = solver_at(seed);
+    for (seed, backlash) in [
+        (1, None),
+        (2, None),
+        (3, None),
+        (4, joints()),
+        (5, joints()),
+    ] {
+        let (mut solver, u) = solver_with(seed, backlash);
         let (r, _) = residual_and_energy(&mut solver, &u);
+        if backlash.is_some() {
+            let engaged = solver.joint_states.iter().filter(|s| s.engaged).count();
+            assert!(
+                engaged > 0 && engaged < solver.joint_states.len(),
+                "seed {seed}: want joints both in contact and loose, {engaged} engaged"
+            );
+        }
         let h = 1e-6;
         for i in 0..solver.structure.free {
             let (mut up, mut um) = (u.clone(), u.clone());
@@ -81,8 +109,14 @@ fn residual_is_the_energy_gradient() {
 
 #[test]
 fn tangent_is_the_residual_jacobian() {
-    for seed in 1..4 {
-        let (mut solver, u) = solver_at(seed);
+    for (seed, backlash) in [
+        (1, None),
+        (2, None),
+        (3, None),
+        (4, joints()),
+        (5, joints()),
+    ] {
+        let (mut solver, u) = solver_with(seed, backlash);
         let (_, _) = residual_and_energy(&mut solver, &u);
         solver.update_slack();
         solver.factor_slack.copy_from_slice(&solver.slack);

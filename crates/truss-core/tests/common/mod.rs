@@ -100,5 +100,6 @@ pub fn file(
         supports,
         loads: vec![],
         top_surface: None,
+        joints: vec![],
     }
 }
