@@ -341,8 +341,10 @@ impl Job {
             {
                 parameters.insert("uniform".to_string(), 1.0);
             }
-            if !model.joints().is_empty() {
+            if let Some(j) = model.joints().first() {
+                // Cases differing in the joints' regularisation form their own series.
                 parameters.insert("backlash".to_string(), 1.0);
+                parameters.insert("joint_compression_ratio".to_string(), j.compression_ratio);
             }
             cases.push(Case {
                 name: c.name.clone(),

@@ -66,6 +66,10 @@ fn backlash_shows_in_the_id_and_the_parameters() {
     assert_ne!(job.id, other.id, "the regularisation is part of the model");
     assert_eq!(job.cases[0].parameters.get("backlash"), Some(&1.0));
     assert_eq!(job.cases[1].parameters.get("backlash"), None);
+    assert_eq!(
+        job.cases[0].parameters.get("joint_compression_ratio"),
+        Some(&1e-5)
+    );
     assert_eq!(job.cases[0].model.joints().len(), 9);
 }
 
