@@ -17,7 +17,8 @@
 //! | area                | mm²             | `area`                                     |
 //! | Young's modulus     | MPa = N/mm²     | `youngs_modulus`                           |
 //! | force               | N               | `loads`, axial forces, residuals           |
-//! | stiffness           | N/mm            | tangent stiffness entries                  |
+//! | stiffness           | N/mm            | tangent stiffness entries, joint stiffness |
+//! | clearance           | mm              | a joint's `clearance` (hole minus shaft diameter) |
 //! | energy              | N·mm            | total potential energy                     |
 //! | angle               | rad             | θ_P; tan θ_x and tan θ_y are dimensionless |
 //!
@@ -46,6 +47,12 @@
 //! point of the total potential energy `Π(u) = Σ W_m − fᵀu`, found by Newton's method with a
 //! line search ([`solver`]).
 //!
+//! Pin joints with backlash (the paper's section 4) add, between a shaft node and a hole
+//! node, the energy of [`joint`]: a contact stiffness once the shaft's offset across its
+//! axis exceeds the clearance `g`, a small centring stiffness below, and a stiff spring
+//! along the axis. Model files list them under `joints`; the prism generator adds one per
+//! node with [`prism::PrismOptions::backlash`].
+//!
 //! ## Distortion angle
 //!
 //! The top surface's normal `n_t = (p₂ − p₁) × (p₃ − p₁)` of its three nodes, and
@@ -57,7 +64,7 @@
 //! ## Reproducibility
 //!
 //! The solver uses only IEEE-754 arithmetic in a fixed order, a block-banded Cholesky of
-//! of our own (no run-time SIMD dispatch), and the pure-Rust `libm` for `atan2`, so the same
+//! our own (no run-time SIMD dispatch), and the pure-Rust `libm` for `atan2`, so the same
 //! input gives the same bits on every x86-64 machine, whatever the thread count.
 
 pub mod band;
