@@ -83,8 +83,9 @@ pub trait Candidate: Send + Sync {
     /// Applies the effect with `values` (one per parameter) to the case.
     fn apply(&self, values: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError>;
     /// Moves `values` onto the feasible set if the box alone does not describe it
-    /// (gravity's \|g\| ≤ 1); the default does nothing.
-    fn project(&self, _values: &mut [f64]) {}
+    /// (gravity's \|g\| ≤ 1), leaving `values[fixed]` where it is if `fixed` is given (a
+    /// profile holds that parameter); the default does nothing.
+    fn project(&self, _values: &mut [f64], _fixed: Option<usize>) {}
 }
 
 /// The applicable candidates, and the (name, reason) of those that are not.
@@ -221,10 +222,29 @@ impl Candidate for Gravity {
         edit.set_effects(&effects);
         Ok(())
     }
-    fn project(&self, v: &mut [f64]) {
-        let norm = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        if norm > 1.0 {
-            v.iter_mut().for_each(|x| *x /= norm);
+    /// Scales g onto the unit ball; with a component held, scales the other two onto the
+    /// disc that leaves (zero if the held one is already ±1).
+    fn project(&self, v: &mut [f64], fixed: Option<usize>) {
+        let norm2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if norm2 <= 1.0 {
+            return;
+        }
+        match fixed {
+            None => v.iter_mut().for_each(|x| *x /= norm2.sqrt()),
+            Some(j) => {
+                let room = (1.0 - v[j] * v[j]).max(0.0);
+                let others = norm2 - v[j] * v[j];
+                let r = if others > 0.0 {
+                    (room / others).sqrt()
+                } else {
+                    0.0
+                };
+                for (i, x) in v.iter_mut().enumerate() {
+                    if i != j {
+                        *x *= r;
+                    }
+                }
+            }
         }
     }
 }
@@ -484,5 +504,27 @@ mod tests {
         assert!((p.internal(0.01) - 0.5).abs() < 1e-12);
         let q = Parameter::linear("b", "mm", -0.1, 0.1, 0.0);
         assert!((q.value(0.75) - 0.05).abs() < 1e-15);
+    }
+
+    /// Gravity's feasible set is the unit ball: a point outside is scaled onto it, and with a
+    /// component held the other two are scaled onto the disc left (3-4-5 triangles by hand).
+    #[test]
+    fn gravity_projects_onto_the_ball_holding_a_component() {
+        let g = Gravity::new();
+        let mut v = [0.6, 0.8, 1.0];
+        g.project(&mut v, None);
+        let s = 2f64.sqrt();
+        assert!((v[0] - 0.6 / s).abs() < 1e-12 && (v[2] - 1.0 / s).abs() < 1e-12);
+        let mut v = [0.6, 0.8, 0.8];
+        g.project(&mut v, Some(0));
+        assert_eq!(v[0], 0.6);
+        assert!((v[1] * v[1] + v[2] * v[2] - 0.64).abs() < 1e-12, "{v:?}");
+        assert!((v[1] - v[2]).abs() < 1e-12);
+        let mut v = [0.1, 1.0, 0.1];
+        g.project(&mut v, Some(1));
+        assert_eq!(v, [0.0, 1.0, 0.0]);
+        let mut v = [0.3, 0.4, 0.0];
+        g.project(&mut v, Some(2));
+        assert_eq!(v, [0.3, 0.4, 0.0]);
     }
 }

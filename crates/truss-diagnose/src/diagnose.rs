@@ -1,16 +1,20 @@
 //! Steps 2 to 4: fit every candidate, choose, add the effect, compare again.
+//!
+//! Every candidate is fitted and tested ([`crate::score`]); the verdict follows from the
+//! tests and BIC ([`decide`]); the named candidate and those indistinguishable from it get
+//! profile-likelihood intervals ([`crate::profile`]). Should a profile find a higher maximum,
+//! that candidate is scored anew and the verdict decided again (profiling any candidate that
+//! newly enters it), so the verdict always rests on the final fits.
 
 use crate::baseline::{Baseline, CaseEdit};
-use crate::candidates::{Candidate, library};
+use crate::candidates::library;
 use crate::compare::{Comparison, compare};
 use crate::errors::DiagnoseError;
-use crate::fit::sandwich;
-use crate::fit::{Interval, intervals, maximise};
-use crate::likelihood::{Gaussian, member_log_likelihood};
 use crate::measured::Measured;
+pub use crate::score::{CandidateScore, FittedParameter, SCAN};
+use crate::score::{Evaluator, Fitted, Test, fit_candidate, profile_candidate};
 use crate::simulate::{Noise, Simulation, simulate, top_indices};
 use serde::Serialize;
-use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::time::Instant;
 
 /// Evidence that counts as a clear improvement and as "as good": a BIC difference of 2
@@ -81,56 +85,6 @@ impl Progress {
     }
 }
 
-/// A fitted parameter.
-#[derive(Debug, Clone, Serialize)]
-pub struct FittedParameter {
-    /// Name.
-    pub name: String,
-    /// Unit.
-    pub unit: &'static str,
-    /// Maximum-likelihood value.
-    pub value: f64,
-    /// 95 % Wald interval.
-    pub interval: Interval,
-    /// The plausible range searched.
-    pub range: [f64; 2],
-    /// The value at which the candidate is the baseline.
-    pub null: f64,
-}
-
-/// One candidate's fit and score.
-#[derive(Debug, Clone, Serialize)]
-pub struct CandidateScore {
-    /// Name.
-    pub name: String,
-    /// The mechanism in words.
-    pub mechanism: String,
-    /// Number of parameters k.
-    pub k: usize,
-    /// Fitted parameters.
-    pub parameters: Vec<FittedParameter>,
-    /// Maximised ℓ (Gaussian synthetic likelihood, plus the member term when given).
-    pub log_likelihood: f64,
-    /// Λ = 2(ℓ − ℓ₀)/((1 + n/N)·λ̄), the adjusted likelihood-ratio statistic against the
-    /// baseline.
-    pub lr_statistic: f64,
-    /// λ̄ = max(1, tr(A⁻¹B)/k), the misspecification adjustment.
-    pub adjustment: f64,
-    /// P(χ²_k ≥ Λ).
-    pub p_value: f64,
-    /// Whether p < α/K.
-    pub significant: bool,
-    /// ΔBIC = k ln n − Λ against the baseline (negative: better).
-    pub delta_bic: f64,
-    /// Likelihood evaluations (each a simulation of N samples).
-    pub evaluations: usize,
-    /// Wall time of the fit \[s\].
-    pub seconds: f64,
-    /// Why the fit failed, if it did.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub error: Option<String>,
-}
-
 /// The verdict.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -177,85 +131,96 @@ pub struct Diagnosis {
     pub work: (usize, usize, f64),
 }
 
-/// ℓ of the measured data under an edited case.
-struct Evaluator<'a> {
-    baseline: &'a Baseline,
-    measured: &'a Measured,
-    samples: usize,
-    sigma_m: f64,
-    simulations: std::cell::Cell<usize>,
+/// The verdict, why, the named candidate and those indistinguishable from it (indices).
+#[derive(Debug, Clone)]
+pub struct Decision {
+    /// The verdict.
+    pub verdict: Verdict,
+    /// Why, in a sentence or two.
+    pub reason: String,
+    /// The named candidate.
+    pub named: Option<usize>,
+    /// Candidates within ΔBIC 2 of the named one.
+    pub indistinguishable: Vec<usize>,
 }
 
-impl Evaluator<'_> {
-    fn job(&self, edit: &CaseEdit) -> Result<mc_shard::Job, DiagnoseError> {
-        self.baseline.job_of(edit, self.samples as u64, None)
-    }
-
-    fn log_likelihood(&self, edit: &CaseEdit) -> Result<Vec<f64>, DiagnoseError> {
-        let job = self.job(edit)?;
-        let sim = simulate(&job, &self.measured.coords, self.samples, None)?;
-        self.simulations.set(self.simulations.get() + 1);
-        self.score(&job, &sim)
-    }
-
-    /// The terms of ℓ: each specimen's, then each member observation's.
-    fn score(&self, job: &mc_shard::Job, sim: &Simulation) -> Result<Vec<f64>, DiagnoseError> {
-        let g = Gaussian::from_simulation(sim, self.sigma_m)?;
-        let mut terms = g.log_densities(&self.measured.y);
-        if let Some(m) = &self.measured.members {
-            terms.extend(member_log_likelihood(&job.cases[0], m, self.sigma_m));
-        }
-        Ok(terms)
-    }
-
-    fn edit(&self, c: &dyn Candidate, values: &[f64]) -> Result<CaseEdit, DiagnoseError> {
-        let mut edit = self.baseline.derived_case();
-        c.apply(values, &mut edit)?;
-        Ok(edit)
-    }
-}
-
-fn values_of(c: &dyn Candidate, t: &[f64]) -> Vec<f64> {
-    let mut v: Vec<f64> = c
-        .parameters()
+/// The verdict from the candidates' scores and the baseline's comparison (crate doc):
+/// `level` is the per-candidate significance level α/K.
+pub fn decide(scores: &[&CandidateScore], before: &Comparison, n: usize, level: f64) -> Decision {
+    let before_disagrees = before.statistics.iter().any(|s| s.disagrees);
+    let best = (0..scores.len())
+        .filter(|&i| scores[i].error.is_none())
+        .min_by(|&a, &b| scores[a].delta_bic.total_cmp(&scores[b].delta_bic));
+    let clear = best.filter(|&i| scores[i].significant && scores[i].delta_bic <= -DELTA_BIC);
+    let (verdict, reason, named, indistinguishable) = if let Some(i) = clear {
+        let others: Vec<usize> = (0..scores.len())
+            .filter(|&j| j != i && scores[j].error.is_none())
+            .filter(|&j| scores[j].delta_bic < scores[i].delta_bic + DELTA_BIC)
+            .collect();
+        let reason = if others.is_empty() {
+            format!(
+                "{} improves the likelihood significantly (p = {:.2e} < α/K = {level:.4}) and is the best by BIC by at least {DELTA_BIC} over every other candidate",
+                scores[i].name, scores[i].p_value,
+            )
+        } else {
+            format!(
+                "{} improves the likelihood significantly (p = {:.2e}) and is best by BIC, but {} explain the data as well (ΔBIC within {DELTA_BIC}): the data cannot tell them apart",
+                scores[i].name,
+                scores[i].p_value,
+                others
+                    .iter()
+                    .map(|&j| scores[j].name.as_str())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        };
+        (Verdict::Named, reason, Some(i), others)
+    } else if scores
         .iter()
-        .zip(t)
-        .map(|(p, &x)| p.value(x))
-        .collect();
-    c.project(&mut v);
-    v
-}
-
-/// The internal coordinates scanned along each parameter axis (the others at their null) for
-/// a start: a candidate's likelihood need not be unimodal between the null and the truth (a
-/// pretension that stiffens the truss predicts a much smaller scatter, so half of the true
-/// pretension can fit worse than none).
-pub const SCAN: [f64; 8] = [0.0, 0.125, 0.25, 0.375, 0.625, 0.75, 0.875, 1.0];
-
-/// The best of the null and the axis scan ([`SCAN`]).
-fn best_start(
-    null: &[f64],
-    project: &dyn Fn(&mut [f64]),
-    f: &mut dyn FnMut(&[f64]) -> Result<crate::fit::Terms, DiagnoseError>,
-) -> Result<Vec<f64>, DiagnoseError> {
-    let mut best = (f(null)?.iter().sum::<f64>(), null.to_vec());
-    for i in 0..null.len() {
-        for &x in &SCAN {
-            let mut t = null.to_vec();
-            t[i] = x;
-            project(&mut t);
-            if t == null {
-                continue;
-            }
-            if let Ok(terms) = f(&t) {
-                let l: f64 = terms.iter().sum();
-                if l > best.0 {
-                    best = (l, t);
+        .any(|s| s.significant || s.delta_bic < -DELTA_BIC)
+    {
+        (
+            Verdict::CannotTell,
+            "some candidates improve the fit, but none both significantly (Bonferroni) and by a clear BIC margin: the data cannot decide".into(),
+            None,
+            Vec::new(),
+        )
+    } else if before.tolerance.within {
+        (
+            Verdict::None,
+            "no candidate improves the fit significantly, and the baseline agrees with the measurements within the stated tolerance".into(),
+            None,
+            Vec::new(),
+        )
+    } else if before_disagrees && n >= MIN_FOR_DISAGREEMENT {
+        (
+            Verdict::Unexplained,
+            "the measurements disagree with the baseline, but no candidate effect of the library explains it significantly".into(),
+            None,
+            Vec::new(),
+        )
+    } else {
+        (
+            Verdict::CannotTell,
+            format!(
+                "no candidate improves the fit significantly, but with {n} specimens the data cannot show that the baseline agrees within tolerance either ({} outside){}: more specimens are needed",
+                before.tolerance.outside.join(", "),
+                if before_disagrees {
+                    ", and the few statistics that disagree are too uncertain with so few specimens"
+                } else {
+                    ""
                 }
-            }
-        }
+            ),
+            None,
+            Vec::new(),
+        )
+    };
+    Decision {
+        verdict,
+        reason,
+        named,
+        indistinguishable,
     }
-    Ok(best.1)
 }
 
 /// Runs steps 1 to 4 on measured data against the baseline case.
@@ -305,161 +270,78 @@ pub fn diagnose(
     let (candidates, skipped) = library(baseline);
     let inflation = 1.0 + n as f64 / samples as f64;
     let kk = candidates.len().max(1) as f64;
-    let mut scores = Vec::new();
+    let test = Test {
+        l0,
+        n,
+        inflation,
+        level: settings.alpha / kk,
+    };
+    let mut fitted: Vec<Fitted> = Vec::new();
     for c in &candidates {
-        let clock = Instant::now();
-        let params = c.parameters();
-        let start: Vec<f64> = params.iter().map(|p| p.internal(p.null)).collect();
-        let count = std::cell::Cell::new(0usize);
-        let mut objective = |t: &[f64]| -> Result<Vec<f64>, DiagnoseError> {
-            count.set(count.get() + 1);
-            let v: Vec<f64> = params.iter().zip(t).map(|(p, &x)| p.value(x)).collect();
-            ev.log_likelihood(&ev.edit(c.as_ref(), &v)?)
-        };
-        let project = |t: &mut [f64]| {
-            let mut v = values_of(c.as_ref(), t);
-            c.project(&mut v);
-            for (x, (p, val)) in t.iter_mut().zip(params.iter().zip(&v)) {
-                *x = p.internal(*val);
-            }
-        };
         progress.note(&format!(
             "fitting {} ({} parameters)…",
             c.name(),
-            params.len()
+            c.parameters().len()
         ));
-        let k = params.len();
-        let start = best_start(&start, &project, &mut objective).unwrap_or(start);
-        let score = match maximise(&start, &project, &mut objective) {
-            Ok(fit) => {
-                let values = values_of(c.as_ref(), &fit.internal);
-                let iv = intervals(&fit, params, inflation);
-                // Λ = 2(ℓ̂ − ℓ₀)/(c·λ̄), λ̄ = max(1, tr(A⁻¹B)/k) (crate doc).
-                let mean_eig = sandwich(&fit, 1.0).map_or(1.0, |(_, m)| m).max(1.0);
-                let lr = (2.0 * (fit.log_likelihood - l0) / (inflation * mean_eig)).max(0.0);
-                let p = 1.0 - ChiSquared::new(k as f64).expect("k ≥ 1").cdf(lr);
-                CandidateScore {
-                    name: c.name().into(),
-                    mechanism: c.mechanism().into(),
-                    k,
-                    parameters: params
-                        .iter()
-                        .zip(values.iter().zip(iv))
-                        .map(|(p, (&value, interval))| FittedParameter {
-                            name: p.name.clone(),
-                            unit: p.unit,
-                            value,
-                            interval,
-                            range: [p.low, p.high],
-                            null: p.null,
-                        })
-                        .collect(),
-                    log_likelihood: fit.log_likelihood,
-                    lr_statistic: lr,
-                    adjustment: mean_eig,
-                    p_value: p,
-                    significant: p < settings.alpha / kk,
-                    delta_bic: k as f64 * (n as f64).ln() - lr,
-                    evaluations: fit.evaluations,
-                    seconds: clock.elapsed().as_secs_f64(),
-                    error: None,
-                }
-            }
-            Err(e) => CandidateScore {
-                name: c.name().into(),
-                mechanism: c.mechanism().into(),
-                k,
-                parameters: Vec::new(),
-                log_likelihood: f64::NEG_INFINITY,
-                lr_statistic: 0.0,
-                adjustment: 1.0,
-                p_value: 1.0,
-                significant: false,
-                delta_bic: f64::INFINITY,
-                evaluations: count.get(),
-                seconds: clock.elapsed().as_secs_f64(),
-                error: Some(e.to_string()),
-            },
-        };
+        let f = fit_candidate(&ev, c.as_ref(), &test);
+        let s = &f.score;
         progress.note(&format!(
             "  {}: ΔBIC {:.1}, Λ {:.1}, p {:.2e}, {} evaluations in {:.1} s",
-            score.name,
-            score.delta_bic,
-            score.lr_statistic,
-            score.p_value,
-            score.evaluations,
-            score.seconds
+            s.name, s.delta_bic, s.lr_statistic, s.p_value, s.evaluations, s.seconds
         ));
-        scores.push(score);
+        fitted.push(f);
     }
-    // Decision.
-    let before_disagrees = before.statistics.iter().any(|s| s.disagrees);
-    let best = (0..scores.len())
-        .filter(|&i| scores[i].error.is_none())
-        .min_by(|&a, &b| scores[a].delta_bic.total_cmp(&scores[b].delta_bic));
-    let clear = best.filter(|&i| scores[i].significant && scores[i].delta_bic <= -DELTA_BIC);
-    let (verdict, reason, named, indistinguishable) = if let Some(i) = clear {
-        let others: Vec<String> = (0..scores.len())
-            .filter(|&j| j != i && scores[j].error.is_none())
-            .filter(|&j| scores[j].delta_bic < scores[i].delta_bic + DELTA_BIC)
-            .map(|j| scores[j].name.clone())
+    // Decision, and profiles of the candidates it rests on.
+    let note = |m: &str| progress.note(m);
+    let decision = loop {
+        let scores: Vec<&CandidateScore> = fitted.iter().map(|f| &f.score).collect();
+        let d = decide(&scores, &before, n, test.level);
+        let wanted: Vec<usize> = d
+            .named
+            .into_iter()
+            .chain(d.indistinguishable.iter().copied())
+            .filter(|&i| !fitted[i].profiled)
             .collect();
-        let reason = if others.is_empty() {
-            format!(
-                "{} improves the likelihood significantly (p = {:.2e} < α/K = {:.4}) and is the best by BIC by at least {DELTA_BIC} over every other candidate",
-                scores[i].name,
-                scores[i].p_value,
-                settings.alpha / kk
-            )
-        } else {
-            format!(
-                "{} improves the likelihood significantly (p = {:.2e}) and is best by BIC, but {} explain the data as well (ΔBIC within {DELTA_BIC}): the data cannot tell them apart",
-                scores[i].name,
-                scores[i].p_value,
-                others.join(", ")
-            )
-        };
-        (Verdict::Named, reason, Some(i), others)
-    } else if scores
-        .iter()
-        .any(|s| s.significant || s.delta_bic < -DELTA_BIC)
-    {
-        (
-            Verdict::CannotTell,
-            "some candidates improve the fit, but none both significantly (Bonferroni) and by a clear BIC margin: the data cannot decide".into(),
-            None,
-            Vec::new(),
-        )
-    } else if before.tolerance.within {
-        (
-            Verdict::None,
-            "no candidate improves the fit significantly, and the baseline agrees with the measurements within the stated tolerance".into(),
-            None,
-            Vec::new(),
-        )
-    } else if before_disagrees && n >= MIN_FOR_DISAGREEMENT {
-        (
-            Verdict::Unexplained,
-            "the measurements disagree with the baseline, but no candidate effect of the library explains it significantly".into(),
-            None,
-            Vec::new(),
-        )
-    } else {
-        (
-            Verdict::CannotTell,
-            format!(
-                "no candidate improves the fit significantly, but with {n} specimens the data cannot show that the baseline agrees within tolerance either ({} outside){}: more specimens are needed",
-                before.tolerance.outside.join(", "),
-                if before_disagrees {
-                    ", and the few statistics that disagree are too uncertain with so few specimens"
-                } else {
-                    ""
-                }
-            ),
-            None,
-            Vec::new(),
-        )
+        if wanted.is_empty() {
+            break d;
+        }
+        for i in wanted {
+            progress.note(&format!(
+                "profile-likelihood intervals of {}…",
+                candidates[i].name()
+            ));
+            profile_candidate(&ev, candidates[i].as_ref(), &mut fitted[i], &test, &note);
+            let s = &fitted[i].score;
+            progress.note(&format!(
+                "  {}: {} profile evaluations, {:.1} s for the fit and profiles; {}",
+                s.name,
+                s.profile_evaluations,
+                s.seconds,
+                s.parameters
+                    .iter()
+                    .map(|p| format!(
+                        "{} {:.4e} [{}, {}]",
+                        p.name,
+                        p.value,
+                        p.interval.lower.map_or("?".into(), |v| format!("{v:.4e}")),
+                        p.interval.upper.map_or("?".into(), |v| format!("{v:.4e}"))
+                    ))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
     };
+    let scores: Vec<CandidateScore> = fitted.into_iter().map(|f| f.score).collect();
+    let Decision {
+        verdict,
+        reason,
+        named,
+        indistinguishable,
+    } = decision;
+    let indistinguishable: Vec<String> = indistinguishable
+        .iter()
+        .map(|&i| scores[i].name.clone())
+        .collect();
     progress.note(&format!("verdict: {verdict:?}: {reason}"));
     // Steps 3 and 4.
     let (updated, after, after_sim) = match named {

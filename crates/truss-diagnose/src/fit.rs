@@ -5,33 +5,33 @@
 //! The parameters are mapped onto the unit cube ([`Parameter::internal`]: linear, or
 //! logarithmic for a scale), where the log-likelihood is smooth because every evaluation uses
 //! the same random numbers. From the best of the null point (the baseline) and a scan along
-//! each axis (`diagnose::SCAN`), a trust-region Newton method:
-//! gradient and Hessian by finite differences of step `h` = [`STEP`] (central for the
-//! gradient and the diagonal, forward for the cross terms: `1 + 2k + k(k−1)/2` evaluations for
-//! `k` parameters), the step `s = (A + μI)⁻¹g` with `A = −H` and the smallest `μ ≥ 0` that
-//! makes `A + μI` positive definite and `|s|` at most the trust radius (0.3 at first, doubled
-//! after a good step, quartered after a failed one), clipped to the cube (and projected where
-//! the box is not the whole constraint). It stops when a step gains less than
-//! [`TOLERANCE`] in ℓ, the radius falls below 1e-4, or after [`MAX_ITERATIONS`].
+//! each axis (`diagnose::SCAN`), a trust-region Newton method: gradient and Hessian by finite
+//! differences with steps adapted to the likelihood's scale ([`crate::derivatives`]), the step
+//! `s = (A + μI)⁻¹g` with `A = −H` and the smallest `μ ≥ 0` that makes `A + μI` positive
+//! definite and `|s|` at most the trust radius (0.3 at first, doubled after a good step,
+//! quartered after a failed one), clipped to the cube (and projected where the box is not the
+//! whole constraint). It stops when the quadratic model promises, or a step gains, less than
+//! [`TOLERANCE`] in ℓ, when the radius falls below 1e-4, or after [`MAX_ITERATIONS`].
 //!
-//! ## Intervals
+//! ## Wald intervals
 //!
 //! ℓ is a sum of per-unit terms ℓ_u (one per specimen, one per member observation). With
 //! `A = −∂²ℓ/∂t²` at the optimum and `B = Σ_u (g_u − ḡ)(g_u − ḡ)ᵀ` the variability of the
-//! per-unit scores `g_u = ∂ℓ_u/∂t` (central differences), the covariance of the internal
-//! coordinates is the sandwich `c·A⁻¹BA⁻¹` (Huber 1967; White 1982), valid when the Gaussian
-//! approximation is not the true distribution of a specimen, with `c = 1 + n/N` for the
-//! simulation's own noise in μ and Σ (it adds to the data's in proportion to the sample
-//! sizes). The 95 % interval of each is `t̂ ± 1.96·√covᵢᵢ` mapped back to the parameter (so a
-//! scale's interval is symmetric in its logarithm). Where `A` is not positive definite the
-//! interval is undetermined.
+//! per-unit scores `g_u = ∂ℓ_u/∂t`, the covariance of the internal coordinates is the
+//! sandwich `c·A⁻¹BA⁻¹` (Huber 1967; White 1982), valid when the Gaussian approximation is
+//! not the true distribution of a specimen, with `c = 1 + n/N` for the simulation's own noise
+//! in μ and Σ (it adds to the data's in proportion to the sample sizes). The 95 % Wald
+//! interval of each is `t̂ ± 1.96·√covᵢᵢ` mapped back to the parameter (so a scale's interval
+//! is symmetric in its logarithm). Where `A` is not positive definite the interval is
+//! undetermined. These rest on ℓ being quadratic over the interval; the diagnosis reports
+//! them next to the profile-likelihood intervals of [`crate::profile`], which do not, and
+//! uses the latter for the named effect.
 
 use crate::candidates::Parameter;
+use crate::derivatives::{INITIAL_STEP, Objective, derivatives, total};
 use crate::errors::DiagnoseError;
 use nalgebra::{DMatrix, DVector};
 
-/// Finite-difference step in internal coordinates.
-pub const STEP: f64 = 0.02;
 /// Smallest gain in ℓ that counts as progress.
 pub const TOLERANCE: f64 = 0.02;
 /// Most Newton iterations.
@@ -40,111 +40,81 @@ pub const MAX_ITERATIONS: usize = 12;
 /// The result of a fit.
 #[derive(Debug, Clone)]
 pub struct Fit {
-    /// The same in internal coordinates.
+    /// The maximum in internal coordinates.
     pub internal: Vec<f64>,
     /// ℓ there.
     pub log_likelihood: f64,
-    /// A = −∂²ℓ/∂t² there (internal coordinates).
+    /// A = −∂²ℓ/∂t² there (internal coordinates); empty (0 × 0) when not asked for.
     pub curvature: DMatrix<f64>,
-    /// B, the variability of the per-unit scores there (module doc).
+    /// B, the variability of the per-unit scores there ([`crate::derivatives`]); empty when
+    /// not asked for.
     pub variability: DMatrix<f64>,
+    /// The finite-difference steps last used, per parameter (internal coordinates).
+    pub steps: Vec<f64>,
     /// Evaluations of ℓ.
     pub evaluations: usize,
     /// Newton iterations.
     pub iterations: usize,
 }
 
-/// A 95 % Wald interval, or why there is none.
+/// How to maximise.
+#[derive(Debug, Clone, Copy)]
+pub struct Options<'a> {
+    /// Initial finite-difference steps; `None`: [`INITIAL_STEP`] on every axis.
+    pub steps: Option<&'a [f64]>,
+    /// Whether `A` and `B` are wanted at the maximum (an inner maximisation of a profile
+    /// needs only ℓ).
+    pub curvature: bool,
+    /// The cluster of each unit term of ℓ for `B` ([`crate::derivatives`]); `None`: every
+    /// unit its own.
+    pub clusters: Option<&'a [usize]>,
+}
+
+impl Default for Options<'_> {
+    fn default() -> Self {
+        Self {
+            steps: None,
+            curvature: true,
+            clusters: None,
+        }
+    }
+}
+
+/// A 95 % interval, or why there is none.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Interval {
     /// Lower end, if determined.
     pub lower: Option<f64>,
     /// Upper end, if determined.
     pub upper: Option<f64>,
-    /// Whether an end reaches the plausible range's end (then it is cut there).
-    pub at_range_end: bool,
+    /// Whether the lower end is the plausible range's (the interval is cut there).
+    pub lower_at_range_end: bool,
+    /// Whether the upper end is the plausible range's.
+    pub upper_at_range_end: bool,
+    /// `profile` ([`crate::profile`]) or `wald` (this module).
+    pub method: &'static str,
+    /// For a profile interval, the threshold `q` of `2(ℓ̂ − ℓ_p) ≤ q`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub threshold: Option<f64>,
 }
 
-/// Per-unit values of ℓ at a point: its terms (one per specimen, and per member
-/// observation); ℓ is their sum.
-pub type Terms = Vec<f64>;
-
-fn total(t: &Terms) -> f64 {
-    t.iter().sum()
-}
-
-/// Gradient, Hessian, and `B = Σ_u (g_u − ḡ)(g_u − ḡ)ᵀ` of the per-unit gradients `g_u`.
-type Derivatives = (DVector<f64>, DMatrix<f64>, DMatrix<f64>);
-
-/// Derivatives at `t`, from a stencil centred at `t` moved inside the cube by at least `h`
-/// (so no evaluation leaves the plausible range); the gradient is carried from the centre
-/// to `t` with the Hessian.
-fn derivatives(
-    t: &[f64],
-    f_t: &Terms,
-    f: &mut dyn FnMut(&[f64]) -> Result<Terms, DiagnoseError>,
-    evaluations: &mut usize,
-) -> Result<Derivatives, DiagnoseError> {
-    let k = t.len();
-    let h = STEP;
-    let centre: Vec<f64> = t.iter().map(|x| x.clamp(h, 1.0 - h)).collect();
-    let moved = centre != t;
-    let owned;
-    let f0 = if moved {
-        *evaluations += 1;
-        owned = f(&centre)?;
-        &owned
-    } else {
-        f_t
-    };
-    let t_at = t;
-    let t = &centre[..];
-    let units = f0.len();
-    let s0 = total(f0);
-    let mut g = DVector::zeros(k);
-    let mut hess = DMatrix::zeros(k, k);
-    let mut plus = vec![0.0; k];
-    let mut unit_grad = DMatrix::zeros(units, k);
-    let mut at = |p: &[f64], evaluations: &mut usize| {
-        *evaluations += 1;
-        f(p)
-    };
-    for i in 0..k {
-        let mut p = t.to_vec();
-        p[i] += h;
-        let tp = at(&p, evaluations)?;
-        p[i] -= 2.0 * h;
-        let tm = at(&p, evaluations)?;
-        let (fp, fm) = (total(&tp), total(&tm));
-        for u in 0..units {
-            unit_grad[(u, i)] = (tp[u] - tm[u]) / (2.0 * h);
-        }
-        plus[i] = fp;
-        g[i] = (fp - fm) / (2.0 * h);
-        hess[(i, i)] = (fp - 2.0 * s0 + fm) / (h * h);
-    }
-    for i in 0..k {
-        for j in 0..i {
-            let mut p = t.to_vec();
-            p[i] += h;
-            p[j] += h;
-            let fij = total(&at(&p, evaluations)?);
-            let v = (fij - plus[i] - plus[j] + s0) / (h * h);
-            hess[(i, j)] = v;
-            hess[(j, i)] = v;
+impl Interval {
+    /// An interval whose ends could not be found.
+    pub fn undetermined(method: &'static str) -> Self {
+        Self {
+            lower: None,
+            upper: None,
+            lower_at_range_end: false,
+            upper_at_range_end: false,
+            method,
+            threshold: None,
         }
     }
-    if moved {
-        let shift = DVector::from_iterator(k, t_at.iter().zip(t).map(|(a, b)| a - b));
-        g += &hess * shift;
+
+    /// Whether an end is cut at the plausible range.
+    pub fn at_range_end(&self) -> bool {
+        self.lower_at_range_end || self.upper_at_range_end
     }
-    let mean = unit_grad.row_mean();
-    let mut b = DMatrix::zeros(k, k);
-    for u in 0..units {
-        let r = unit_grad.row(u) - &mean;
-        b += r.transpose() * r;
-    }
-    Ok((g, hess, b))
 }
 
 /// The step `(A + μI)⁻¹g` within `radius` (module doc).
@@ -195,36 +165,120 @@ fn trust_step(g: &DVector<f64>, a: &DMatrix<f64>, radius: f64) -> DVector<f64> {
     solve(hi)
 }
 
-/// Maximises `f` (ℓ as a function of internal coordinates) over the unit cube from `start`;
-/// `project` maps internal coordinates onto the feasible set.
-pub fn maximise(
-    start: &[f64],
+/// The trust step restricted to the subspace orthogonal to the orthonormal `blocked`.
+fn restricted_step(
+    g: &DVector<f64>,
+    a: &DMatrix<f64>,
+    radius: f64,
+    blocked: &[DVector<f64>],
+) -> DVector<f64> {
+    let k = g.len();
+    if blocked.is_empty() {
+        return trust_step(g, a, radius);
+    }
+    let mut p = DMatrix::identity(k, k);
+    for b in blocked {
+        p -= b * b.transpose();
+    }
+    let eig = nalgebra::SymmetricEigen::new(p);
+    let basis: Vec<DVector<f64>> = (0..k)
+        .filter(|&i| eig.eigenvalues[i] > 0.5)
+        .map(|i| eig.eigenvectors.column(i).into_owned())
+        .collect();
+    if basis.is_empty() {
+        return DVector::zeros(k);
+    }
+    let z = DMatrix::from_columns(&basis);
+    let zt = z.transpose();
+    let s = trust_step(&(&zt * g), &(&zt * a * &z), radius);
+    z * s
+}
+
+/// The trust step from `t`, restricted away from the constraints active at `t` that it
+/// pushes against, and the next point: `t` plus the step, clipped to the cube and projected
+/// (module doc).
+fn constrained_step(
+    t: &[f64],
+    g: &DVector<f64>,
+    a: &DMatrix<f64>,
+    radius: f64,
     project: &dyn Fn(&mut [f64]),
-    f: &mut dyn FnMut(&[f64]) -> Result<Terms, DiagnoseError>,
-) -> Result<Fit, DiagnoseError> {
-    let mut t = start.to_vec();
-    let mut evaluations = 1;
-    let mut terms = f(&t)?;
-    let mut f0 = total(&terms);
-    let mut radius = 0.3;
-    let mut iterations = 0;
-    let (mut _g, mut hess, mut b) = derivatives(&t, &terms, f, &mut evaluations)?;
-    let mut fresh = true;
-    while iterations < MAX_ITERATIONS && radius > 1e-4 {
-        iterations += 1;
-        if !fresh {
-            (_g, hess, b) = derivatives(&t, &terms, f, &mut evaluations)?;
-        }
-        let a = -&hess;
-        let s = trust_step(&_g, &a, radius);
-        let mut next: Vec<f64> = t
+) -> (DVector<f64>, Vec<f64>) {
+    let k = t.len();
+    let onto = |s: &DVector<f64>| -> Vec<f64> {
+        let mut p: Vec<f64> = t
             .iter()
             .zip(s.iter())
             .map(|(x, d)| (x + d).clamp(0.0, 1.0))
             .collect();
-        project(&mut next);
-        let step = DVector::from_iterator(t.len(), next.iter().zip(&t).map(|(a, b)| a - b));
-        let predicted = _g.dot(&step) - 0.5 * step.dot(&(&a * &step));
+        project(&mut p);
+        p
+    };
+    let mut blocked: Vec<DVector<f64>> = Vec::new();
+    loop {
+        let s = restricted_step(g, a, radius, &blocked);
+        let norm = s.norm();
+        if blocked.len() + 1 >= k || norm == 0.0 {
+            return (s.clone(), onto(&s));
+        }
+        // Is a constraint active at t against this step? Move 1e-6 along it and see what
+        // the projection takes away.
+        let eps = 1e-6;
+        let small = &s * (eps / norm);
+        let moved = onto(&small);
+        let mut n = DVector::from_iterator(k, (0..k).map(|i| t[i] + small[i] - moved[i]));
+        if n.norm() <= 1e-3 * eps {
+            return (s.clone(), onto(&s));
+        }
+        for b in &blocked {
+            n -= b * b.dot(&n);
+        }
+        if n.norm() <= 1e-6 * eps {
+            return (s.clone(), onto(&s));
+        }
+        blocked.push(n.normalize());
+    }
+}
+
+/// Maximises `f` (ℓ as a function of internal coordinates) over the unit cube from `start`;
+/// `project` maps internal coordinates onto the feasible set.
+pub fn maximise(
+    start: &[f64],
+    options: Options,
+    project: &dyn Fn(&mut [f64]),
+    f: &mut Objective,
+) -> Result<Fit, DiagnoseError> {
+    let k = start.len();
+    let mut t = start.to_vec();
+    let mut evaluations = 1;
+    let mut terms = f(&t)?;
+    let mut f0 = total(&terms);
+    let mut steps = options
+        .steps
+        .map_or_else(|| vec![INITIAL_STEP; k], <[f64]>::to_vec);
+    let mut radius = 0.3;
+    let mut iterations = 0;
+    let mut d = derivatives(&t, &terms, &steps, options.clusters, f, &mut evaluations)?;
+    let mut fresh = true;
+    while iterations < MAX_ITERATIONS && radius > 1e-4 {
+        iterations += 1;
+        if !fresh {
+            d = derivatives(&t, &terms, &steps, options.clusters, f, &mut evaluations)?;
+            fresh = true;
+        }
+        steps.clone_from(&d.steps);
+        let a = -&d.hessian;
+        let (wanted, next) = constrained_step(&t, &d.gradient, &a, radius, project);
+        let step = DVector::from_iterator(k, next.iter().zip(&t).map(|(a, b)| a - b));
+        let model = |s: &DVector<f64>| d.gradient.dot(s) - 0.5 * s.dot(&(&a * s));
+        // The gain the quadratic model predicts for the step taken, and for the step it
+        // wanted (before clipping and projection: on a curved boundary the projection can
+        // spoil a long step that a shorter one would not).
+        let (predicted, promised) = (model(&step), model(&wanted));
+        if promised.max(predicted) < TOLERANCE {
+            // The model promises no progress worth an evaluation: t is the maximum.
+            break;
+        }
         evaluations += 1;
         let next_terms = f(&next)?;
         let f1 = total(&next_terms);
@@ -245,47 +299,59 @@ pub fn maximise(
             }
         } else {
             fresh = true;
-            radius = 0.25 * step.norm().min(radius);
-            if predicted < TOLERANCE {
+            radius = 0.25 * step.norm().max(wanted.norm()).min(radius);
+            if promised < TOLERANCE {
                 break;
             }
         }
     }
-    if !fresh {
-        (_g, hess, b) = derivatives(&t, &terms, f, &mut evaluations)?;
+    if !fresh && options.curvature {
+        d = derivatives(&t, &terms, &steps, options.clusters, f, &mut evaluations)?;
     }
+    let (curvature, variability) = if options.curvature {
+        steps.clone_from(&d.steps);
+        (-d.hessian, d.variability)
+    } else {
+        (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0))
+    };
     Ok(Fit {
         internal: t,
         log_likelihood: f0,
-        curvature: -hess,
-        variability: b,
+        curvature,
+        variability,
+        steps,
         evaluations,
         iterations,
     })
 }
 
-/// The robust (sandwich) covariance `c·A⁻¹BA⁻¹` of the internal coordinates, `c = 1 + n/N`,
-/// and the mean eigenvalue `tr(A⁻¹B)/k` of the misspecification (1 when the Gaussian model
-/// is right); `None` when `A` is not positive definite.
-pub fn sandwich(fit: &Fit, inflation: f64) -> Option<(DMatrix<f64>, f64)> {
+/// The robust (sandwich) covariance `c·A⁻¹BA⁻¹` of the internal coordinates, `c = 1 + n/N`;
+/// `None` when `A` is not positive definite.
+pub fn sandwich(fit: &Fit, inflation: f64) -> Option<DMatrix<f64>> {
+    let a_inv = nalgebra::Cholesky::new(fit.curvature.clone())?.inverse();
+    Some(&a_inv * &fit.variability * &a_inv * inflation)
+}
+
+/// The misspecification adjustments at a fit: `λ̄ = tr(A⁻¹B)/k`, the mean eigenvalue of
+/// `A⁻¹B` (that of the k-parameter likelihood-ratio test), and per parameter
+/// `λⱼ = (A⁻¹BA⁻¹)ⱼⱼ/(A⁻¹)ⱼⱼ` (that of parameter j's profile: the ratio of its sandwich
+/// variance to its model-based one); both 1 when the Gaussian model is right, and `None`
+/// when `A` is not positive definite.
+pub fn adjustments(fit: &Fit) -> Option<(f64, Vec<f64>)> {
     let k = fit.internal.len();
     let a_inv = nalgebra::Cholesky::new(fit.curvature.clone())?.inverse();
     let ab = &a_inv * &fit.variability;
-    let cov = &ab * &a_inv * inflation;
-    Some((cov, ab.trace() / k as f64))
+    let cov = &ab * &a_inv;
+    let per = (0..k).map(|j| cov[(j, j)] / a_inv[(j, j)]).collect();
+    Some((ab.trace() / k as f64, per))
 }
 
 /// Wald intervals of the parameters from the sandwich covariance (module doc); `inflation`
 /// is `c = 1 + n/N`.
-pub fn intervals(fit: &Fit, parameters: &[Parameter], inflation: f64) -> Vec<Interval> {
+pub fn wald_intervals(fit: &Fit, parameters: &[Parameter], inflation: f64) -> Vec<Interval> {
     let k = parameters.len();
-    let undetermined = || Interval {
-        lower: None,
-        upper: None,
-        at_range_end: false,
-    };
-    let Some((cov, _)) = sandwich(fit, inflation) else {
-        return vec![undetermined(); k];
+    let Some(cov) = sandwich(fit, inflation) else {
+        return vec![Interval::undetermined("wald"); k];
     };
     (0..k)
         .map(|i| {
@@ -295,7 +361,10 @@ pub fn intervals(fit: &Fit, parameters: &[Parameter], inflation: f64) -> Vec<Int
             Interval {
                 lower: Some(p.value(lo.max(0.0))),
                 upper: Some(p.value(hi.min(1.0))),
-                at_range_end: lo < 0.0 || hi > 1.0,
+                lower_at_range_end: lo <= 0.0,
+                upper_at_range_end: hi >= 1.0,
+                method: "wald",
+                threshold: None,
             }
         })
         .collect()
@@ -304,6 +373,7 @@ pub fn intervals(fit: &Fit, parameters: &[Parameter], inflation: f64) -> Vec<Int
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::derivatives::Terms;
 
     /// A concave quadratic with its maximum inside the cube is found in a few iterations, and
     /// the Wald interval is the exact one of a normal likelihood: for ℓ = −(t − m)²/(2s²),
@@ -319,7 +389,7 @@ mod tests {
                     / (2.0 * s * s),
             ])
         };
-        let fit = maximise(&[0.5, 0.5], &|_| {}, &mut f).unwrap();
+        let fit = maximise(&[0.5, 0.5], Options::default(), &|_| {}, &mut f).unwrap();
         assert!((fit.internal[0] - m[0]).abs() < 1e-6, "{:?}", fit.internal);
         assert!((fit.internal[1] - m[1]).abs() < 1e-6, "{:?}", fit.internal);
         let p = Parameter {
@@ -339,15 +409,55 @@ mod tests {
                 .map(|x| -(x - t[0]).powi(2) / (2.0 * 4.0 * s * s))
                 .collect())
         };
-        let fit = maximise(&[0.5], &|_| {}, &mut g).unwrap();
+        let fit = maximise(&[0.5], Options::default(), &|_| {}, &mut g).unwrap();
         assert!((fit.internal[0] - 0.4).abs() < 1e-6);
         // A = 4/(4s²) = 1/s²; B = Σ (x_u − x̄)²/(4s²)² = 20s²/16s⁴ = 1.25/s²: A⁻¹BA⁻¹ = 1.25 s².
-        let (cov, mean_eig) = sandwich(&fit, 1.0).unwrap();
+        let cov = sandwich(&fit, 1.0).unwrap();
         assert!((cov[(0, 0)] / (s * s) - 1.25).abs() < 1e-6, "{cov}");
-        assert!((mean_eig - 1.25).abs() < 1e-6);
-        let iv = intervals(&fit, &[p], 1.0);
+        let (mean_eig, per) = adjustments(&fit).unwrap();
+        assert!((mean_eig - 1.25).abs() < 1e-6 && (per[0] - 1.25).abs() < 1e-6);
+        let iv = wald_intervals(&fit, &[p], 1.0);
         let s = s * 1.25f64.sqrt();
         assert!((iv[0].lower.unwrap() - (0.4 - 1.96 * s)).abs() < 1e-3);
         assert!((iv[0].upper.unwrap() - (0.4 + 1.96 * s)).abs() < 1e-3);
+    }
+
+    /// A maximum on a curved constraint: ℓ = −(x − 1)²/(2·0.01²) − (y − 0.7)²/(2·0.2²) on
+    /// the disc |t − (½, ½)| ≤ ½ (gravity's ball in internal coordinates), started on the
+    /// circle at (1, ½), where the unconstrained step points out of the disc. The method
+    /// slides along the circle to the constrained maximum, found here by a fine scan of the
+    /// angle (the reference).
+    #[test]
+    fn slides_along_a_curved_constraint() {
+        let ell = |x: f64, y: f64| {
+            -(x - 1.0).powi(2) / (2.0 * 0.01f64.powi(2)) - (y - 0.7).powi(2) / (2.0 * 0.04)
+        };
+        let mut f = |t: &[f64]| -> Result<Terms, DiagnoseError> { Ok(vec![ell(t[0], t[1])]) };
+        let disc = |t: &mut [f64]| {
+            let (dx, dy) = (t[0] - 0.5, t[1] - 0.5);
+            let r = (dx * dx + dy * dy).sqrt();
+            if r > 0.5 {
+                t[0] = 0.5 + 0.5 * dx / r;
+                t[1] = 0.5 + 0.5 * dy / r;
+            }
+        };
+        let fit = maximise(&[1.0, 0.5], Options::default(), &disc, &mut f).unwrap();
+        let best = (0..=200_000)
+            .map(|i| -0.5 + 1.0 * f64::from(i) / 200_000.0)
+            .map(|phi| (0.5 + 0.5 * phi.cos(), 0.5 + 0.5 * phi.sin()))
+            .max_by(|a, b| ell(a.0, a.1).total_cmp(&ell(b.0, b.1)))
+            .unwrap();
+        assert!(
+            ell(fit.internal[0], fit.internal[1]) > ell(best.0, best.1) - 2.0 * TOLERANCE,
+            "{:?} (ℓ {}) vs {best:?} (ℓ {})",
+            fit.internal,
+            fit.log_likelihood,
+            ell(best.0, best.1)
+        );
+        assert!(
+            (fit.internal[1] - best.1).abs() < 0.02,
+            "{:?} vs {best:?}",
+            fit.internal
+        );
     }
 }

@@ -23,11 +23,17 @@
 //!    surface's height (piston), tan θ_x and tan θ_y, θ_P's percentiles, a KS test on θ_P and
 //!    an energy-distance test on the displacement vectors, each with a 95 % interval and a
 //!    sentence; Holm-adjusted p-values say which disagree.
-//! 2. **Which effect** ([`candidates`], [`likelihood`], [`fit`], [`diagnose`]). Each
-//!    candidate's Gaussian synthetic likelihood is maximised over its parameters; candidates
-//!    are compared with the baseline by a likelihood-ratio test (χ²_k, Bonferroni over the
-//!    candidates, the statistic deflated by 1 + n/N for the simulation's own noise) and with
-//!    each other by BIC = −2ℓ + k ln n. The verdict is one of
+//! 2. **Which effect** ([`candidates`], [`likelihood`], [`fit`], [`score`], [`diagnose`]).
+//!    Each candidate's Gaussian synthetic likelihood ℓ is maximised over its parameters
+//!    (finite-difference derivatives with steps adapted to ℓ's own scale, [`derivatives`]);
+//!    candidates are compared with the baseline by a likelihood-ratio test (χ²_k, Bonferroni
+//!    over the candidates, the statistic Λ = 2(ℓ̂ − ℓ₀)/(c·λ̄) deflated by c = 1 + n/N for
+//!    the simulation's own noise and by λ̄ = max(1, tr(A⁻¹B)/k) for misspecification) and
+//!    with each other by the BIC of a misspecified likelihood, −2ℓ/c + tr(A⁻¹B)·ln n (Gao &
+//!    Song 2010; tr(A⁻¹B) = k·λ̄, the effective number of parameters, never below k), so
+//!    ΔBIC = k·λ̄·ln n − 2(ℓ̂ − ℓ₀)/c = λ̄·(k ln n − Λ) against the baseline: λ̄ raises a
+//!    candidate's penalty rather than shrinking its likelihood, which would make the
+//!    likelihoods of candidates with different λ̄ incomparable. The verdict is one of
 //!    - `named`: the best candidate by BIC is significant and better than the baseline by
 //!      ΔBIC ≤ −2; candidates within ΔBIC 2 of it are listed as *indistinguishable*;
 //!    - `cannot_tell`: some candidate improves the fit but not both significantly and by
@@ -36,6 +42,18 @@
 //!    - `none`: no candidate improves the fit and the baseline agrees within tolerance;
 //!    - `unexplained`: no candidate improves the fit, yet the baseline disagrees (a
 //!      Holm-significant statistic, with at least 30 specimens; with fewer: `cannot_tell`).
+//!
+//!    The named effect's parameters (and those of candidates indistinguishable from it) get
+//!    95 % **profile-likelihood intervals** ([`profile`]): the values θⱼ where
+//!    2(ℓ̂ − ℓ_p(θⱼ)) ≤ χ²₁(0.95)·c·λⱼ, ℓ_p the maximum over the other parameters, with the
+//!    test's adjustments (c as above, λⱼ = max(1, (A⁻¹BA⁻¹)ⱼⱼ/(A⁻¹)ⱼⱼ) the one-parameter
+//!    form of λ̄), found by root-finding on the profile with common random numbers and cut
+//!    at the plausible range (flagged). They follow ℓ where it is far from quadratic (slack
+//!    cables, a fit near the edge of the range) and reduce to the sandwich Wald interval
+//!    where it is quadratic. For a statement about all k parameters at once, the joint
+//!    95 % region (threshold χ²_k(0.95)·c·λ̄) is projected on each parameter as well
+//!    (`joint_interval`). Every candidate also carries its Wald interval, c·A⁻¹BA⁻¹
+//!    ([`fit`]), reported beside the profile one.
 //! 3. **Add it**: `DIR/updated-job.json`, the baseline job with the named effect in the
 //!    case at its fitted values (same case name), which mc-shard and mc-merge run as usual.
 //! 4. **The gap shrinks**: step 1 again with the effect; every statistic before and after,
@@ -58,13 +76,16 @@
 pub mod baseline;
 pub mod candidates;
 pub mod compare;
+pub mod derivatives;
 pub mod diagnose;
 mod errors;
 pub mod fit;
 pub mod likelihood;
 pub mod measured;
 pub mod plot;
+pub mod profile;
 pub mod report;
+pub mod score;
 pub mod simulate;
 pub mod synth;
 

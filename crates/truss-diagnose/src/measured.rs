@@ -21,7 +21,10 @@
 //!
 //! CSV `specimen`, `member`, `length_error` (mm; natural length minus nominal, as in the
 //! job's distributions), member ids of the model; unknown member ids are ignored and
-//! reported.
+//! reported. Specimen ids are matched to the node file's: a specimen's node positions and
+//! its own members' length errors come from the same truss, and the intervals treat them as
+//! one independent unit ([`Measured::clusters`]); members of a specimen without (usable)
+//! node data are one unit per specimen.
 
 use crate::errors::DiagnoseError;
 use std::collections::{BTreeMap, HashMap};
@@ -82,6 +85,11 @@ pub struct DataReport {
 pub struct MemberData {
     /// (member index, measured length error \[mm\]).
     pub observations: Vec<(usize, f64)>,
+    /// For each observation, the truss it was measured on: its specimen's index among the
+    /// node file's specimens used (then the observation and that specimen's node positions
+    /// are not independent), or, for a specimen not among them, their number plus the
+    /// specimen's index among such others in order of first appearance.
+    pub truss: Vec<usize>,
 }
 
 /// The measured data as the diagnosis uses it.
@@ -106,6 +114,17 @@ pub struct Measured {
 }
 
 impl Measured {
+    /// The cluster of each unit term of ℓ (each specimen's, then each member observation's,
+    /// as [`crate::score`] lists them): one per truss ([`MemberData::truss`]), a specimen's
+    /// node positions with its own member observations.
+    pub fn clusters(&self) -> Vec<usize> {
+        let mut out: Vec<usize> = (0..self.n()).collect();
+        if let Some(m) = &self.members {
+            out.extend_from_slice(&m.truss);
+        }
+        out
+    }
+
     /// Number of specimens `n`.
     pub fn n(&self) -> usize {
         self.specimens.len()
@@ -349,7 +368,7 @@ pub fn read(
     }
     let members = match members_path {
         None => None,
-        Some(p) => Some(read_members(model, p, &mut report)?),
+        Some(p) => Some(read_members(model, p, &specimens, &mut report)?),
     };
     Ok(Measured {
         specimens,
@@ -366,9 +385,15 @@ pub fn read(
 fn read_members(
     model: &Model,
     path: &Path,
+    specimens: &[String],
     report: &mut DataReport,
 ) -> Result<MemberData, DiagnoseError> {
     let rows = read_table(path, &["specimen", "member", "length_error"])?;
+    let mut truss: HashMap<String, usize> = specimens
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (s.clone(), i))
+        .collect();
     let mut seen: HashMap<(String, usize), u64> = HashMap::new();
     let mut unknown: BTreeMap<String, ()> = BTreeMap::new();
     let mut data = MemberData::default();
@@ -389,6 +414,8 @@ fn read_members(
             });
         }
         data.observations.push((m, value));
+        let next = truss.len();
+        data.truss.push(*truss.entry(f[0].clone()).or_insert(next));
     }
     report.member_rows = Some(data.observations.len());
     report.unknown_members = unknown.into_keys().collect();
@@ -442,6 +469,27 @@ mod tests {
         assert!((m.y[9 + x20] - 0.0005).abs() < 1e-12);
         // tan θ_x = (z₂ − z₁)/l (paper eq. 17) for s1.
         assert!((m.tan_x[0] - 0.001 / 380.0).abs() < 1e-12);
+        // Members: s2's and s1's join their node terms (clusters 1 and 0); s3 (left out of
+        // the node data) and s4 (no node data) are one cluster each after them; an unknown
+        // member id is reported.
+        let members = write(
+            dir.path(),
+            "mm.csv",
+            "specimen,member,length_error\n\
+             s2,longeron.1.0,0.001\n\
+             s3,longeron.1.0,0.002\n\
+             s1,longeron.1.1,-0.001\n\
+             s3,longeron.1.1,0.0\n\
+             s4,batten.1.0,0.003\n\
+             s1,strut.9,0.1\n",
+        );
+        let m = read(&model, &p, Some(&members), 1).unwrap();
+        let data = m.members.as_ref().unwrap();
+        assert_eq!(data.observations.len(), 5);
+        assert_eq!(data.truss, vec![1, 2, 0, 2, 3]);
+        assert_eq!(m.clusters(), vec![0, 1, 1, 2, 0, 2, 3]);
+        assert_eq!(m.report.member_rows, Some(5));
+        assert_eq!(m.report.unknown_members, vec!["strut.9"]);
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! `diagnosis.json` and `diagnosis.md`.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 1)
+//! ## diagnosis.json (format `truss-diagnose`, version 2)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -9,20 +9,37 @@
 //!              nodes[], unknown_nodes[], rare_nodes[], supports[], member_rows, unknown_members[]}
 //! verdict     "named" | "none" | "cannot_tell" | "unexplained";  reason (words)
 //! named_effect "none" or the effect's name
-//! parameters  [{name, unit, value, interval {lower, upper, at_range_end}, range, null}]
+//! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null}]
+//!              (the named effect's)
+//!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
+//!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
+//!              indistinguishable from it, else "wald"; lower/upper null when not found;
+//!              an end at the range end is the range's (the interval is cut there)
+//!   joint_interval  where profiled: the joint 95 % region of all k parameters projected on
+//!              this one (same fields, threshold χ²_k(0.95)·c·λ̄): every parameter inside its
+//!              joint interval at once with 95 % confidence
 //! indistinguishable [names]   (explain the data as well: ΔBIC within 2; empty when clear)
 //! baseline    {log_likelihood}
-//! candidates  [{name, mechanism, k, parameters[], log_likelihood, lr_statistic, p_value,
-//!               significant, delta_bic, evaluations, seconds, error?}]
+//! candidates  [{name, mechanism, k, parameters[], log_likelihood, lr_statistic, adjustment,
+//!               p_value, significant, delta_bic, evaluations, profile_evaluations, seconds,
+//!               error?}]
 //! skipped     [{name, reason}]
 //! statistics  {before: Comparison, after: Comparison | null}
 //!   Comparison {specimens, samples, energy, energy_p, tolerance {within, outside[], bands},
 //!               statistics[] {id, kind, unit, measured, simulated, comparison, estimate
 //!               {value, lower, upper}, p_value, p_holm, disagrees, words}}
 //! discrepancy_before, discrepancy_after   (energy distance; after = before when no effect is added)
-//! method      {likelihood, selection, verdicts, statistics, discrepancy}   (in words)
+//! method      {likelihood, fit, intervals, selection, verdicts, statistics, discrepancy}
+//!             (in words)
 //! timing      {simulations, solves, seconds}
 //! ```
+//!
+//! Version 2 (from 1): intervals are profile-likelihood intervals for the named effect, with
+//! the Wald interval beside them (`wald_interval`), the joint region's projection
+//! (`joint_interval`), `method` and `threshold`; the one `at_range_end` flag became one per
+//! end; `adjustment`, `profile_evaluations` and `method.intervals` are new; `delta_bic`
+//! charges the misspecification adjustment λ̄ in the penalty (k·λ̄·ln n) instead of dividing
+//! the likelihood ratio by it.
 
 use crate::baseline::Baseline;
 use crate::compare::{Comparison, Statistic};
@@ -33,7 +50,7 @@ use serde::Serialize;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -71,6 +88,7 @@ struct Timing {
 struct Method {
     likelihood: &'static str,
     fit: &'static str,
+    intervals: &'static str,
     selection: &'static str,
     verdicts: &'static str,
     statistics: &'static str,
@@ -80,8 +98,9 @@ struct Method {
 /// The method, in words (also in the crate doc).
 const METHOD: Method = Method {
     likelihood: "Gaussian synthetic likelihood of the specimens' displacement vectors at the compared coordinates: N(μ, Σ) with μ and Σ the mean and covariance of N simulated samples (common random numbers: same seed and case name as the baseline) plus (σ_m² + τ²)·I, τ = 0.1 µm; ℓ = Σ ln N(yᵢ; μ, Σ). With --measured-members, plus Σ ln N(e; E ε, Var ε + σ_m² + τ²) over the measured member length errors.",
-    fit: "each candidate's ℓ maximised over its plausible range from its null (the baseline) by a trust-region Newton method with finite-difference derivatives on the unit cube (log scale for σ); 95 % Wald intervals from the curvature, inflated by c = 1 + n/N for the simulation's own noise.",
-    selection: "likelihood-ratio statistic Λ = 2(ℓ − ℓ₀)/(1 + n/N) against the baseline, p = P(χ²_k ≥ Λ), significant when p < 0.05/K (Bonferroni over the K candidates); ΔBIC = k ln n − Λ (n specimens). Named: the candidate with the lowest ΔBIC if it is significant and ΔBIC ≤ −2; indistinguishable: other candidates with ΔBIC within 2 of it.",
+    fit: "each candidate's ℓ maximised over its plausible range (log scale for σ, |g| ≤ 1 for gravity) from the best of its null (the baseline) and a scan along each parameter, by a trust-region Newton method on the unit cube; gradient, curvature A and score variability B by finite differences whose step along each parameter is adapted to the likelihood's own scale (the central second difference about one unit of ℓ, i.e. a step of about one standard error; 1e-7 to 0.05 of the range).",
+    intervals: "95 % profile-likelihood intervals for the named effect and any indistinguishable from it: the values θ_j where 2(ℓ̂ − ℓ_p(θ_j)) ≤ χ²₁(0.95)·c·λ_j, ℓ_p the maximum over the other parameters, c = 1 + n/N for the simulation's own noise, λ_j = max(1, (A⁻¹BA⁻¹)_jj/(A⁻¹)_jj) for misspecification (Royall & Tsou 2003; the one-parameter form of the test's λ̄); ends found by safeguarded root-finding on √(2(ℓ̂ − ℓ_p)) with common random numbers, to 5 % in the threshold; an end that reaches the plausible range is cut there and flagged. For all k parameters at once, the joint 95 % region 2(ℓ̂ − ℓ(θ)) ≤ χ²_k(0.95)·c·λ̄ projected on each parameter (joint_interval; the same computation with that threshold). Every candidate also has the sandwich Wald interval t̂ ± 1.96·√(c·A⁻¹BA⁻¹) (wald_interval), which assumes ℓ quadratic; the verdict and checks use the profile interval.",
+    selection: "likelihood-ratio statistic Λ = 2(ℓ − ℓ₀)/(c·λ̄) against the baseline, c = 1 + n/N, λ̄ = max(1, tr(A⁻¹B)/k); p = P(χ²_k ≥ Λ), significant when p < 0.05/K (Bonferroni over the K candidates); ΔBIC = k·λ̄·ln n − 2(ℓ − ℓ₀)/c = λ̄·(k ln n − Λ) (n specimens), the BIC of a misspecified likelihood whose penalty counts the effective number of parameters tr(A⁻¹B) = k·λ̄ (Gao & Song 2010), so that candidates' likelihoods are compared unscaled. Named: the candidate with the lowest ΔBIC if it is significant and ΔBIC ≤ −2; indistinguishable: other candidates with ΔBIC within 2 of it. Significant means better than the baseline, not present: when the baseline misses some effect, any candidate that mimics part of it improves on the baseline, and BIC chooses between them.",
     verdicts: "named: as above. cannot_tell: some candidate improves the fit but not both significantly and by ΔBIC ≤ −2, or none improves it and the data cannot show the baseline agrees within tolerance. none: no candidate improves it and the baseline agrees within tolerance (every coordinate's mean within ±0.5 predicted SD, its SD and θ_P's median and 95th percentile within a factor 1.3, judged by their 95 % intervals). unexplained: no candidate improves it, yet the baseline disagrees (a Holm-significant statistic, with at least 30 specimens; with fewer, cannot_tell).",
     statistics: "per coordinate, piston (mean top z), tan θ_x, tan θ_y: mean difference (Welch interval), SD ratio (interval on ln with kurtosis-corrected variance), covariances (fourth-moment variance); θ_P percentiles 50/90/95/99 (Hyndman–Fan definition 1) as ratios with Poisson-bootstrap intervals (B = 1000); KS on θ_P; energy distance with a permutation test (R = 199). The simulation carries the instrument's noise. Disagrees: Holm-adjusted p < 0.05.",
     discrepancy: "energy distance (unbiased U-statistic, Székely & Rizzo 2004) between the measured and simulated displacement vectors, each coordinate divided by its measured SD: 0 when the distributions agree.",
@@ -177,18 +196,31 @@ fn g(v: f64) -> String {
 }
 
 fn parameter_text(p: &FittedParameter) -> String {
-    let iv = match (p.interval.lower, p.interval.upper) {
-        (Some(a), Some(b)) => format!(
-            " (95 % CI {}–{}{})",
-            g(a),
-            g(b),
-            if p.interval.at_range_end {
-                ", cut at the plausible range"
-            } else {
-                ""
+    let i = &p.interval;
+    let end = |v: Option<f64>| v.map_or("?".to_string(), g);
+    // The joint region's projection, where it differs from the parameter's own interval
+    // (k > 1).
+    let joint = match &p.joint_interval {
+        Some(j) if *j != p.interval && (j.lower.is_some() || j.upper.is_some()) => {
+            format!("; all parameters jointly {}–{}", end(j.lower), end(j.upper))
+        }
+        _ => String::new(),
+    };
+    let iv = if i.lower.is_none() && i.upper.is_none() {
+        format!(" (interval undetermined{joint})")
+    } else {
+        format!(
+            " (95 % {} CI {}–{}{}{joint})",
+            i.method,
+            end(i.lower),
+            end(i.upper),
+            match (i.lower_at_range_end, i.upper_at_range_end) {
+                (true, true) => ", both ends cut at the plausible range",
+                (true, false) => ", lower end cut at the plausible range",
+                (false, true) => ", upper end cut at the plausible range",
+                (false, false) => "",
             }
-        ),
-        _ => " (interval undetermined)".into(),
+        )
     };
     format!("{} = {} {}{iv}", p.name, g(p.value), p.unit)
 }
@@ -467,6 +499,7 @@ pub fn markdown(
     for (k, v) in [
         ("Likelihood", METHOD.likelihood),
         ("Fit", METHOD.fit),
+        ("Intervals", METHOD.intervals),
         ("Selection", METHOD.selection),
         ("Verdicts", METHOD.verdicts),
         ("Statistics", METHOD.statistics),

@@ -1,0 +1,406 @@
+//! One candidate at a time: ℓ of the data under an edited case, the candidate's maximum, its
+//! likelihood-ratio test against the baseline, and its intervals (Wald for every candidate,
+//! profile likelihood for those the verdict rests on).
+
+use crate::baseline::{Baseline, CaseEdit};
+use crate::candidates::Candidate;
+use crate::derivatives::Terms;
+use crate::errors::DiagnoseError;
+use crate::fit::{Fit, Interval, Options, adjustments, maximise, wald_intervals};
+use crate::likelihood::{Gaussian, member_log_likelihood};
+use crate::measured::Measured;
+use crate::profile::{Intervals, Problem, Profile, profile_intervals};
+use crate::simulate::{Simulation, simulate};
+use serde::Serialize;
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+use std::time::Instant;
+
+/// A fitted parameter.
+#[derive(Debug, Clone, Serialize)]
+pub struct FittedParameter {
+    /// Name.
+    pub name: String,
+    /// Unit.
+    pub unit: &'static str,
+    /// Maximum-likelihood value.
+    pub value: f64,
+    /// The 95 % interval the report and the checks use: the profile-likelihood interval
+    /// where it was computed, else the Wald interval.
+    pub interval: Interval,
+    /// The 95 % sandwich Wald interval, for comparison.
+    pub wald_interval: Interval,
+    /// Where profiled: the projection of the joint 95 % profile-likelihood region of all
+    /// the candidate's k parameters (threshold χ²_k(0.95)·c·λ̄), so that every parameter
+    /// lies in its joint interval at once with 95 % confidence ([`crate::profile`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub joint_interval: Option<Interval>,
+    /// The plausible range searched.
+    pub range: [f64; 2],
+    /// The value at which the candidate is the baseline.
+    pub null: f64,
+}
+
+/// One candidate's fit and score.
+#[derive(Debug, Clone, Serialize)]
+pub struct CandidateScore {
+    /// Name.
+    pub name: String,
+    /// The mechanism in words.
+    pub mechanism: String,
+    /// Number of parameters k.
+    pub k: usize,
+    /// Fitted parameters.
+    pub parameters: Vec<FittedParameter>,
+    /// Maximised ℓ (Gaussian synthetic likelihood, plus the member term when given).
+    pub log_likelihood: f64,
+    /// Λ = 2(ℓ − ℓ₀)/((1 + n/N)·λ̄), the adjusted likelihood-ratio statistic against the
+    /// baseline.
+    pub lr_statistic: f64,
+    /// λ̄ = max(1, tr(A⁻¹B)/k), the misspecification adjustment.
+    pub adjustment: f64,
+    /// P(χ²_k ≥ Λ).
+    pub p_value: f64,
+    /// Whether p < α/K.
+    pub significant: bool,
+    /// ΔBIC = k·λ̄·ln n − 2(ℓ − ℓ₀)/(1 + n/N) = λ̄·(k ln n − Λ) against the baseline
+    /// (negative: better): the BIC of a misspecified likelihood, whose penalty counts the
+    /// effective number of parameters tr(A⁻¹B) = k·λ̄ (crate doc).
+    pub delta_bic: f64,
+    /// Likelihood evaluations (each a simulation of N samples), profiles included.
+    pub evaluations: usize,
+    /// Of which for the profile intervals.
+    pub profile_evaluations: usize,
+    /// Wall time of the fit and the profiles \[s\].
+    pub seconds: f64,
+    /// Why the fit failed, if it did.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// ℓ of the measured data under an edited case.
+pub(crate) struct Evaluator<'a> {
+    pub baseline: &'a Baseline,
+    pub measured: &'a Measured,
+    pub samples: usize,
+    pub sigma_m: f64,
+    pub simulations: std::cell::Cell<usize>,
+}
+
+impl Evaluator<'_> {
+    /// The one-case job of an edit, N samples, the baseline's seed.
+    pub fn job(&self, edit: &CaseEdit) -> Result<mc_shard::Job, DiagnoseError> {
+        self.baseline.job_of(edit, self.samples as u64, None)
+    }
+
+    fn log_likelihood(&self, edit: &CaseEdit) -> Result<Terms, DiagnoseError> {
+        let job = self.job(edit)?;
+        let sim = simulate(&job, &self.measured.coords, self.samples, None)?;
+        self.simulations.set(self.simulations.get() + 1);
+        self.score(&job, &sim)
+    }
+
+    /// The terms of ℓ: each specimen's, then each member observation's.
+    pub fn score(&self, job: &mc_shard::Job, sim: &Simulation) -> Result<Terms, DiagnoseError> {
+        let g = Gaussian::from_simulation(sim, self.sigma_m)?;
+        let mut terms = g.log_densities(&self.measured.y);
+        if let Some(m) = &self.measured.members {
+            terms.extend(member_log_likelihood(&job.cases[0], m, self.sigma_m));
+        }
+        Ok(terms)
+    }
+
+    /// The baseline case with the candidate applied at `values`.
+    pub fn edit(&self, c: &dyn Candidate, values: &[f64]) -> Result<CaseEdit, DiagnoseError> {
+        let mut edit = self.baseline.derived_case();
+        c.apply(values, &mut edit)?;
+        Ok(edit)
+    }
+}
+
+/// The parameter values at internal coordinates `t`, on the feasible set.
+fn values_of(c: &dyn Candidate, t: &[f64]) -> Vec<f64> {
+    let mut v: Vec<f64> = c
+        .parameters()
+        .iter()
+        .zip(t)
+        .map(|(p, &x)| p.value(x))
+        .collect();
+    c.project(&mut v, None);
+    v
+}
+
+/// The internal coordinates scanned along each parameter axis (the others at their null) for
+/// a start: a candidate's likelihood need not be unimodal between the null and the truth (a
+/// pretension that stiffens the truss predicts a much smaller scatter, so half of the true
+/// pretension can fit worse than none).
+pub const SCAN: [f64; 8] = [0.0, 0.125, 0.25, 0.375, 0.625, 0.75, 0.875, 1.0];
+
+/// The best of the null and the axis scan ([`SCAN`]).
+fn best_start(
+    null: &[f64],
+    project: &dyn Fn(&mut [f64], Option<usize>),
+    f: &mut dyn FnMut(&[f64]) -> Result<Terms, DiagnoseError>,
+) -> Result<Vec<f64>, DiagnoseError> {
+    let mut best = (f(null)?.iter().sum::<f64>(), null.to_vec());
+    for i in 0..null.len() {
+        for &x in &SCAN {
+            let mut t = null.to_vec();
+            t[i] = x;
+            project(&mut t, None);
+            if t == null {
+                continue;
+            }
+            if let Ok(terms) = f(&t) {
+                let l: f64 = terms.iter().sum();
+                if l > best.0 {
+                    best = (l, t);
+                }
+            }
+        }
+    }
+    Ok(best.1)
+}
+
+/// What scoring needs to know about the data and the test.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Test {
+    /// ℓ₀ of the baseline.
+    pub l0: f64,
+    /// Specimens n.
+    pub n: usize,
+    /// `c = 1 + n/N`.
+    pub inflation: f64,
+    /// The per-candidate level α/K.
+    pub level: f64,
+}
+
+/// A candidate's fit, kept for its profile.
+pub(crate) struct Fitted {
+    pub score: CandidateScore,
+    pub fit: Option<Fit>,
+    pub profiled: bool,
+}
+
+/// A candidate's objective: ℓ's terms at internal coordinates.
+fn objective<'a>(
+    ev: &'a Evaluator<'a>,
+    c: &'a dyn Candidate,
+) -> impl FnMut(&[f64]) -> Result<Terms, DiagnoseError> + 'a {
+    let params = c.parameters();
+    move |t: &[f64]| {
+        let v: Vec<f64> = params.iter().zip(t).map(|(p, &x)| p.value(x)).collect();
+        ev.log_likelihood(&ev.edit(c, &v)?)
+    }
+}
+
+/// A candidate's projection of internal coordinates onto its feasible set, leaving the
+/// coordinate given (if any) where it is.
+fn projection(c: &dyn Candidate) -> impl Fn(&mut [f64], Option<usize>) + '_ {
+    let params = c.parameters();
+    move |t: &mut [f64], fixed: Option<usize>| {
+        let mut v: Vec<f64> = params
+            .iter()
+            .zip(t.iter())
+            .map(|(p, &x)| p.value(x))
+            .collect();
+        c.project(&mut v, fixed);
+        for (i, (x, (p, val))) in t.iter_mut().zip(params.iter().zip(&v)).enumerate() {
+            if Some(i) != fixed {
+                *x = p.internal(*val);
+            }
+        }
+    }
+}
+
+/// The score of a fit: the test against the baseline and the Wald intervals.
+fn score_of(c: &dyn Candidate, fit: &Fit, test: &Test) -> CandidateScore {
+    let params = c.parameters();
+    let k = params.len();
+    let values = values_of(c, &fit.internal);
+    let wald = wald_intervals(fit, params, test.inflation);
+    // Λ = 2(ℓ̂ − ℓ₀)/(c·λ̄), λ̄ = max(1, tr(A⁻¹B)/k) (crate doc).
+    let mean_eig = adjustments(fit).map_or(1.0, |(m, _)| m).max(1.0);
+    let lr = (2.0 * (fit.log_likelihood - test.l0) / (test.inflation * mean_eig)).max(0.0);
+    let p = 1.0 - ChiSquared::new(k as f64).expect("k ≥ 1").cdf(lr);
+    CandidateScore {
+        name: c.name().into(),
+        mechanism: c.mechanism().into(),
+        k,
+        parameters: params
+            .iter()
+            .zip(values.iter().zip(wald))
+            .map(|(p, (&value, wald))| FittedParameter {
+                name: p.name.clone(),
+                unit: p.unit,
+                value,
+                interval: wald.clone(),
+                wald_interval: wald,
+                joint_interval: None,
+                range: [p.low, p.high],
+                null: p.null,
+            })
+            .collect(),
+        log_likelihood: fit.log_likelihood,
+        lr_statistic: lr,
+        adjustment: mean_eig,
+        p_value: p,
+        significant: p < test.level,
+        delta_bic: mean_eig * (k as f64 * (test.n as f64).ln() - lr),
+        evaluations: fit.evaluations,
+        profile_evaluations: 0,
+        seconds: 0.0,
+        error: None,
+    }
+}
+
+/// Fits a candidate: the best start of the axis scan, then the trust-region Newton method.
+pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> Fitted {
+    let clock = Instant::now();
+    let params = c.parameters();
+    let null: Vec<f64> = params.iter().map(|p| p.internal(p.null)).collect();
+    let count = std::cell::Cell::new(0usize);
+    let (mut objective, project) = (objective(ev, c), projection(c));
+    let mut counted = |t: &[f64]| {
+        count.set(count.get() + 1);
+        objective(t)
+    };
+    let start = best_start(&null, &project, &mut counted).unwrap_or(null);
+    let clusters = ev.measured.clusters();
+    let options = Options {
+        clusters: Some(&clusters),
+        ..Options::default()
+    };
+    let fit = maximise(&start, options, &|t| project(t, None), &mut counted);
+    let (mut score, fit) = match fit {
+        Ok(fit) => (score_of(c, &fit, test), Some(fit)),
+        Err(e) => (
+            CandidateScore {
+                name: c.name().into(),
+                mechanism: c.mechanism().into(),
+                k: params.len(),
+                parameters: Vec::new(),
+                log_likelihood: f64::NEG_INFINITY,
+                lr_statistic: 0.0,
+                adjustment: 1.0,
+                p_value: 1.0,
+                significant: false,
+                delta_bic: f64::INFINITY,
+                evaluations: 0,
+                profile_evaluations: 0,
+                seconds: 0.0,
+                error: Some(e.to_string()),
+            },
+            None,
+        ),
+    };
+    score.evaluations = count.get();
+    score.seconds = clock.elapsed().as_secs_f64();
+    Fitted {
+        score,
+        fit,
+        profiled: false,
+    }
+}
+
+/// Profile-likelihood intervals for a fitted candidate ([`crate::profile`]); where a profile
+/// finds a higher point the candidate is fitted again from there and scored anew (at most
+/// twice). A profile that fails, or still finds a higher point after that, leaves the Wald
+/// intervals and says why in the progress notes.
+pub(crate) fn profile_candidate(
+    ev: &Evaluator,
+    c: &dyn Candidate,
+    fitted: &mut Fitted,
+    test: &Test,
+    note: &dyn Fn(&str),
+) {
+    fitted.profiled = true;
+    let Some(mut fit) = fitted.fit.take() else {
+        return;
+    };
+    let clock = Instant::now();
+    let (mut objective, project) = (objective(ev, c), projection(c));
+    let clusters = ev.measured.clusters();
+    let mut spent = 0;
+    let mut refitted = false;
+    let mut outcome = None;
+    for attempt in 0..3 {
+        let problem = Problem {
+            parameters: c.parameters(),
+            project: &project,
+            inflation: test.inflation,
+        };
+        match profile_intervals(&fit, &problem, &mut objective, true) {
+            Ok(Profile::Intervals(iv)) => {
+                spent += iv.evaluations;
+                outcome = Some(iv);
+                break;
+            }
+            Ok(Profile::Higher(_, n)) if attempt == 2 => {
+                spent += n;
+                note(&format!(
+                    "  {}: the profile still finds higher points after two new fits; Wald intervals kept",
+                    c.name()
+                ));
+            }
+            Ok(Profile::Higher(t, n)) => {
+                spent += n;
+                note(&format!(
+                    "  {}: the profile found a higher point; fitting again from there",
+                    c.name()
+                ));
+                let options = Options {
+                    steps: Some(&fit.steps),
+                    curvature: true,
+                    clusters: Some(&clusters),
+                };
+                match maximise(&t, options, &|t| project(t, None), &mut objective) {
+                    Ok(better) if better.log_likelihood > fit.log_likelihood => {
+                        spent += better.evaluations;
+                        fit = better;
+                        refitted = true;
+                    }
+                    Ok(other) => {
+                        spent += other.evaluations;
+                        note(&format!(
+                            "  {}: fitting again found no higher maximum; Wald intervals kept",
+                            c.name()
+                        ));
+                        break;
+                    }
+                    Err(e) => {
+                        note(&format!(
+                            "  {}: fitting again failed ({e}); Wald intervals kept",
+                            c.name()
+                        ));
+                        break;
+                    }
+                }
+            }
+            Err(e) => {
+                note(&format!(
+                    "  {}: profile failed ({e}); Wald intervals kept",
+                    c.name()
+                ));
+                break;
+            }
+        }
+    }
+    let (evaluations, seconds) = (fitted.score.evaluations, fitted.score.seconds);
+    if refitted {
+        fitted.score = score_of(c, &fit, test);
+    }
+    if let Some(Intervals {
+        marginal, joint, ..
+    }) = outcome
+    {
+        let joint = joint.into_iter().map(Some).chain(std::iter::repeat(None));
+        for ((p, i), jt) in fitted.score.parameters.iter_mut().zip(marginal).zip(joint) {
+            p.interval = i;
+            p.joint_interval = jt;
+        }
+    }
+    fitted.score.evaluations = evaluations + spent;
+    fitted.score.profile_evaluations = spent;
+    fitted.score.seconds = seconds + clock.elapsed().as_secs_f64();
+    fitted.fit = Some(fit);
+}
