@@ -98,6 +98,16 @@ impl DistributionSpec {
         }
     }
 
+    /// The least value a draw can take \[mm\]: −∞ for a normal with σ > 0.
+    pub fn lowest(&self) -> f64 {
+        match *self {
+            DistributionSpec::Normal { sigma, .. } if sigma > 0.0 => f64::NEG_INFINITY,
+            DistributionSpec::Normal { mean, .. } => mean,
+            DistributionSpec::Uniform { low, .. } => low,
+            DistributionSpec::Constant { value } => value,
+        }
+    }
+
     /// The value the two words `w1`, `w2` give (see the module doc).
     #[inline]
     pub fn from_words(&self, w1: u64, w2: u64) -> f64 {

@@ -305,13 +305,7 @@ impl Job {
                     ));
                 }
                 b.clearance.check().map_err(|m| JobError::at(&path, &m))?;
-                let lowest = match b.clearance {
-                    DistributionSpec::Normal { sigma, .. } if sigma > 0.0 => f64::NEG_INFINITY,
-                    DistributionSpec::Normal { mean, .. } => mean,
-                    DistributionSpec::Uniform { low, .. } => low,
-                    DistributionSpec::Constant { value } => value,
-                };
-                if lowest < 0.0 {
+                if b.clearance.lowest() < 0.0 {
                     return Err(JobError::at(
                         &path,
                         "a clearance cannot be negative: give a distribution whose values are \

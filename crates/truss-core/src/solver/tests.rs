@@ -72,15 +72,20 @@ fn joints() -> Option<BacklashOptions> {
     })
 }
 
-#[test]
-fn residual_is_the_energy_gradient() {
-    for (seed, backlash) in [
+/// The seeds of the finite-difference checks: three without joints, two with.
+fn cases() -> [(u64, Option<BacklashOptions>); 5] {
+    [
         (1, None),
         (2, None),
         (3, None),
         (4, joints()),
         (5, joints()),
-    ] {
+    ]
+}
+
+#[test]
+fn residual_is_the_energy_gradient() {
+    for (seed, backlash) in cases() {
         let (mut solver, u) = solver_with(seed, backlash);
         let (r, _) = residual_and_energy(&mut solver, &u);
         if backlash.is_some() {
@@ -109,13 +114,7 @@ fn residual_is_the_energy_gradient() {
 
 #[test]
 fn tangent_is_the_residual_jacobian() {
-    for (seed, backlash) in [
-        (1, None),
-        (2, None),
-        (3, None),
-        (4, joints()),
-        (5, joints()),
-    ] {
+    for (seed, backlash) in cases() {
         let (mut solver, u) = solver_with(seed, backlash);
         let (_, _) = residual_and_energy(&mut solver, &u);
         solver.update_slack();
