@@ -25,6 +25,8 @@
 # Usage: scripts/diagnose-check.sh [--coverage] [WORKDIR]      (needs python3 and bc)
 #        COVERAGE_EFFECT=NAME:P=V,… COVERAGE_TRUTH="P=V …" COVERAGE_SPECIMENS=N
 #        COVERAGE_SEEDS="S …" scripts/diagnose-check.sh --coverage
+#        COVERAGE_JOB=J COVERAGE_CASE=C COVERAGE_SYNTH_CASE=C2 MEMBERS=1 (another job; the
+#        specimens made from C2 with the effect, diagnosed against C)
 set -euo pipefail
 coverage=0
 if [[ "${1:-}" == "--coverage" ]]; then
@@ -42,30 +44,39 @@ J="$REPO/jobs/diagnose-baseline.json"
 status=0
 
 # run NAME EFFECT SEED SPECIMENS: synthesises and diagnoses (with MEMBERS=1 also the member
-# length errors, measured one by one); prints the wall time.
+# length errors, measured one by one); prints the wall time. JOB (default $J), CASE (default
+# as-built) and SYNTH_CASE (default CASE: the case the specimens are made from) choose
+# another job.
 run() {
   local name=$1 effect=$2 seed=$3 n=$4
+  local job=${JOB:-$J} case=${CASE:-as-built}
+  local synth_case=${SYNTH_CASE:-$case}
   local synth_members=() diagnose_members=()
   if [[ "${MEMBERS:-0}" == 1 ]]; then
     synth_members=(--members-out "$WORK/$name-members.csv")
     diagnose_members=(--measured-members "$WORK/$name-members.csv")
   fi
-  "$T" synth-measured --job "$J" --case as-built --specimens "$n" --seed "$seed" \
+  "$T" synth-measured --job "$job" --case "$synth_case" --specimens "$n" --seed "$seed" \
     --effect "$effect" --measurement-sigma 0.001 "${synth_members[@]}" > "$WORK/$name.csv"
   local start end
   start=$(date +%s.%N)
-  "$T" diagnose --job "$J" --case as-built --measured "$WORK/$name.csv" \
+  "$T" diagnose --job "$job" --case "$case" --measured "$WORK/$name.csv" \
     --measurement-sigma 0.001 "${diagnose_members[@]}" --out "$WORK/$name" --quiet > /dev/null
   end=$(date +%s.%N)
   echo "$end - $start" | bc
 }
 
-# check NAME EFFECT SEED SPECIMENS EXPECT [PARAM=TRUTH ...]
+# check NAME EFFECT SEED SPECIMENS EXPECT [PARAM=TRUTH ...]   (EXPECT "any": only reported)
 check() {
   local name=$1 effect=$2 seed=$3 n=$4 expect=$5
   shift 5
   local secs
-  secs=$(run "$name" "$effect" "$seed" "$n")
+  if ! secs=$(run "$name" "$effect" "$seed" "$n"); then
+    echo "$name: truss synth-measured or diagnose failed (see above)"
+    echo "    FAILED"
+    status=1
+    return 0
+  fi
   python3 - "$WORK/$name/diagnosis.json" "$name" "$effect" "$expect" "$secs" "$@" <<'PY' || status=1
 import json, sys
 path, name, effect, expect, secs, *truth = sys.argv[1:]
@@ -74,13 +85,15 @@ ok = True
 line = f"{name:<11} hidden {effect:<48} n={d['data']['specimens_used']:<4} verdict {d['verdict']:<11} named {d['named_effect']:<19}"
 line += f" disc {d['discrepancy_before']:.4f} -> {d['discrepancy_after']:.4f}  {float(secs):.1f} s"
 print(line)
-if expect in ("none", "cannot_tell", "unexplained"):
+if expect == "any":
+    pass
+elif expect in ("none", "cannot_tell", "unexplained"):
     ok &= d["verdict"] == expect
 else:
     ok &= d["verdict"] == "named" and d["named_effect"] == expect
     ok &= d["discrepancy_after"] <= 0.5 * d["discrepancy_before"]
-    if d["indistinguishable"]:
-        print("    indistinguishable:", ", ".join(d["indistinguishable"]))
+if d["indistinguishable"]:
+    print("    indistinguishable:", ", ".join(d["indistinguishable"]))
 params = {p["name"]: p for p in d["parameters"]}
 
 def show(i, v):
@@ -90,6 +103,8 @@ def show(i, v):
     cut = ("<" if i["lower_at_range_end"] else "") + (">" if i["upper_at_range_end"] else "")
     return inside, f"[{f(lo)}, {f(hi)}]{cut} {'in' if inside else 'OUT'}"
 
+if expect == "any":
+    truth = [t for t in truth if t.split("=")[0] in params]
 for t in truth:
     k, v = t.split("=")
     v = float(v)
@@ -105,6 +120,9 @@ for t in truth:
     _, own = show(p["interval"], v)
     _, wald = show(p["wald_interval"], v)
     print(f"    {k:<16} truth {v:<8g} fit {p['value']:<11.5g} joint {jt:<34} own {own:<34} Wald {wald}")
+if expect == "any":
+    print("    (reported, not checked)")
+    sys.exit(0)
 print("    ok" if ok else "    FAILED")
 sys.exit(0 if ok else 1)
 PY
@@ -118,7 +136,8 @@ if [[ $coverage == 1 ]]; then
   name="${effect%%:*}"
   echo "coverage study: $effect hidden in $n specimens, seeds $seeds"
   for s in $seeds; do
-    secs=$(run "cov-$s" "$effect" "$s" "$n")
+    secs=$(JOB=${COVERAGE_JOB:-$J} CASE=${COVERAGE_CASE:-as-built} \
+      SYNTH_CASE=${COVERAGE_SYNTH_CASE:-${COVERAGE_CASE:-as-built}} run "cov-$s" "$effect" "$s" "$n")
     echo "  seed $s: $(python3 -c "import json; d = json.load(open('$WORK/cov-$s/diagnosis.json')); print(d['verdict'], d['named_effect'])") in $secs s"
   done
   # shellcheck disable=SC2086
@@ -184,5 +203,19 @@ check sigma+mm    "length_sigma:sigma.longeron=0.012"              23 200 length
 check pretension  "diagonal_pretension:length_error=-0.05"         24 200 diagonal_pretension length_error=-0.05
 check gravity     "gravity:g_x=1"                                  11 200 gravity g_x=1 g_y=0 g_z=0
 check few         "thermal_gradient:gradient_x=0.0005"             25 12  cannot_tell
+# Backlash (section 4.2.3's truss, σ = 0.033 mm, diagonals U[-0.099, 0] mm): a common
+# clearance made through the candidate, and the paper's clearances U[0.004, 0.017] mm made
+# by the job's own backlash case, diagnosed against the rigid case with the members measured
+# one by one and, last, from the node positions alone (reported, not required: there a joint
+# effect shortens the longerons much as a length error does). The paper's clearances scatter
+# among the joints, which the one-parameter candidate cannot; the truth printed is their
+# mean.
+P="$REPO/jobs/paper-4.2.3.json"
+JOB=$P CASE=rigid-sigma-0.033 MEMBERS=1 \
+check backlash    "backlash:clearance=0.0105"                      31 200 backlash clearance=0.0105
+JOB=$P CASE=rigid-sigma-0.033 SYNTH_CASE=backlash-sigma-0.033 MEMBERS=1 \
+check paper-bl+mm "none"                                           31 200 backlash clearance=0.0105
+JOB=$P CASE=rigid-sigma-0.033 SYNTH_CASE=backlash-sigma-0.033 \
+check paper-bl    "none"                                           31 200 any clearance=0.0105
 echo "outputs in $WORK"
 exit $status

@@ -9,6 +9,7 @@
 use crate::baseline::{Baseline, CaseEdit};
 use crate::candidates::library;
 use crate::compare::{Comparison, compare};
+use crate::derivatives::Terms;
 use crate::errors::DiagnoseError;
 use crate::measured::Measured;
 pub use crate::score::{CandidateScore, FittedParameter, SCAN};
@@ -20,6 +21,10 @@ use std::time::Instant;
 /// Evidence that counts as a clear improvement and as "as good": a BIC difference of 2
 /// (Kass & Raftery 1995: below 2 "not worth more than a bare mention").
 pub const DELTA_BIC: f64 = 2.0;
+/// Vuong's z below which the named candidate is not shown closer to the data's distribution
+/// than another significant candidate (two-sided 5 %): the other is listed as
+/// indistinguishable.
+pub const VUONG_Z: f64 = 1.96;
 /// Fewest specimens for the verdict `unexplained`: below it the large-sample intervals of
 /// single statistics (covariances above all) are not trusted to show a disagreement that no
 /// candidate explains, and the verdict is `cannot_tell`.
@@ -144,36 +149,93 @@ pub struct Decision {
     pub indistinguishable: Vec<usize>,
 }
 
+/// Vuong's (1989) statistic for two non-nested models fitted to the same data: with
+/// `a` and `b` the per-unit terms of their maximised ℓ and `d_u` their difference summed
+/// over each cluster u (a specimen with its member observations), of n_u clusters,
+/// `z = Σ d_u / √(c·n_u·var(d))`, c = 1 + n/N for the simulation's own noise in both fits.
+/// Positive: `a` closer. Zero when the two predict the same for every unit.
+pub fn vuong(a: &[f64], b: &[f64], clusters: &[usize], inflation: f64) -> f64 {
+    let units = clusters.iter().max().map_or(0, |m| m + 1);
+    let mut d = vec![0.0; units];
+    for ((x, y), &u) in a.iter().zip(b).zip(clusters) {
+        d[u] += x - y;
+    }
+    if units < 2 {
+        return 0.0;
+    }
+    let n = units as f64;
+    let sum: f64 = d.iter().sum();
+    let mean = sum / n;
+    let var = d.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    if var > 0.0 {
+        sum / (inflation * n * var).sqrt()
+    } else {
+        0.0
+    }
+}
+
 /// The verdict from the candidates' scores and the baseline's comparison (crate doc):
-/// `level` is the per-candidate significance level α/K.
-pub fn decide(scores: &[&CandidateScore], before: &Comparison, n: usize, level: f64) -> Decision {
+/// `level` is the per-candidate significance level α/K; `closeness(i, j)` is Vuong's z of
+/// candidate i against j ([`vuong`]), asked only of significant candidates.
+pub fn decide(
+    scores: &[&CandidateScore],
+    before: &Comparison,
+    n: usize,
+    level: f64,
+    closeness: &dyn Fn(usize, usize) -> f64,
+) -> Decision {
     let before_disagrees = before.statistics.iter().any(|s| s.disagrees);
     let best = (0..scores.len())
         .filter(|&i| scores[i].error.is_none())
         .min_by(|&a, &b| scores[a].delta_bic.total_cmp(&scores[b].delta_bic));
     let clear = best.filter(|&i| scores[i].significant && scores[i].delta_bic <= -DELTA_BIC);
     let (verdict, reason, named, indistinguishable) = if let Some(i) = clear {
-        let others: Vec<usize> = (0..scores.len())
-            .filter(|&j| j != i && scores[j].error.is_none())
+        let candidates = (0..scores.len()).filter(|&j| j != i && scores[j].error.is_none());
+        let by_bic: Vec<usize> = candidates
+            .clone()
             .filter(|&j| scores[j].delta_bic < scores[i].delta_bic + DELTA_BIC)
             .collect();
-        let reason = if others.is_empty() {
-            format!(
-                "{} improves the likelihood significantly (p = {:.2e} < α/K = {level:.4}) and is the best by BIC by at least {DELTA_BIC} over every other candidate",
-                scores[i].name, scores[i].p_value,
-            )
-        } else {
-            format!(
-                "{} improves the likelihood significantly (p = {:.2e}) and is best by BIC, but {} explain the data as well (ΔBIC within {DELTA_BIC}): the data cannot tell them apart",
-                scores[i].name,
-                scores[i].p_value,
-                others
+        let by_vuong: Vec<(usize, f64)> = candidates
+            .filter(|&j| !by_bic.contains(&j) && scores[j].significant)
+            .map(|j| (j, closeness(i, j)))
+            .filter(|&(_, z)| z < VUONG_Z)
+            .collect();
+        let names = |js: &mut dyn Iterator<Item = usize>| {
+            js.map(|j| scores[j].name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut reason = format!(
+            "{} improves the likelihood significantly (p = {:.2e} < α/K = {level:.4}) and is the best by BIC",
+            scores[i].name, scores[i].p_value,
+        );
+        if by_bic.is_empty() && by_vuong.is_empty() {
+            reason += &format!(
+                " by at least {DELTA_BIC} over every other candidate, and fits significantly closer than every other significant one (Vuong z ≥ {VUONG_Z})"
+            );
+        }
+        if !by_bic.is_empty() {
+            reason += &format!(
+                "; {} explain the data as well (ΔBIC within {DELTA_BIC})",
+                names(&mut by_bic.iter().copied())
+            );
+        }
+        if !by_vuong.is_empty() {
+            reason += &format!(
+                "; {} also improve significantly and it does not fit significantly closer than they do ({})",
+                names(&mut by_vuong.iter().map(|&(j, _)| j)),
+                by_vuong
                     .iter()
-                    .map(|&j| scores[j].name.as_str())
+                    .map(|&(j, z)| format!("Vuong z = {z:.2} against {}", scores[j].name))
                     .collect::<Vec<_>>()
                     .join(", ")
-            )
-        };
+            );
+        }
+        if !by_bic.is_empty() || !by_vuong.is_empty() {
+            reason += ": the data cannot tell them apart";
+        }
+        let mut others = by_bic;
+        others.extend(by_vuong.iter().map(|&(j, _)| j));
         (Verdict::Named, reason, Some(i), others)
     } else if scores
         .iter()
@@ -293,9 +355,20 @@ pub fn diagnose(
     }
     // Decision, and profiles of the candidates it rests on.
     let note = |m: &str| progress.note(m);
+    let clusters = measured.clusters();
+    let terms = std::cell::RefCell::new(vec![None; candidates.len()]);
     let decision = loop {
         let scores: Vec<&CandidateScore> = fitted.iter().map(|f| &f.score).collect();
-        let d = decide(&scores, &before, n, test.level);
+        let closeness = |i: usize, j: usize| {
+            let (Some(a), Some(b)) = (
+                fitted_terms(&ev, candidates[i].as_ref(), &fitted[i], &terms, i),
+                fitted_terms(&ev, candidates[j].as_ref(), &fitted[j], &terms, j),
+            ) else {
+                return f64::INFINITY;
+            };
+            vuong(&a, &b, &clusters, inflation)
+        };
+        let d = decide(&scores, &before, n, test.level, &closeness);
         let wanted: Vec<usize> = d
             .named
             .into_iter()
@@ -331,7 +404,20 @@ pub fn diagnose(
             ));
         }
     };
-    let scores: Vec<CandidateScore> = fitted.into_iter().map(|f| f.score).collect();
+    let mut scores: Vec<CandidateScore> = fitted.iter().map(|f| f.score.clone()).collect();
+    if let Some(i) = decision.named {
+        for j in 0..scores.len() {
+            if j != i && scores[j].significant && scores[j].error.is_none() {
+                let (a, b) = (
+                    fitted_terms(&ev, candidates[i].as_ref(), &fitted[i], &terms, i),
+                    fitted_terms(&ev, candidates[j].as_ref(), &fitted[j], &terms, j),
+                );
+                if let (Some(a), Some(b)) = (a, b) {
+                    scores[j].vuong_z = Some(vuong(&a, &b, &clusters, inflation));
+                }
+            }
+        }
+    }
     let Decision {
         verdict,
         reason,
@@ -377,4 +463,119 @@ pub fn diagnose(
         top,
         work: (sims, sims * samples, progress.seconds()),
     })
+}
+
+/// Each candidate's fitted parameter values and ℓ's per-unit terms there.
+type TermsCache = std::cell::RefCell<Vec<Option<(Vec<f64>, Terms)>>>;
+
+/// ℓ's per-unit terms at a candidate's fit, computed once per fitted point (one simulation).
+fn fitted_terms(
+    ev: &Evaluator,
+    c: &dyn crate::candidates::Candidate,
+    fitted: &Fitted,
+    cache: &TermsCache,
+    i: usize,
+) -> Option<Terms> {
+    let values: Vec<f64> = fitted.score.parameters.iter().map(|p| p.value).collect();
+    if let Some((at, terms)) = &cache.borrow()[i]
+        && at == &values
+    {
+        return Some(terms.clone());
+    }
+    let terms = ev.terms_at(c, &values).ok()?;
+    cache.borrow_mut()[i] = Some((values, terms.clone()));
+    Some(terms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compare::Tolerance;
+
+    fn score(name: &str, k: usize, delta_bic: f64, significant: bool) -> CandidateScore {
+        CandidateScore {
+            name: name.into(),
+            mechanism: String::new(),
+            k,
+            parameters: Vec::new(),
+            log_likelihood: 0.0,
+            lr_statistic: 0.0,
+            adjustment: 1.0,
+            p_value: if significant { 1e-6 } else { 0.5 },
+            significant,
+            delta_bic,
+            evaluations: 0,
+            profile_evaluations: 0,
+            seconds: 0.0,
+            vuong_z: None,
+            error: None,
+        }
+    }
+
+    fn comparison() -> Comparison {
+        Comparison {
+            specimens: 200,
+            samples: 4000,
+            statistics: Vec::new(),
+            energy: 0.0,
+            energy_p: 1.0,
+            tolerance: Tolerance {
+                within: true,
+                outside: Vec::new(),
+                bands: String::new(),
+            },
+        }
+    }
+
+    /// The best by BIC is named; a significant candidate 3 BIC worse that it does not fit
+    /// significantly closer than (z = 1.0) is indistinguishable, one it does (z = 4.0) is
+    /// not, and a candidate that is not significant is not asked about.
+    #[test]
+    fn indistinguishable_by_bic_or_by_closeness() {
+        let s = [
+            score("a", 1, -14.0, true),
+            score("b", 2, -11.0, true),
+            score("c", 2, -10.5, true),
+            score("d", 1, -12.5, true),
+            score("e", 3, 5.0, false),
+        ];
+        let refs: Vec<&CandidateScore> = s.iter().collect();
+        let asked = std::cell::RefCell::new(Vec::new());
+        let z = |i: usize, j: usize| {
+            asked.borrow_mut().push((i, j));
+            if j == 1 { 1.0 } else { 4.0 }
+        };
+        let d = decide(&refs, &comparison(), 200, 0.01, &z);
+        assert_eq!(d.verdict, Verdict::Named);
+        assert_eq!(d.named, Some(0));
+        assert_eq!(d.indistinguishable, vec![3, 1]);
+        assert_eq!(*asked.borrow(), vec![(0, 1), (0, 2)]);
+        assert!(
+            d.reason.contains("Vuong z = 1.00 against b"),
+            "{}",
+            d.reason
+        );
+        let clear = decide(&refs[..3], &comparison(), 200, 0.01, &|_, _| 4.0);
+        assert!(clear.indistinguishable.is_empty());
+        assert!(
+            clear.reason.contains("closer than every other"),
+            "{}",
+            clear.reason
+        );
+    }
+
+    /// Vuong's z by hand: units 0, 1, 2 with differences 1, 3, 2 (unit 2's split over two
+    /// terms, as a specimen's member observations are): sum 6, variance 1, z = 6/√3; and
+    /// with c = 4 half that. Identical fits give 0, and swapping the models changes the sign.
+    #[test]
+    fn vuong_sums_clusters_and_scales_by_their_spread() {
+        let a = [1.0, 3.0, 1.5, 0.5];
+        let b = [0.0, 0.0, 0.0, 0.0];
+        let clusters = [0, 1, 2, 2];
+        let z = vuong(&a, &b, &clusters, 1.0);
+        assert!((z - 6.0 / 3f64.sqrt()).abs() < 1e-12, "{z}");
+        assert!((vuong(&a, &b, &clusters, 4.0) - z / 2.0).abs() < 1e-12);
+        assert_eq!(vuong(&b, &a, &clusters, 1.0), -z);
+        assert_eq!(vuong(&a, &a, &clusters, 1.0), 0.0);
+    }
 }

@@ -35,7 +35,10 @@
 //!    candidate's penalty rather than shrinking its likelihood, which would make the
 //!    likelihoods of candidates with different λ̄ incomparable. The verdict is one of
 //!    - `named`: the best candidate by BIC is significant and better than the baseline by
-//!      ΔBIC ≤ −2; candidates within ΔBIC 2 of it are listed as *indistinguishable*;
+//!      ΔBIC ≤ −2; candidates within ΔBIC 2 of it are listed as *indistinguishable*, and
+//!      so are significant candidates it does not fit significantly closer than (Vuong's
+//!      test for non-nested models, z < 1.96 on the per-specimen differences of the two
+//!      maximised ℓ: BIC may prefer it, but the data do not show it fits closer);
 //!    - `cannot_tell`: some candidate improves the fit but not both significantly and by
 //!      that margin; or none does, and the intervals are too wide to show that the baseline
 //!      agrees within tolerance (see [`compare`]): more specimens are needed;
@@ -64,9 +67,14 @@
 //!
 //! ## Candidate effects
 //!
-//! `gravity`, `thermal_gradient`, `length_bias`, `length_sigma`, `diagonal_pretension`
-//! (parameters and ranges in [`candidates`]). `backlash` waits for joint clearances in
-//! truss-core and the job format; it will be one more [`candidates::Candidate`].
+//! `backlash`, `gravity`, `thermal_gradient`, `length_bias`, `length_sigma`,
+//! `diagonal_pretension` (parameters and ranges in [`candidates`]). `backlash` turns the
+//! prism's nodes into truss-core's pin joints with a common clearance; on node positions
+//! alone its main trace, the top surface lowered as the diagonals pull the joints across
+//! their clearance, is much what a length error or a uniform temperature change leaves. The
+//! members measured one by one (`--measured-members`) show whether the members themselves
+//! are off, and so tell it from the length effects; a temperature change they cannot rule
+//! out, and the diagnosis then lists it as indistinguishable.
 //!
 //! ## Measured data
 //!

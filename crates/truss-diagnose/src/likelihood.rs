@@ -158,18 +158,29 @@ impl Gaussian {
 }
 
 /// The member terms of ℓ (module doc), one per observation, for the case's per-member
-/// distributions.
+/// distributions. The observations name members of the `measured` model (the baseline's);
+/// a derived case's model may number them differently (backlash adds joints and nodes), so
+/// they are found by id.
 pub fn member_log_likelihood(
     case: &mc_shard::job::Case,
+    measured: &truss_core::Model,
     data: &MemberData,
     sigma_m: f64,
 ) -> Vec<f64> {
     let floor = sigma_m * sigma_m + RESOLUTION * RESOLUTION;
+    let index = |m: usize| {
+        let id = &measured.members()[m].id;
+        match case.model.members().get(m) {
+            Some(member) if &member.id == id => Some(m),
+            _ => case.model.member_index(id),
+        }
+    };
     data.observations
         .iter()
         .map(|&(m, e)| {
-            let (mean, var) =
-                case.member_errors[m].map_or((0.0, 0.0), |d| (d.mean(), d.std_dev().powi(2)));
+            let (mean, var) = index(m)
+                .and_then(|i| case.member_errors[i])
+                .map_or((0.0, 0.0), |d| (d.mean(), d.std_dev().powi(2)));
             let v = var + floor;
             -0.5 * ((2.0 * std::f64::consts::PI * v).ln() + (e - mean).powi(2) / v)
         })

@@ -1,6 +1,6 @@
 //! `diagnosis.json` and `diagnosis.md`.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 2)
+//! ## diagnosis.json (format `truss-diagnose`, version 3)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -18,11 +18,14 @@
 //!   joint_interval  where profiled: the joint 95 % region of all k parameters projected on
 //!              this one (same fields, threshold χ²_k(0.95)·c·λ̄): every parameter inside its
 //!              joint interval at once with 95 % confidence
-//! indistinguishable [names]   (explain the data as well: ΔBIC within 2; empty when clear)
+//! indistinguishable [names]   (explain the data as well: ΔBIC within 2, or significant and
+//!              not shown further from the data than the named one, Vuong z < 1.96; empty
+//!              when clear)
 //! baseline    {log_likelihood}
 //! candidates  [{name, mechanism, k, parameters[], log_likelihood, lr_statistic, adjustment,
 //!               p_value, significant, delta_bic, evaluations, profile_evaluations, seconds,
-//!               error?}]
+//!               vuong_z?, error?}]   (vuong_z: the named one's Vuong z against this one,
+//!               for significant candidates when one is named)
 //! skipped     [{name, reason}]
 //! statistics  {before: Comparison, after: Comparison | null}
 //!   Comparison {specimens, samples, energy, energy_p, tolerance {within, outside[], bands},
@@ -33,6 +36,9 @@
 //!             (in words)
 //! timing      {simulations, solves, seconds}
 //! ```
+//!
+//! Version 3 (from 2): `candidates[].vuong_z`, and `indistinguishable` also lists
+//! significant candidates the named one does not fit significantly better than (Vuong).
 //!
 //! Version 2 (from 1): intervals are profile-likelihood intervals for the named effect, with
 //! the Wald interval beside them (`wald_interval`), the joint region's projection
@@ -50,7 +56,7 @@ use serde::Serialize;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -100,7 +106,7 @@ const METHOD: Method = Method {
     likelihood: "Gaussian synthetic likelihood of the specimens' displacement vectors at the compared coordinates: N(μ, Σ) with μ and Σ the mean and covariance of N simulated samples (common random numbers: same seed and case name as the baseline) plus (σ_m² + τ²)·I, τ = 0.1 µm; ℓ = Σ ln N(yᵢ; μ, Σ). With --measured-members, plus Σ ln N(e; E ε, Var ε + σ_m² + τ²) over the measured member length errors.",
     fit: "each candidate's ℓ maximised over its plausible range (log scale for σ, |g| ≤ 1 for gravity) from the best of its null (the baseline) and a scan along each parameter, by a trust-region Newton method on the unit cube; gradient, curvature A and score variability B by finite differences whose step along each parameter is adapted to the likelihood's own scale (the central second difference about one unit of ℓ, i.e. a step of about one standard error; 1e-7 to 0.05 of the range).",
     intervals: "95 % profile-likelihood intervals for the named effect and any indistinguishable from it: the values θ_j where 2(ℓ̂ − ℓ_p(θ_j)) ≤ χ²₁(0.95)·c·λ_j, ℓ_p the maximum over the other parameters, c = 1 + n/N for the simulation's own noise, λ_j = max(1, (A⁻¹BA⁻¹)_jj/(A⁻¹)_jj) for misspecification (Royall & Tsou 2003; the one-parameter form of the test's λ̄); ends found by safeguarded root-finding on √(2(ℓ̂ − ℓ_p)) with common random numbers, to 5 % in the threshold; an end that reaches the plausible range is cut there and flagged. For all k parameters at once, the joint 95 % region 2(ℓ̂ − ℓ(θ)) ≤ χ²_k(0.95)·c·λ̄ projected on each parameter (joint_interval; the same computation with that threshold). Every candidate also has the sandwich Wald interval t̂ ± 1.96·√(c·A⁻¹BA⁻¹) (wald_interval), which assumes ℓ quadratic; the verdict and checks use the profile interval.",
-    selection: "likelihood-ratio statistic Λ = 2(ℓ − ℓ₀)/(c·λ̄) against the baseline, c = 1 + n/N, λ̄ = max(1, tr(A⁻¹B)/k); p = P(χ²_k ≥ Λ), significant when p < 0.05/K (Bonferroni over the K candidates); ΔBIC = k·λ̄·ln n − 2(ℓ − ℓ₀)/c = λ̄·(k ln n − Λ) (n specimens), the BIC of a misspecified likelihood whose penalty counts the effective number of parameters tr(A⁻¹B) = k·λ̄ (Gao & Song 2010), so that candidates' likelihoods are compared unscaled. Named: the candidate with the lowest ΔBIC if it is significant and ΔBIC ≤ −2; indistinguishable: other candidates with ΔBIC within 2 of it. Significant means better than the baseline, not present: when the baseline misses some effect, any candidate that mimics part of it improves on the baseline, and BIC chooses between them.",
+    selection: "likelihood-ratio statistic Λ = 2(ℓ − ℓ₀)/(c·λ̄) against the baseline, c = 1 + n/N, λ̄ = max(1, tr(A⁻¹B)/k); p = P(χ²_k ≥ Λ), significant when p < 0.05/K (Bonferroni over the K candidates); ΔBIC = k·λ̄·ln n − 2(ℓ − ℓ₀)/c = λ̄·(k ln n − Λ) (n specimens), the BIC of a misspecified likelihood whose penalty counts the effective number of parameters tr(A⁻¹B) = k·λ̄ (Gao & Song 2010), so that candidates' likelihoods are compared unscaled. Named: the candidate with the lowest ΔBIC if it is significant and ΔBIC ≤ −2; indistinguishable: other candidates with ΔBIC within 2 of it, and significant candidates the named one does not fit significantly closer than by Vuong's test for non-nested models, z = Σ_u d_u/√(c·n·var d) < 1.96 with d_u the difference of the two maximised ℓ's terms for specimen u (its member observations included) (Vuong 1989): BIC then prefers the named one, but by its penalty or by a difference in ℓ within the specimens' own scatter, not by a fit the data show to be closer. Significant means better than the baseline, not present: when the baseline misses some effect, any candidate that mimics part of it improves on the baseline, and BIC chooses between them.",
     verdicts: "named: as above. cannot_tell: some candidate improves the fit but not both significantly and by ΔBIC ≤ −2, or none improves it and the data cannot show the baseline agrees within tolerance. none: no candidate improves it and the baseline agrees within tolerance (every coordinate's mean within ±0.5 predicted SD, its SD and θ_P's median and 95th percentile within a factor 1.3, judged by their 95 % intervals). unexplained: no candidate improves it, yet the baseline disagrees (a Holm-significant statistic, with at least 30 specimens; with fewer, cannot_tell).",
     statistics: "per coordinate, piston (mean top z), tan θ_x, tan θ_y: mean difference (Welch interval), SD ratio (interval on ln with kurtosis-corrected variance), covariances (fourth-moment variance); θ_P percentiles 50/90/95/99 (Hyndman–Fan definition 1) as ratios with Poisson-bootstrap intervals (B = 1000); KS on θ_P; energy distance with a permutation test (R = 199). The simulation carries the instrument's noise. Disagrees: Holm-adjusted p < 0.05.",
     discrepancy: "energy distance (unbiased U-statistic, Székely & Rizzo 2004) between the measured and simulated displacement vectors, each coordinate divided by its measured SD: 0 when the distributions agree.",
@@ -381,12 +387,12 @@ pub fn markdown(
     push(&mut m, "## 2. Which effect\n");
     push(
         &mut m,
-        "| candidate | k | ℓ | Λ | p | ΔBIC | fitted |\n|---|---|---|---|---|---|---|",
+        "| candidate | k | ℓ | Λ | p | ΔBIC | Vuong z | fitted |\n|---|---|---|---|---|---|---|---|",
     );
     push(
         &mut m,
         &format!(
-            "| baseline | 0 | {:.1} | | | 0 | |",
+            "| baseline | 0 | {:.1} | | | 0 | | |",
             d.baseline_log_likelihood
         ),
     );
@@ -396,7 +402,7 @@ pub fn markdown(
         push(
             &mut m,
             &format!(
-                "| {}{} | {} | {:.1} | {:.1} | {:.2e} | {:.1} | {} |",
+                "| {}{} | {} | {:.1} | {:.1} | {:.2e} | {:.1} | {} | {} |",
                 c.name,
                 if c.significant { " *" } else { "" },
                 c.k,
@@ -404,6 +410,7 @@ pub fn markdown(
                 c.lr_statistic,
                 c.p_value,
                 c.delta_bic,
+                c.vuong_z.map_or(String::new(), |z| format!("{z:.2}")),
                 c.error.clone().unwrap_or_else(|| c
                     .parameters
                     .iter()
@@ -413,7 +420,10 @@ pub fn markdown(
             ),
         );
     }
-    push(&mut m, "\n\\* significant at 0.05/K (Bonferroni).\n");
+    push(
+        &mut m,
+        "\n\\* significant at 0.05/K (Bonferroni). Vuong z: how much closer the named effect fits than this one (below 1.96: not significantly).\n",
+    );
     for (n, why) in &d.skipped {
         push(&mut m, &format!("- `{n}` not tried: {why}."));
     }

@@ -72,6 +72,11 @@ pub struct CandidateScore {
     pub profile_evaluations: usize,
     /// Wall time of the fit and the profiles \[s\].
     pub seconds: f64,
+    /// Vuong's z of the named candidate against this one, for significant candidates when
+    /// one is named (positive: the named one fits closer; below 1.96 they are
+    /// indistinguishable).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vuong_z: Option<f64>,
     /// Why the fit failed, if it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -104,9 +109,19 @@ impl Evaluator<'_> {
         let g = Gaussian::from_simulation(sim, self.sigma_m)?;
         let mut terms = g.log_densities(&self.measured.y);
         if let Some(m) = &self.measured.members {
-            terms.extend(member_log_likelihood(&job.cases[0], m, self.sigma_m));
+            terms.extend(member_log_likelihood(
+                &job.cases[0],
+                self.baseline.model(),
+                m,
+                self.sigma_m,
+            ));
         }
         Ok(terms)
+    }
+
+    /// ℓ's per-unit terms with the candidate at `values` (one simulation).
+    pub fn terms_at(&self, c: &dyn Candidate, values: &[f64]) -> Result<Terms, DiagnoseError> {
+        self.log_likelihood(&self.edit(c, values)?)
     }
 
     /// The baseline case with the candidate applied at `values`.
@@ -249,6 +264,7 @@ fn score_of(c: &dyn Candidate, fit: &Fit, test: &Test) -> CandidateScore {
         evaluations: fit.evaluations,
         profile_evaluations: 0,
         seconds: 0.0,
+        vuong_z: None,
         error: None,
     }
 }
@@ -288,6 +304,7 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
                 evaluations: 0,
                 profile_evaluations: 0,
                 seconds: 0.0,
+                vuong_z: None,
                 error: Some(e.to_string()),
             },
             None,

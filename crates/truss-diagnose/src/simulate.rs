@@ -92,6 +92,23 @@ pub fn simulate(
     noise: Option<(Noise, [[usize; 3]; 3])>,
 ) -> Result<Simulation, DiagnoseError> {
     let d = coords.len();
+    // The coordinates name nodes of the baseline's model; a derived case's model may number
+    // them differently (backlash adds hole nodes), so they are found by id.
+    let model = &job.cases[0].model;
+    let nodes: Vec<(usize, usize)> = coords
+        .iter()
+        .map(|c| match model.nodes().get(c.node) {
+            Some(n) if n.id == c.node_id => Ok((c.node, c.axis)),
+            _ => model
+                .node_index(&c.node_id)
+                .map(|i| (i, c.axis))
+                .ok_or_else(|| DiagnoseError::Simulation {
+                    what: job.cases[0].name.clone(),
+                    message: format!("the derived model has no node {:?}", c.node_id),
+                }),
+        })
+        .collect::<Result<_, _>>()?;
+    let nodes = &nodes;
     let threads = threads().clamp(1, samples.max(1));
     let chunk = samples.div_ceil(threads).max(1);
     let mut rows: Vec<Row> = Vec::with_capacity(samples);
@@ -112,9 +129,9 @@ pub fn simulate(
                             }
                             let solver = worker.solver(0).expect("the case was solved");
                             Row {
-                                x: coords
+                                x: nodes
                                     .iter()
-                                    .map(|c| solver.displacement(c.node)[c.axis])
+                                    .map(|&(node, axis)| solver.displacement(node)[axis])
                                     .collect(),
                                 failure: None,
                             }
@@ -128,7 +145,6 @@ pub fn simulate(
         }
     });
     let case = &job.cases[0];
-    let model = &case.model;
     let mut sim = Simulation {
         d,
         ..Simulation::default()

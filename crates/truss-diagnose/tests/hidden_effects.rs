@@ -7,6 +7,8 @@
 //! discrepancy by at least half; data without an effect must give `none`; too few
 //! specimens must say `cannot_tell`.
 //!
+//! The backlash check uses section 4.2.3's job (`jobs/paper-4.2.3.json`) instead.
+//!
 //! These are the fast versions (80 specimens where the effect is strong, N = 1200 simulated
 //! samples; a scale needs the 200 specimens for a tight interval);
 //! `scripts/diagnose-check.sh` runs the full 200-specimen checks with the release build.
@@ -32,11 +34,32 @@ fn make_with_members(
     seed: u64,
     members_out: Option<PathBuf>,
 ) -> PathBuf {
+    make_from(
+        (&job(), "as-built"),
+        dir,
+        name,
+        effect,
+        specimens,
+        seed,
+        members_out,
+    )
+}
+
+/// Measured data from case `case` of job `job` with `effect` added.
+fn make_from(
+    (job, case): (&Path, &str),
+    dir: &Path,
+    name: &str,
+    effect: &str,
+    specimens: usize,
+    seed: u64,
+    members_out: Option<PathBuf>,
+) -> PathBuf {
     let mut out = Vec::new();
     synth(
         &SynthOptions {
-            job: job(),
-            case: "as-built".into(),
+            job: job.to_path_buf(),
+            case: case.into(),
             specimens,
             seed,
             effect: effect.into(),
@@ -61,10 +84,20 @@ fn diagnose_with_members(
     measured: &Path,
     members: Option<PathBuf>,
 ) -> serde_json::Value {
+    diagnose_against((&job(), "as-built"), dir, measured, members)
+}
+
+/// Diagnoses `measured` against case `case` of job `job`, N = 1200.
+fn diagnose_against(
+    (job, case): (&Path, &str),
+    dir: &Path,
+    measured: &Path,
+    members: Option<PathBuf>,
+) -> serde_json::Value {
     let out = dir.join("out");
     let s = run(&DiagnoseOptions {
-        job: job(),
-        case: "as-built".into(),
+        job: job.to_path_buf(),
+        case: case.into(),
         measured: measured.to_path_buf(),
         measured_members: members,
         out: out.clone(),
@@ -278,4 +311,75 @@ fn member_measurements_narrow_a_length_effect() {
         width(&both),
         width(&alone)
     );
+}
+
+/// The backlash check on section 4.2.3's truss at σ = 0.033 mm (diagonals
+/// U[−0.099, 0] mm), 200 specimens with their members measured one by one, diagnosed
+/// against the rigid case `rigid-sigma-0.033` of `jobs/paper-4.2.3.json`:
+/// - a common clearance of 0.0105 mm (the mean of the paper's U[0.004, 0.017]) hidden
+///   through the candidate: named, recovered within its interval, the gap at least halved;
+/// - the paper's clearances themselves, made by the job's own backlash case
+///   (`backlash-sigma-0.033`, not through the candidate): named and the gap at least
+///   halved. Their scatter among the joints is outside the one-parameter candidate, whose
+///   clearance then stands for an effective common one (`scripts/diagnose-check.sh` prints
+///   it against the mean).
+///
+/// The second is a check of power, not a certainty: on ten data sets (seeds 31–40, the
+/// default N = 4000) backlash was named in 8; in the other two no candidate was significant
+/// (backlash p = 0.011 and 0.027 against α/K = 0.0083: in this model, with the default joint
+/// regularisation, the joints shift the top surface by about 13 µm against a 34 µm scatter).
+/// This test uses seed 32 of those. With top-node positions alone, a joint effect shortens
+/// the longerons much as a length error does: backlash is then listed as indistinguishable
+/// from the length effects (the check script reports it).
+#[test]
+fn hidden_backlash_is_named_with_member_measurements() {
+    let dir = tempfile::tempdir().unwrap();
+    let paper = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../jobs/paper-4.2.3.json");
+    let rigid = (paper.as_path(), "rigid-sigma-0.033");
+    let (d1, d2) = (dir.path().join("common"), dir.path().join("paper"));
+    std::fs::create_dir_all(&d1).unwrap();
+    std::fs::create_dir_all(&d2).unwrap();
+    let members = d1.join("members.csv");
+    let m = make_from(
+        rigid,
+        &d1,
+        "common",
+        "backlash:clearance=0.0105",
+        200,
+        31,
+        Some(members.clone()),
+    );
+    let v = diagnose_against(rigid, &d1, &m, Some(members));
+    check_recovered(&v, "backlash", &[("clearance", 0.0105)]);
+    let updated = std::fs::read_to_string(d1.join("out/updated-job.json")).unwrap();
+    let job: serde_json::Value = serde_json::from_str(&updated).unwrap();
+    let case = job["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "rigid-sigma-0.033")
+        .unwrap();
+    assert_eq!(case["model"]["prism"]["backlash"], true, "{case}");
+    assert!(
+        case["backlash"]["clearance"]["constant"].is_object(),
+        "{case}"
+    );
+
+    let members = d2.join("members.csv");
+    let m = make_from(
+        (&paper, "backlash-sigma-0.033"),
+        &d2,
+        "paper",
+        "none",
+        200,
+        32,
+        Some(members.clone()),
+    );
+    let v = diagnose_against(rigid, &d2, &m, Some(members));
+    assert_eq!(v["named_effect"], "backlash", "{}", v["reason"]);
+    let (before, after) = (
+        v["discrepancy_before"].as_f64().unwrap(),
+        v["discrepancy_after"].as_f64().unwrap(),
+    );
+    assert!(after <= 0.5 * before, "discrepancy {before} → {after}");
 }
