@@ -36,14 +36,17 @@ fn solver_with(seed: u64, backlash: Option<BacklashOptions>) -> (Solver, Vec<f64
     let mut u = vec![0.0; n + 1];
     for (i, v) in u[..n].iter_mut().enumerate() {
         // Only free directions move (the fixed ones of a partly fixed node have no rows).
-        if solver.structure.node_dofs[solver.structure.dof_owner[i].0]
-            [solver.structure.dof_owner[i].1 as usize]
-            != crate::structure::FIXED
-        {
+        if !is_fixed(&solver, i) {
             *v = 0.005 * next();
         }
     }
     (solver, u)
+}
+
+/// Whether unknown `i` is a fixed direction of a partly fixed node (an identity row).
+fn is_fixed(solver: &Solver, i: usize) -> bool {
+    let (node, axis) = solver.structure.dof_owner[i];
+    solver.structure.node_dofs[node][axis as usize] == crate::structure::FIXED
 }
 
 fn residual_and_energy(solver: &mut Solver, u: &[f64]) -> (Vec<f64>, f64) {
@@ -130,10 +133,7 @@ fn tangent_is_the_residual_jacobian() {
             let (rm, _) = residual_and_energy(&mut solver, &um);
             for i in 0..n {
                 let fd = (rp[i] - rm[i]) / (2.0 * h);
-                let k = if solver.structure.node_dofs[solver.structure.dof_owner[i].0]
-                    [solver.structure.dof_owner[i].1 as usize]
-                    == crate::structure::FIXED
-                {
+                let k = if is_fixed(&solver, i) {
                     0.0 // identity rows of fixed directions are not part of the Jacobian
                 } else {
                     solver.k.get(i, j)
