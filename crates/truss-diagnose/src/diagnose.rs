@@ -355,18 +355,12 @@ pub fn diagnose(
     }
     // Decision, and profiles of the candidates it rests on.
     let note = |m: &str| progress.note(m);
-    let clusters = measured.clusters();
     let terms = std::cell::RefCell::new(vec![None; candidates.len()]);
     let decision = loop {
         let scores: Vec<&CandidateScore> = fitted.iter().map(|f| &f.score).collect();
         let closeness = |i: usize, j: usize| {
-            let (Some(a), Some(b)) = (
-                fitted_terms(&ev, candidates[i].as_ref(), &fitted[i], &terms, i),
-                fitted_terms(&ev, candidates[j].as_ref(), &fitted[j], &terms, j),
-            ) else {
-                return f64::INFINITY;
-            };
-            vuong(&a, &b, &clusters, inflation)
+            closeness_of(&ev, &candidates, &fitted, &terms, test.inflation, (i, j))
+                .unwrap_or(f64::INFINITY)
         };
         let d = decide(&scores, &before, n, test.level, &closeness);
         let wanted: Vec<usize> = d
@@ -406,15 +400,9 @@ pub fn diagnose(
     };
     let mut scores: Vec<CandidateScore> = fitted.iter().map(|f| f.score.clone()).collect();
     if let Some(i) = decision.named {
-        for j in 0..scores.len() {
-            if j != i && scores[j].significant && scores[j].error.is_none() {
-                let (a, b) = (
-                    fitted_terms(&ev, candidates[i].as_ref(), &fitted[i], &terms, i),
-                    fitted_terms(&ev, candidates[j].as_ref(), &fitted[j], &terms, j),
-                );
-                if let (Some(a), Some(b)) = (a, b) {
-                    scores[j].vuong_z = Some(vuong(&a, &b, &clusters, inflation));
-                }
+        for (j, s) in scores.iter_mut().enumerate() {
+            if j != i && s.significant && s.error.is_none() {
+                s.vuong_z = closeness_of(&ev, &candidates, &fitted, &terms, test.inflation, (i, j));
             }
         }
     }
@@ -463,6 +451,21 @@ pub fn diagnose(
         top,
         work: (sims, sims * samples, progress.seconds()),
     })
+}
+
+/// Vuong's z of fitted candidate i against j ([`vuong`]), `inflation` = c = 1 + n/N;
+/// `None` if a simulation failed.
+fn closeness_of(
+    ev: &Evaluator,
+    candidates: &[Box<dyn crate::candidates::Candidate>],
+    fitted: &[Fitted],
+    cache: &TermsCache,
+    inflation: f64,
+    (i, j): (usize, usize),
+) -> Option<f64> {
+    let a = fitted_terms(ev, candidates[i].as_ref(), &fitted[i], cache, i)?;
+    let b = fitted_terms(ev, candidates[j].as_ref(), &fitted[j], cache, j)?;
+    Some(vuong(&a, &b, &ev.measured.clusters(), inflation))
 }
 
 /// Each candidate's fitted parameter values and ℓ's per-unit terms there.

@@ -117,6 +117,15 @@ fn diagnose_against(
     v
 }
 
+/// The discrepancy at least halved by the named effect.
+fn check_halved(v: &serde_json::Value) {
+    let (before, after) = (
+        v["discrepancy_before"].as_f64().unwrap(),
+        v["discrepancy_after"].as_f64().unwrap(),
+    );
+    assert!(after <= 0.5 * before, "discrepancy {before} → {after}");
+}
+
 /// The named effect; its intervals computed from the profile likelihood; the truth inside
 /// the joint 95 % region's projection on every parameter (`joint_interval`: all k parameters
 /// at once with 95 % confidence; requiring each of k parameters inside its own 95 %
@@ -147,11 +156,7 @@ fn check_recovered(v: &serde_json::Value, effect: &str, truth: &[(&str, f64)]) {
             p["value"]
         );
     }
-    let (before, after) = (
-        v["discrepancy_before"].as_f64().unwrap(),
-        v["discrepancy_after"].as_f64().unwrap(),
-    );
-    assert!(after <= 0.5 * before, "discrepancy {before} → {after}");
+    check_halved(v);
 }
 
 #[test]
@@ -377,9 +382,5 @@ fn hidden_backlash_is_named_with_member_measurements() {
     );
     let v = diagnose_against(rigid, &d2, &m, Some(members));
     assert_eq!(v["named_effect"], "backlash", "{}", v["reason"]);
-    let (before, after) = (
-        v["discrepancy_before"].as_f64().unwrap(),
-        v["discrepancy_after"].as_f64().unwrap(),
-    );
-    assert!(after <= 0.5 * before, "discrepancy {before} → {after}");
+    check_halved(&v);
 }
