@@ -39,7 +39,7 @@ cat > "$WORK/job.json" <<'EOF'
   "model": {"prism": {"stages": 5}},
   "seed": 4242,
   "cases": [
-    {"name": "sigma-0.0063", "samples": 24000,
+    {"name": "sigma-0.0063", "samples": 240000,
      "length_errors": {"batten": {"normal": {"sigma": 0.0063}}, "longeron": {"normal": {"sigma": 0.0063}}}}
   ]
 }
@@ -68,7 +68,9 @@ step "merged report is byte-identical to the single-process report"
 step "cancelling one array task mid-shard, then resubmitting what is missing"
 eval "$("$SLURM/submit.sh" "$WORK/job.json" --shards 8 --out "$WORK/killed")"
 victim=5
-shard_file="$WORK/killed/$(printf 'shard-%010d-%010d.jsonl' 15000 18000)"
+# Shards of 30,000 samples (about a second of one core): the cancel lands mid-shard. With
+# 3,000 a shard could finish between its first lines and the scancel, leaving nothing missing.
+shard_file="$WORK/killed/$(printf 'shard-%010d-%010d.jsonl' 150000 180000)"
 deadline=$((SECONDS + 300))
 until [[ -f "$shard_file" ]] && (( $(wc -l < "$shard_file") > 1 )); do
     (( SECONDS < deadline )) || fail "task $victim never started writing"
