@@ -205,9 +205,11 @@ fn kubernetes_manifest_is_consistent_with_the_cli() {
 /// A small version of the paper's section 4.2.3 study (Fig. 16): the 5-stage truss with
 /// clearances U[0.004, 0.017] mm drawn per joint and diagonals U[−3σ, 0], split into shards,
 /// merged. Every sample converges, the report counts the samples with loose joints, and the
-/// answer is split-independent. The check against an independent estimate: once every
-/// joint is centred or taken up, backlash moves θ_P95 by a few per cent at most, so it must
-/// lie within 15 % of the same cases without backlash (REPRODUCTION.md has the full study).
+/// answer is split-independent. The physical check, the paper's conclusion for small σ
+/// (its section 4.2.3: backlash "has a dominant effect" when the length errors are smaller
+/// than the clearances): at σ = 0.0067 mm, against clearances of 0.004–0.017 mm per
+/// longeron end, backlash raises θ_P95 well above the same cases without backlash
+/// (REPRODUCTION.md has the full study: by half).
 #[test]
 fn backlash_study_runs_split_and_merges() {
     let case = |name: &str, backlash: bool| {
@@ -253,8 +255,5 @@ fn backlash_study_runs_split_and_merges() {
         "no joints, none recorded"
     );
     let ratio = p95(with) / p95(without);
-    assert!(
-        (0.85..1.15).contains(&ratio),
-        "θ_P95 with/without backlash {ratio}"
-    );
+    assert!(ratio > 1.2, "θ_P95 with/without backlash {ratio}");
 }

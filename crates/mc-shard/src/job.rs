@@ -54,7 +54,7 @@ use truss_core::{Model, Structure};
 
 /// Version of the numerics: bumped whenever the solver or the sampling would give different
 /// numbers for the same job, so that the job id changes and old and new shards never mix.
-pub const NUMERICS_VERSION: u32 = 1;
+pub const NUMERICS_VERSION: u32 = 2;
 
 /// A job file as written.
 #[derive(Debug, Clone, Deserialize)]
@@ -111,7 +111,8 @@ pub struct PrismSpec {
 /// The prism's backlash joints as a job writes them: `true` for the defaults, or an object
 /// overriding some of `clearance` (mm, the model's own clearance, used when a case draws
 /// none), `tension_factor` (contact stiffness over a longeron's `E·A/h`) and
-/// `compression_ratio` (centring stiffness of a loose joint over its contact stiffness).
+/// `compression_ratio` (a loose joint's regularising stiffness over its contact stiffness;
+/// default 0, none).
 #[derive(Debug, Clone, Copy, Deserialize)]
 #[serde(untagged)]
 enum BacklashSpec {

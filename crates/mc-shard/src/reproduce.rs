@@ -8,13 +8,16 @@
 //! backlash clearances), `iterations` (per Newton iteration: out-of-balance
 //! force \[N\], step \[mm\], line-search α, whether the tangent was factorised afresh, the slack
 //! cables), and, when it converged, `displacements` (mm per node id), `forces` (N per member
-//! id, tension positive) and `slack_cables`.
+//! id, tension positive), `slack_cables` and, for a model with backlash joints, `joints` (per
+//! joint id: the hole centre's `offset` from the shaft centre \[mm\], the `contact` force
+//! \[N\], 0 when loose, and whether it is `loose`).
 
 use crate::job::Job;
 use crate::worker::Worker;
 use serde::Serialize;
 use serde::ser::{SerializeMap, Serializer};
 use truss_core::SolveOptions;
+use truss_core::joint::JointSummary;
 
 /// Pairs serialised as a JSON object in their order.
 struct Ordered<T>(Vec<(String, T)>);
@@ -53,6 +56,8 @@ struct Detail<'a> {
     forces: Option<Ordered<f64>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     slack_cables: Option<Vec<String>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    joints: Option<Ordered<JointSummary>>,
 }
 
 /// The line of sample `k` of case `c` (with its newline), and with `detail` the JSON detail.
@@ -125,6 +130,8 @@ pub fn reproduce(job: &Job, c: usize, k: u64, detail: bool) -> String {
                 .map(member_id)
                 .collect()
         }),
+        joints: (converged && !model.joints().is_empty())
+            .then(|| Ordered(solver.joint_summaries())),
     };
     let mut text = serde_json::to_string_pretty(&detail).expect("the detail always serialises");
     text.push('\n');

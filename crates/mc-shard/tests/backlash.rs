@@ -70,7 +70,8 @@ fn backlash_shows_in_the_id_and_the_parameters() {
         job.cases[0].parameters.get("joint_compression_ratio"),
         Some(&1e-5)
     );
-    assert_eq!(job.cases[0].model.joints().len(), 9);
+    // One joint per longeron end: 6 per stage, 2 stages.
+    assert_eq!(job.cases[0].model.joints().len(), 12);
 }
 
 /// Clearances are drawn after the members' words: the members' errors are those of the same
@@ -96,7 +97,7 @@ fn clearances_follow_the_member_draws() {
         assert_eq!(worker.last_errors(), plain.last_errors());
         assert!(plain.last_clearances().is_empty());
         let c = worker.last_clearances();
-        assert_eq!(c.len(), 9);
+        assert_eq!(c.len(), 12);
         assert!(c.iter().all(|&g| (0.004..=0.017).contains(&g)), "{c:?}");
         seen.extend_from_slice(c);
     }
@@ -104,7 +105,7 @@ fn clearances_follow_the_member_draws() {
     seen.dedup();
     assert_eq!(
         seen.len(),
-        180,
+        20 * 12,
         "every joint and sample draws its own clearance"
     );
 }
@@ -126,4 +127,64 @@ fn backlash_samples_do_not_depend_on_the_split() {
     assert_eq!(x.len(), 48);
     assert_eq!(x, y);
     assert!(x[0].contains("\"loose_joints\""));
+}
+
+/// Golden values of a small backlash job (2 stages, 12 joints, 40 samples with backlash and
+/// 40 without): its id and the SHA-256 of its sample lines. A change to the solver, the
+/// joint layout or the draws that moves any byte fails here, and must bump
+/// `NUMERICS_VERSION` (which changes the id) in the same commit.
+#[test]
+fn golden_backlash_job_is_pinned() {
+    use sha2::{Digest, Sha256};
+    let job = Job::from_json(&backlash_job(40, 0.0), Path::new(".")).unwrap();
+    let mut worker = mc_shard::worker::Worker::new(&job);
+    let mut hash = Sha256::new();
+    for k in 0..80 {
+        let line = worker.sample(k);
+        hash.update(serde_json::to_string(&line).unwrap().as_bytes());
+        hash.update(b"\n");
+    }
+    let digest = shard_record::hex(&hash.finalize());
+    assert_eq!(
+        job.id,
+        "baacafd9453f3dfe89f310339da175cc192b10335cdffbda8fec63c59694a4ab"
+    );
+    assert_eq!(
+        digest,
+        "c5d2519b8e7748cdb2510ac3d8db68781141aec271d257b995ff170917e7ab15"
+    );
+}
+
+/// `reproduce --detail` names each joint by its longeron end (`joint.{k}.{j}.below|above`)
+/// with its clearance and its state: a bearing joint's offset is its clearance plus a
+/// penetration of at most a micrometre, a loose one's is within its clearance and carries
+/// nothing.
+#[test]
+fn detail_names_each_joint_with_its_state() {
+    let job = Job::from_json(&backlash_job(4, 0.0), Path::new(".")).unwrap();
+    let text = mc_shard::reproduce::reproduce(&job, 0, 2, true);
+    let detail: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let joints = detail["joints"].as_object().unwrap();
+    let clearances = detail["clearances"].as_object().unwrap();
+    let ids: Vec<&String> = joints.keys().collect();
+    assert_eq!(ids, clearances.keys().collect::<Vec<_>>());
+    assert_eq!(joints.len(), 12);
+    assert!(joints.contains_key("joint.0.0.above") && joints.contains_key("joint.1.2.below"));
+    assert!(joints.contains_key("joint.1.2.above") && !joints.contains_key("joint.0.0.below"));
+    for (id, j) in joints {
+        let g = clearances[id].as_f64().unwrap();
+        let o: Vec<f64> = j["offset"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        let d = (o[0] * o[0] + o[1] * o[1] + o[2] * o[2]).sqrt();
+        let contact = j["contact"].as_f64().unwrap();
+        if j["loose"].as_bool().unwrap() {
+            assert!(d <= g * (1.0 + 1e-12) && contact == 0.0, "{id}: {d} in {g}");
+        } else {
+            assert!(d >= g && d - g < 1e-6 && contact > 0.0, "{id}: {d} for {g}");
+        }
+    }
 }

@@ -128,7 +128,8 @@ pub struct PrismArgs {
     /// Joint contact stiffness over a longeron's axial stiffness E·A/h (with `--backlash`).
     #[arg(long, default_value_t = truss_core::joint::DEFAULT_JOINT_TENSION_FACTOR, requires = "backlash")]
     pub joint_tension_factor: f64,
-    /// Loose joint's centring stiffness over its contact stiffness (with `--backlash`).
+    /// Loose joint's regularising stiffness over its contact stiffness, in [0, 1e-5]; 0 for
+    /// none, the physical limit (with `--backlash`).
     #[arg(long, default_value_t = truss_core::joint::DEFAULT_JOINT_COMPRESSION_RATIO, requires = "backlash")]
     pub joint_compression_ratio: f64,
 }

@@ -10,13 +10,14 @@
 //!   "displacements": {"n1.0": [0.0, 0.0, 0.0094], …},
 //!   "forces": {"batten.0.0": -0.31, …},
 //!   "slack_cables": ["diagonal.1.1.a", …],
-//!   "joints": {"joint.1.0": {"offset": [0.0, 0.0, 0.0101], "contact": 2.3, "loose": false}, …}
+//!   "joints": {"joint.1.0.below": {"offset": [0.0, 0.0, 0.0101], "contact": 2.3, "loose": false}, …}
 //! }
 //! ```
 //!
 //! `joints` is present for a model with backlash joints: per joint id, the hole centre's
-//! offset from the shaft centre across the shaft (mm), the contact force (N; 0 when loose)
-//! and whether the joint is loose (its position then set by the centring regularisation).
+//! offset from the shaft centre (mm), the contact force (N; 0 when loose) and whether the
+//! joint is loose (a loose pin carries no force; its offset is then its share of the
+//! member's free play, one of the positions the statics leaves open).
 //!
 //! Displacements are in mm per node id, forces in N per member id (tension positive), both
 //! in model order. The angles are absent when the model names no top surface. A failed
@@ -26,19 +27,9 @@ use crate::{CliError, SolveArgs};
 use serde::Serialize;
 use serde::ser::{SerializeMap, Serializer};
 use std::io::Write;
+use truss_core::joint::JointSummary;
 use truss_core::solver::IterationRecord;
 use truss_core::{Model, SolveOptions, Solver};
-
-/// One backlash joint's state at equilibrium.
-#[derive(Debug, Serialize)]
-pub struct JointLine {
-    /// Hole centre minus shaft centre, across the shaft \[mm\].
-    pub offset: [f64; 3],
-    /// Contact force \[N\]; 0 when loose.
-    pub contact: f64,
-    /// Whether the shaft is clear of the hole's edge.
-    pub loose: bool,
-}
 
 /// Pairs serialised as a JSON object in their order.
 #[derive(Debug)]
@@ -108,7 +99,7 @@ pub struct SolveOutput {
     pub slack_cables: Option<Vec<String>>,
     /// Backlash joints' states, per joint id.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub joints: Option<Ordered<JointLine>>,
+    pub joints: Option<Ordered<JointSummary>>,
     /// Every Newton iteration, with `--iterations`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub iteration_log: Option<Vec<IterationLine>>,
@@ -217,24 +208,7 @@ pub fn run(args: &SolveArgs, out: &mut dyn Write) -> Result<(), CliError> {
                         .map(|m| model.members()[m].id.clone())
                         .collect(),
                 ),
-                joints: (!model.joints().is_empty()).then(|| {
-                    Ordered(
-                        model
-                            .joints()
-                            .iter()
-                            .enumerate()
-                            .map(|(j, joint)| {
-                                let st = solver.joint_state(j);
-                                let line = JointLine {
-                                    offset: st.offset,
-                                    contact: st.contact,
-                                    loose: !st.engaged,
-                                };
-                                (joint.id.clone(), line)
-                            })
-                            .collect(),
-                    )
-                }),
+                joints: (!model.joints().is_empty()).then(|| Ordered(solver.joint_summaries())),
                 iteration_log: log,
             }
         }

@@ -9,7 +9,8 @@
 //! L = |c|,  n = c / L                          current length \[mm\], unit direction
 //! e = L − L₀ = (2 D·d + d·d)/(L + L_r) + s₀,   s₀ = L_r − L₀          elongation \[mm\]
 //! k = E·A / L₀                                 axial stiffness \[N/mm\]
-//! k_e = k, or r·k for a cable with e < 0       effective stiffness (r: compression ratio)
+//! k_e = k, or r·k for a one-sided member        effective stiffness (r: compression ratio)
+//!       slack (σ·e < 0, σ = +1 tension-only, −1 compression-only)
 //! N = k_e · e                                  axial force, tension positive \[N\]
 //! W = ½ · k_e · e²                             strain energy \[N·mm\]
 //! ∂W/∂u_j = −∂W/∂u_i = N · n                   internal force on the nodes \[N\]
@@ -19,8 +20,9 @@
 //! `(L − L_r)` is computed as `(L² − L_r²)/(L + L_r)` with `L² − L_r² = 2 D·d + d·d` exactly
 //! expanded, so no two nearly equal lengths are subtracted; `s₀` is computed once per sample
 //! from the nominal value and the length error. `W` is continuous with a continuous first
-//! derivative at `e = 0`, where a cable switches between taut and slack (`e = 0` counts as
-//! taut).
+//! derivative at `e = 0`, where a one-sided member switches between taut and slack (`e = 0`
+//! counts as taut). A cable is tension-only (`σ = +1`); the compression-only members
+//! (`σ = −1`) are half of a longeron whose ends sit in clearance holes (see [`crate::joint`]).
 
 /// The constants of one member for one sample.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,8 +37,12 @@ pub struct AxialMember {
     pub initial_stretch: f64,
     /// `E·A` \[N\].
     pub rigidity: f64,
-    /// Compression stiffness ratio `r`: 1 for a bar, small for a cable.
+    /// Compression stiffness ratio `r`: 1 for a bar, small for a cable (the stiffness ratio
+    /// of its slack side for any one-sided member).
     pub compression_ratio: f64,
+    /// The side that carries load, `σ`: +1 for bars and tension-only members, −1 for a
+    /// compression-only member (slack when `σ·e < 0`).
+    pub sense: f64,
 }
 
 /// The state of a member at a given relative displacement.
@@ -52,7 +58,7 @@ pub struct AxialState {
     pub force: f64,
     /// Effective axial stiffness `k_e` \[N/mm\].
     pub stiffness: f64,
-    /// Whether a cable is slack (`e < 0` and `r < 1`).
+    /// Whether a one-sided member is slack (`σ·e < 0` and `r < 1`).
     pub slack: bool,
 }
 
@@ -75,6 +81,7 @@ impl AxialMember {
             initial_stretch,
             rigidity,
             compression_ratio,
+            sense: 1.0,
         }
     }
 
@@ -97,7 +104,7 @@ impl AxialMember {
         let length = norm(c);
         let stretch_sq = 2.0 * dot(self.reference, d) + dot(d, d);
         let elongation = stretch_sq / (length + self.reference_length) + self.initial_stretch;
-        let slack = elongation < 0.0 && self.compression_ratio < 1.0;
+        let slack = self.sense * elongation < 0.0 && self.compression_ratio < 1.0;
         let stiffness = if slack { self.compression_ratio * k } else { k };
         let inv = 1.0 / length;
         AxialState {
@@ -168,13 +175,27 @@ mod tests {
     use super::*;
 
     /// Central-difference check of the force (gradient of W) and of the tangent block
-    /// (Jacobian of the force), for a bar and for a cable on both sides of slack.
+    /// (Jacobian of the force), for a bar, for a cable and for a compression-only member
+    /// (the half of a member in clearance holes), each on both sides of slack.
     #[test]
     fn force_and_tangent_match_central_differences() {
         let reference = [300.0, -120.0, 180.0];
-        for (stretch, ratio) in [(0.01, 1.0), (-0.02, 1.0), (0.003, 1e-3), (-0.004, 1e-3)] {
+        let cases = [
+            (0.01, 1.0, 1.0),
+            (-0.02, 1.0, 1.0),
+            (0.003, 1e-3, 1.0),
+            (-0.004, 1e-3, 1.0),
+            (0.003, 1e-3, -1.0),
+            (-0.004, 1e-3, -1.0),
+        ];
+        for (stretch, ratio, sense) in cases {
             let lr = norm(reference);
-            let m = AxialMember::new(reference, lr - stretch, stretch, 2.17e5, ratio);
+            let m = AxialMember {
+                sense,
+                ..AxialMember::new(reference, lr - stretch, stretch, 2.17e5, ratio)
+            };
+            let st = m.state([0.0; 3]);
+            assert_eq!(st.slack, ratio < 1.0 && sense * stretch < 0.0);
             let d0 = [0.011, -0.007, 0.013];
             let s = m.state(d0);
             let h = 1e-4;

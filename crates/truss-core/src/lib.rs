@@ -47,11 +47,14 @@
 //! point of the total potential energy `Π(u) = Σ W_m − fᵀu`, found by Newton's method with a
 //! line search ([`solver`]).
 //!
-//! Pin joints with backlash (the paper's section 4) add, between a shaft node and a hole
-//! node, the energy of [`joint`]: a contact stiffness once the shaft's offset across its
-//! axis exceeds the clearance `g`, a small centring stiffness below, and a stiff spring
-//! along the axis. Model files list them under `joints`; the prism generator adds one per
-//! node with [`prism::PrismOptions::backlash`].
+//! Pin joints with backlash (the paper's section 4, see [`joint`]) have free play: a loose
+//! pin carries no force, a loaded pin bears on its hole's edge. Every member end has its own
+//! hole (two joints at each node between two stages of the prism), so a hole node carries
+//! one member and is eliminated exactly: the member and its joints become a bar with a dead
+//! band of the joints' total clearance, a tension-only and a compression-only half in
+//! parallel, and which joints bear is found like the slack cables. Model files list joints
+//! under `joints`; the prism generator adds one per longeron end with
+//! [`prism::PrismOptions::backlash`].
 //!
 //! ## Distortion angle
 //!

@@ -39,6 +39,9 @@ pub(crate) struct CableBasis {
     pub g_t: Vec<f64>,
     /// `1/((1 − r_c)·k_c)` per cable, with nominal `k_c` \[mm/N\].
     pub w_inv: Vec<f64>,
+    /// `σ_c` per cable: +1 tension-only (slack when `e < 0`), −1 compression-only (slack
+    /// when `e > 0`).
+    pub sense: Vec<f64>,
 }
 
 /// A slack set whose capacitance matrix has a pivot below this fraction of its diagonal
@@ -82,12 +85,14 @@ impl CableBasis {
                 g_t[b * nc + a] = g[a * nc + b];
             }
         }
+        let sense = cables.iter().map(|&m| s.members[m].sense).collect();
         Self {
             cables,
             z,
             g,
             g_t,
             w_inv,
+            sense,
         }
     }
 }
@@ -260,7 +265,9 @@ impl ActiveSet {
             .extend(basis.cables.iter().map(|&m| gather_b(s, m, u) + stretch[m]));
         let e_lin = &self.e_lin;
         self.slack.clear();
-        self.slack.extend((0..nc).filter(|&c| e_lin[c] < 0.0));
+        let sense = &basis.sense;
+        self.slack
+            .extend((0..nc).filter(|&c| sense[c] * e_lin[c] < 0.0));
         let mut pieces = 0;
         loop {
             pieces += 1;
@@ -284,7 +291,9 @@ impl ActiveSet {
                 *e += el;
             }
             let e = &self.e;
-            let settled = (0..nc).filter(|&c| e[c] < 0.0).eq(slack.iter().copied());
+            let settled = (0..nc)
+                .filter(|&c| sense[c] * e[c] < 0.0)
+                .eq(slack.iter().copied());
             if settled {
                 for (&c, zc) in self.slack.iter().zip(&self.z) {
                     for (ui, zi) in u[..n].iter_mut().zip(&basis.z[c * n..(c + 1) * n]) {
@@ -298,7 +307,8 @@ impl ActiveSet {
                 return Err(ActiveSetFailure::NoFixedPoint);
             }
             self.slack.clear();
-            self.slack.extend((0..nc).filter(|&c| self.e[c] < 0.0));
+            self.slack
+                .extend((0..nc).filter(|&c| sense[c] * self.e[c] < 0.0));
         }
     }
 }

@@ -3,9 +3,11 @@
 //! A [`Model`] is built only by validating a [`ModelFile`]; from then on its invariants hold:
 //! ids are unique, every reference resolves to an index, every number is finite, areas,
 //! moduli and natural lengths are positive, no member has zero length, a joint's two nodes
-//! coincide, and the nominal structure (its joints loose) is not a mechanism.
+//! coincide, every hole node carries exactly one member, perpendicular to its shaft's axis,
+//! and nothing else (one hole per member end: see [`crate::joint`]), and the nominal
+//! structure is not a mechanism.
 
-use crate::joint::{DEFAULT_JOINT_COMPRESSION_RATIO, DEFAULT_JOINT_TENSION_FACTOR, JointElement};
+use crate::joint::{DEFAULT_JOINT_COMPRESSION_RATIO, DEFAULT_JOINT_TENSION_FACTOR};
 use crate::model_file::{
     BehaviourSpec, JointSpec, LoadSpec, MemberSpec, ModelFile, NodeSpec, SupportSpec,
     TopSurfaceSpec,
@@ -93,23 +95,11 @@ pub struct Joint {
     pub clearance: f64,
     /// Contact stiffness `k_t` \[N/mm\].
     pub tension_stiffness: f64,
-    /// `k_c/k_t`, the loose joint's centring stiffness over the contact stiffness.
+    /// `k_c/k_t` ≥ 0, a loose joint's regularising stiffness over the contact stiffness
+    /// (0, the default, for none: the physical limit).
     pub compression_ratio: f64,
     /// Stiffness along the axis `k_a` \[N/mm\].
     pub axial_stiffness: f64,
-}
-
-impl Joint {
-    /// The joint's element with clearance `clearance` \[mm\].
-    pub fn element(&self, clearance: f64) -> JointElement {
-        JointElement {
-            axis: self.axis,
-            clearance,
-            tension_stiffness: self.tension_stiffness,
-            compression_stiffness: self.compression_ratio * self.tension_stiffness,
-            axial_stiffness: self.axial_stiffness,
-        }
-    }
 }
 
 /// A validated truss model (see the module doc for its invariants).
@@ -206,6 +196,14 @@ impl Model {
             .enumerate()
             .map(|(i, j)| check_joint(i, j, &nodes, &members, &lookup))
             .collect::<Result<Vec<_>, _>>()?;
+        check_joint_layout(
+            &joints,
+            &nodes,
+            &members,
+            &fixed,
+            &loads,
+            top_surface.as_ref(),
+        )?;
         Ok(Self {
             nodes,
             members,
@@ -604,12 +602,14 @@ fn check_joint(
         .compression_ratio
         .unwrap_or(DEFAULT_JOINT_COMPRESSION_RATIO);
     finite(&item(), "compression_ratio", &[compression_ratio])?;
-    if !(compression_ratio > 0.0 && compression_ratio <= 1.0) {
+    if !(0.0..=MAX_JOINT_COMPRESSION_RATIO).contains(&compression_ratio) {
         return Err(ModelError::Invalid {
             item: item(),
             message: format!(
-                "compression_ratio must be in (0, 1] (a loose joint needs some stiffness to \
-                 have a position), got {compression_ratio}"
+                "compression_ratio must be in [0, {MAX_JOINT_COMPRESSION_RATIO:e}] (0, the \
+                 default, is a loose pin that carries no force; a larger regularisation \
+                 would hold a loose joint more stiffly than its member), got \
+                 {compression_ratio}"
             ),
         });
     }
@@ -627,4 +627,96 @@ fn check_joint(
         compression_ratio,
         axial_stiffness,
     })
+}
+
+/// Largest accepted `compression_ratio` of a joint: with the default contact stiffness
+/// (10⁵ × the member's), a loose joint's regularisation is then at most the member's own
+/// stiffness.
+pub const MAX_JOINT_COMPRESSION_RATIO: f64 = 1e-5;
+
+/// The layout that makes a joint's hole part of one member end (see [`crate::joint`]): each
+/// hole node is the hole of one joint and the shaft of none, carries exactly one member,
+/// perpendicular to the shaft's axis, and has no support, load or place in the top surface.
+fn check_joint_layout(
+    joints: &[Joint],
+    nodes: &[Node],
+    members: &[Member],
+    fixed: &[[bool; 3]],
+    loads: &[[f64; 3]],
+    top: Option<&TopSurface>,
+) -> Result<(), ModelError> {
+    let invalid = |j: &Joint, message: String| ModelError::Invalid {
+        item: format!("joint {:?}", j.id),
+        message,
+    };
+    for (i, j) in joints.iter().enumerate() {
+        let h = j.hole;
+        if let Some(other) = joints
+            .iter()
+            .enumerate()
+            .find(|(k, o)| (*k != i && o.hole == h) || o.shaft == h)
+        {
+            return Err(invalid(
+                j,
+                format!(
+                    "its hole node is also in joint {:?}: a hole belongs to one member end",
+                    other.1.id
+                ),
+            ));
+        }
+        let at: Vec<&Member> = members.iter().filter(|m| m.nodes.contains(&h)).collect();
+        if at.len() != 1 {
+            return Err(invalid(
+                j,
+                format!(
+                    "its hole node carries {} members ({}); a hole is one member end's, so \
+                     give each member end its own hole node and joint (a node between two \
+                     stages holds two joints on one shaft)",
+                    at.len(),
+                    at.iter()
+                        .map(|m| format!("{:?}", m.id))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+        if at[0].behaviour != Behaviour::Bar {
+            return Err(invalid(
+                j,
+                format!(
+                    "member {:?} in its hole is a cable: only bars sit on pins",
+                    at[0].id
+                ),
+            ));
+        }
+        if fixed[h].iter().any(|&f| f) || loads[h] != [0.0; 3] {
+            return Err(invalid(
+                j,
+                "its hole node must have no support and no load: support or load the shaft".into(),
+            ));
+        }
+        if top.is_some_and(|t| t.nodes.contains(&h)) {
+            return Err(invalid(
+                j,
+                "its hole node is in the top surface: measure the shaft nodes".into(),
+            ));
+        }
+        if let Some(a) = j.axis {
+            let m = at[0];
+            let [p, q] = m.nodes.map(|n| nodes[n].xyz);
+            let d = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+            let cos = (a[0] * d[0] + a[1] * d[1] + a[2] * d[2]).abs() / distance(p, q);
+            if cos > 1e-6 {
+                return Err(invalid(
+                    j,
+                    format!(
+                        "member {:?} is not perpendicular to the shaft's axis (cosine {cos:.3e}); \
+                         a pin's axis is perpendicular to the member it holds",
+                        m.id
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }

@@ -14,9 +14,9 @@
 //!   "supports": [{"node": "n0.0", "fixed": "xyz"}, …],
 //!   "loads":    [{"node": "n5.0", "force": [0.0, 0.0, -1.0]}],
 //!   "top_surface": {"nodes": ["n5.0", "n5.1", "n5.2"], "reference_normal": [0.0, 0.0, 1.0]},
-//!   "joints":   [{"id": "joint.5.0", "shaft": "n5.0", "hole": "n5.0.h",
+//!   "joints":   [{"id": "joint.5.0.below", "shaft": "n5.0", "hole": "n5.0.below",
 //!                 "axis": [-0.866, -0.5, 0.0], "clearance": 0.01,
-//!                 "tension_stiffness": 2.745e8, "compression_ratio": 1e-5}]
+//!                 "tension_stiffness": 2.745e8}]
 //! }
 //! ```
 //!
@@ -37,12 +37,12 @@
 //! | `top_surface.nodes` | three nodes whose plane is measured (paper Fig. 5 order 1, 2, 3); optional | |
 //! | `top_surface.reference_normal` | the normal θ_P is measured against, default `[0, 0, 1]` | |
 //! | `joints[].id` | unique joint name; optional section (see [`crate::joint`]) | |
-//! | `joints[].shaft`, `joints[].hole` | the shaft-centre node (batten end) and hole-centre node (longeron end); they must have the same `xyz` | |
+//! | `joints[].shaft`, `joints[].hole` | the shaft-centre node (batten end) and hole-centre node (one member end); same `xyz`; the hole node carries exactly one member, perpendicular to the axis, and no support, load or top-surface place (one hole per member end) | |
 //! | `joints[].axis` | the shaft's axis (any length, normalised); optional: without it the clearance acts in every direction | |
 //! | `joints[].clearance` | nominal clearance `g` ≥ 0, the virtual cable's natural length; a job may draw it per sample | mm |
 //! | `joints[].tension_stiffness` | contact stiffness `k_t` > 0; default 10⁵ × the largest `E·A/L₀` of the members at the joint's nodes | N/mm |
-//! | `joints[].compression_ratio` | `k_c/k_t` in (0, 1], the centring stiffness of a loose joint; default 1e-5 | |
-//! | `joints[].axial_stiffness` | `k_a` > 0 along the axis; default `k_t` | N/mm |
+//! | `joints[].compression_ratio` | `k_c/k_t` in [0, 1e-5], a regularising stiffness of a loose joint; default 0 (none: a loose pin carries no force) | |
+//! | `joints[].axial_stiffness` | `k_a` > 0 along the axis; default `k_t` (kept for the file format: the shoulders are taken as rigid along the axis) | N/mm |
 //!
 //! Unknown fields are refused, so a misspelt field name is an error rather than a silently
 //! ignored value.

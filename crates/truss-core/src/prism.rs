@@ -17,11 +17,17 @@
 //! is the order in which a Monte Carlo sample draws length errors. Level 0 is fully fixed.
 //! The top surface is `n{N}.0`, `n{N}.1`, `n{N}.2` against the normal (0, 0, 1).
 //!
-//! With [`PrismOptions::backlash`] every node is a pin joint with backlash (section 4 of the
-//! paper; see [`crate::joint`]): the node `n{k}.{j}` above becomes the *shaft* node, where
-//! the battens and the diagonals attach, and a *hole* node `n{k}.{j}.h` at the same place
-//! carries the longerons' ends (the longeron `longeron.{s}.{j}` joins `n{s-1}.{j}.h` to
-//! `n{s}.{j}.h`), joined to it by the joint `joint.{k}.{j}`. The diagonals attach on the
+//! With [`PrismOptions::backlash`] every longeron end is a pin joint with backlash (section 4
+//! of the paper; see [`crate::joint`]). The node `n{k}.{j}` above becomes the *shaft* node,
+//! the batten-end fitting's shaft, where the battens and the diagonals attach. Each
+//! longeron end has its own hole on that shaft: in a deployable mast each stage's longerons
+//! are separate members, so the longeron below a node and the longeron above it sit in two
+//! holes with independent clearances, and the longeron is not continuous through the node.
+//! So `longeron.{s}.{j}` joins the hole node `n{s-1}.{j}.above` (its bottom end) to the hole
+//! node `n{s}.{j}.below` (its top end), and the joints `joint.{k}.{j}.above` and
+//! `joint.{k}.{j}.below` join each hole node to the shaft `n{k}.{j}`: two joints at each
+//! vertex of the levels between stages, one at the bottom and top levels, `6·N` in all (30
+//! for the paper's 5 stages). The diagonals attach on the
 //! batten side because the batten-end fitting, which carries the shaft, is where a
 //! deployable truss anchors its diagonals; it is also what the paper's Fig. 13 shows: the
 //! shortened diagonals pull the battens towards each other, and each shaft comes to rest
@@ -30,8 +36,9 @@
 //! bisector of the normals of the two side faces that meet there, so that the clearance
 //! acts in each face's plane as in the paper's two-dimensional panel (Fig. 12). The bottom
 //! shaft nodes are fixed; the top surface is the top shaft nodes (the battens' plane). Hole
-//! nodes are listed after all shaft nodes, joints level by level; members keep the order
-//! above, so a sample's length errors are drawn alike with and without backlash.
+//! nodes are listed after all shaft nodes, and hole nodes and joints level by level, vertex
+//! by vertex, `below` before `above`; members keep the order above, so a sample's length
+//! errors are drawn alike with and without backlash.
 //!
 //! Table 1's diagonal natural length, 537.4 mm, is 1.15 µm shorter than the face diagonal
 //! 380·√2 = 537.401 15 mm, so the diagonals start slightly in tension (0.46 N) and the frame
@@ -83,7 +90,7 @@ pub struct BacklashOptions {
     pub clearance: f64,
     /// Contact stiffness over the longeron's axial stiffness `E·A/h`.
     pub tension_factor: f64,
-    /// Centring stiffness of a loose joint over its contact stiffness.
+    /// Regularisation of a loose joint over its contact stiffness (0, the default: none).
     pub compression_ratio: f64,
 }
 
@@ -152,18 +159,27 @@ impl PrismOptions {
                 });
             }
         }
-        // With backlash, the longerons' ends are the hole nodes.
-        let hole = |k: usize, j: usize| match self.backlash {
-            Some(_) => format!("n{k}.{j}.h"),
+        // With backlash, the longerons' ends are the hole nodes, one per end: `side` is
+        // "below" for the top end of the longeron below level k, "above" for the bottom end of
+        // the longeron above it.
+        let hole = |k: usize, j: usize, side: &str| match self.backlash {
+            Some(_) => format!("n{k}.{j}.{side}"),
             None => node(k, j),
+        };
+        let sides = |k: usize| {
+            [("below", k > 0), ("above", k < self.stages)]
+                .into_iter()
+                .filter_map(|(side, present)| present.then_some(side))
         };
         if self.backlash.is_some() {
             for k in 0..=self.stages {
                 for j in 0..3 {
-                    nodes.push(NodeSpec {
-                        id: hole(k, j),
-                        xyz: vertex(j, k),
-                    });
+                    for side in sides(k) {
+                        nodes.push(NodeSpec {
+                            id: hole(k, j, side),
+                            xyz: vertex(j, k),
+                        });
+                    }
                 }
             }
         }
@@ -221,8 +237,8 @@ impl PrismOptions {
             for j in 0..3 {
                 push(
                     format!("longeron.{s}.{j}"),
-                    hole(s - 1, j),
-                    hole(s, j),
+                    hole(s - 1, j, "above"),
+                    hole(s, j, "below"),
                     "longeron",
                 );
             }
@@ -261,16 +277,18 @@ impl PrismOptions {
             let radial = [[-half, -0.5, 0.0], [half, -0.5, 0.0], [0.0, 1.0, 0.0]];
             for k in 0..=self.stages {
                 for (j, axis) in radial.iter().enumerate() {
-                    joints.push(JointSpec {
-                        id: format!("joint.{k}.{j}"),
-                        shaft: node(k, j),
-                        hole: hole(k, j),
-                        axis: Some(*axis),
-                        clearance: b.clearance,
-                        tension_stiffness: Some(tension),
-                        compression_ratio: Some(b.compression_ratio),
-                        axial_stiffness: Some(tension),
-                    });
+                    for side in sides(k) {
+                        joints.push(JointSpec {
+                            id: format!("joint.{k}.{j}.{side}"),
+                            shaft: node(k, j),
+                            hole: hole(k, j, side),
+                            axis: Some(*axis),
+                            clearance: b.clearance,
+                            tension_stiffness: Some(tension),
+                            compression_ratio: Some(b.compression_ratio),
+                            axial_stiffness: Some(tension),
+                        });
+                    }
                 }
             }
         }

@@ -6,10 +6,15 @@
 //! geometric stiffness) is factorised here once: it proves the model is not a mechanism,
 //! and with the Woodbury data over the cables it solves the linearised problem of every
 //! sample (see the `linearised` module).
+//!
+//! Backlash joints are condensed here (see [`crate::joint`]): each hole node is dropped
+//! (it gets no unknowns), its member is attached to the joint's shaft node instead, and a
+//! member with joints at its ends becomes two one-sided members in parallel, its
+//! tension-only half in the member's own place and its compression-only half after all the
+//! model's members.
 
 use crate::block::{Block, BlockBandMatrix};
 use crate::element::{AxialMember, norm, sub};
-use crate::joint::JointElement;
 use crate::linearised::{CableBasis, MAX_WOODBURY_CABLES};
 use crate::model::{Behaviour, Model};
 use crate::ordering::number_nodes;
@@ -40,10 +45,29 @@ pub(crate) struct CompiledMember {
     pub rigidity: f64,
     /// Nominal axial stiffness `k = E·A/L₀` \[N/mm\].
     pub stiffness: f64,
-    /// 1 for bars; the compression ratio for cables.
+    /// 1 for bars; the compression ratio for cables (and a half's slack-side ratio).
     pub compression_ratio: f64,
-    /// Whether the member is a cable.
+    /// Whether the member is one-sided: a cable, or a half of a member with a dead band.
     pub is_cable: bool,
+    /// `σ`: +1 for bars and tension-only members, −1 for a compression-only half.
+    pub sense: f64,
+    /// The model member this stands for (itself, but for compression-only halves).
+    pub model_member: usize,
+    /// For a half of a member whose ends sit in clearance holes: its dead band.
+    pub band: Option<Band>,
+}
+
+/// The dead band of a member whose ends sit in clearance holes (see [`crate::joint`]).
+#[derive(Debug, Clone)]
+pub(crate) struct Band {
+    /// The joints (model order) at the member's first and second node, where there are.
+    pub joints: [Option<usize>; 2],
+    /// `Σ 1/k_t` over those joints \[mm/N\].
+    pub compliance: f64,
+    /// The member's own `E·A` \[N\].
+    pub member_rigidity: f64,
+    /// The other half's index among the structure's members.
+    pub partner: usize,
 }
 
 /// Where a two-node element (a member or a joint, from node `i` to node `j`) puts its
@@ -71,13 +95,21 @@ pub(crate) struct Link {
     pub masked: bool,
 }
 
-/// One joint, compiled: node `i` is the shaft, node `j` the hole.
+/// One joint, compiled: condensed into its member's dead band.
 #[derive(Debug, Clone)]
 pub(crate) struct CompiledJoint {
-    /// Where its stiffness and forces go.
-    pub link: Link,
-    /// Its element with the nominal clearance.
-    pub nominal: JointElement,
+    /// Its id, for messages.
+    pub id: String,
+    /// Its member's tension-only half (the model member's index).
+    pub member: usize,
+    /// Whether the hole is at the member's first node.
+    pub at_start: bool,
+    /// The shaft node.
+    pub shaft: usize,
+    /// Nominal clearance `g` \[mm\].
+    pub clearance: f64,
+    /// Contact stiffness `k_t` \[N/mm\].
+    pub tension_stiffness: f64,
 }
 
 /// A model compiled for solving (see the module doc).
@@ -92,6 +124,11 @@ pub struct Structure {
     /// Number of rows (3 per active node); vectors have one more entry, the zero slot.
     pub(crate) free: usize,
     pub(crate) members: Vec<CompiledMember>,
+    /// Number of the model's members (the first ones of `members`).
+    pub(crate) model_members: usize,
+    /// For each node that is a joint's hole, that joint: the node has no unknowns, and its
+    /// position is its shaft's plus the joint's offset.
+    pub(crate) hole_joint: Vec<Option<usize>>,
     /// The joints, in model order.
     pub(crate) joints: Vec<CompiledJoint>,
     /// Block slots and directions of fixed directions of active nodes (identity rows).
@@ -112,12 +149,25 @@ impl Structure {
     /// Compiles `model` and factorises `K₀`; fails if the model is a mechanism.
     pub fn new(model: &Model) -> Result<Self, ModelError> {
         let nodes = model.nodes();
-        let fixed: Vec<[bool; 3]> = (0..nodes.len()).map(|i| model.fixed(i)).collect();
+        let mut hole_joint = vec![None; nodes.len()];
+        for (k, j) in model.joints().iter().enumerate() {
+            hole_joint[j.hole] = Some(k);
+        }
+        // A member end in a hole acts on the joint's shaft; the hole node has no unknowns.
+        let attach = |node: usize| hole_joint[node].map_or(node, |k| model.joints()[k].shaft);
+        let fixed: Vec<[bool; 3]> = (0..nodes.len())
+            .map(|i| {
+                if hole_joint[i].is_some() {
+                    [true; 3]
+                } else {
+                    model.fixed(i)
+                }
+            })
+            .collect();
         let edges: Vec<[usize; 2]> = model
             .members()
             .iter()
-            .map(|m| m.nodes)
-            .chain(model.joints().iter().map(|j| [j.shaft, j.hole]))
+            .map(|m| m.nodes.map(attach))
             .collect();
         let numbering = number_nodes(&fixed, &edges);
         let free = 3 * numbering.blocks;
@@ -163,46 +213,95 @@ impl Structure {
                     || (bj.is_some() && fixed[j].iter().any(|&f| f)),
             }
         };
-        let mut members: Vec<CompiledMember> = model
-            .members()
+        let model_members = model.members().len();
+        let mut members = Vec::with_capacity(model_members);
+        let mut halves = Vec::new();
+        for (m, member) in model.members().iter().enumerate() {
+            let [i, j] = member.nodes;
+            let reference = sub(nodes[j].xyz, nodes[i].xyz);
+            let length = norm(reference);
+            let (is_cable, compression_ratio) = match member.behaviour {
+                Behaviour::Bar => (false, 1.0),
+                Behaviour::Cable { compression_ratio } => (true, compression_ratio),
+            };
+            let rigidity = member.youngs_modulus * member.area;
+            let mut compiled = CompiledMember {
+                link: link(attach(i), attach(j)),
+                reference,
+                unit: reference.map(|x| x / length),
+                reference_length: length,
+                natural_length: member.natural_length,
+                nominal_stretch: model.nominal_length(m) - member.natural_length,
+                rigidity,
+                stiffness: rigidity / member.natural_length,
+                compression_ratio,
+                is_cable,
+                sense: 1.0,
+                model_member: m,
+                band: None,
+            };
+            let ends = [hole_joint[i], hole_joint[j]];
+            if ends != [None, None] {
+                let joints = ends.iter().flatten().map(|&k| &model.joints()[k]);
+                let compliance: f64 = joints.clone().map(|j| 1.0 / j.tension_stiffness).sum();
+                // The joints' regularisations in series (zero if any joint has none).
+                let regularisation = 1.0
+                    / joints
+                        .clone()
+                        .map(|j| 1.0 / (j.compression_ratio * j.tension_stiffness))
+                        .sum::<f64>();
+                let series = 1.0 / (member.natural_length / rigidity + compliance);
+                let ratio = 0.5 * regularisation / series;
+                if ratio >= 1.0 {
+                    let first = ends.iter().flatten().next().expect("a joint at one end");
+                    return Err(ModelError::Invalid {
+                        item: format!("joint {:?}", model.joints()[*first].id),
+                        message: format!(
+                            "its regularisation compression_ratio·tension_stiffness holds the \
+                             loose member {:?} more stiffly than the member itself (ratio \
+                             {ratio:e}); use a smaller compression_ratio",
+                            member.id
+                        ),
+                    });
+                }
+                compiled.natural_length = member.natural_length;
+                compiled.rigidity = series * member.natural_length;
+                compiled.stiffness = series;
+                compiled.compression_ratio = ratio;
+                compiled.is_cable = true;
+                compiled.band = Some(Band {
+                    joints: ends,
+                    compliance,
+                    member_rigidity: rigidity,
+                    partner: model_members + halves.len(),
+                });
+                let mut half = compiled.clone();
+                half.sense = -1.0;
+                half.band.as_mut().expect("just set").partner = m;
+                halves.push(half);
+            }
+            members.push(compiled);
+        }
+        members.extend(halves);
+        let joints: Vec<CompiledJoint> = model
+            .joints()
             .iter()
-            .enumerate()
-            .map(|(m, member)| {
-                let [i, j] = member.nodes;
-                let reference = sub(nodes[j].xyz, nodes[i].xyz);
-                let length = norm(reference);
-                let (is_cable, compression_ratio) = match member.behaviour {
-                    Behaviour::Bar => (false, 1.0),
-                    Behaviour::Cable { compression_ratio } => (true, compression_ratio),
-                };
-                CompiledMember {
-                    link: link(i, j),
-                    reference,
-                    unit: reference.map(|x| x / length),
-                    reference_length: length,
-                    natural_length: member.natural_length,
-                    nominal_stretch: model.nominal_length(m) - member.natural_length,
-                    rigidity: member.youngs_modulus * member.area,
-                    stiffness: member.youngs_modulus * member.area / member.natural_length,
-                    compression_ratio,
-                    is_cable,
+            .map(|j| {
+                let member = (0..model_members)
+                    .find(|&m| model.members()[m].nodes.contains(&j.hole))
+                    .expect("the model checks that a hole carries one member");
+                CompiledJoint {
+                    id: j.id.clone(),
+                    member,
+                    at_start: model.members()[member].nodes[0] == j.hole,
+                    shaft: j.shaft,
+                    clearance: j.clearance,
+                    tension_stiffness: j.tension_stiffness,
                 }
             })
             .collect();
-        let mut joints: Vec<CompiledJoint> = model
-            .joints()
-            .iter()
-            .map(|j| CompiledJoint {
-                link: link(j.shaft, j.hole),
-                nominal: j.element(j.clearance),
-            })
-            .collect();
         let mut touched = vec![false; k.blocks() * (k.bandwidth() + 1)];
-        let links = members
-            .iter_mut()
-            .map(|c| &mut c.link)
-            .chain(joints.iter_mut().map(|j| &mut j.link));
-        for link in links {
+        for link in members.iter_mut().map(|c| &mut c.link) {
             for (first, &slot) in link.first.iter_mut().zip(&link.slots) {
                 if slot != NONE && !touched[slot] {
                     touched[slot] = true;
@@ -231,6 +330,8 @@ impl Structure {
             dof_owner,
             free,
             members,
+            model_members,
+            hole_joint,
             joints,
             identity_rows,
             untouched,
@@ -254,8 +355,7 @@ impl Structure {
 
     /// Assembles the linearised material stiffness `Σ f(m)·k_m·b_m b_mᵀ` (nominal `k_m`
     /// and directions, `f(m)` a per-member factor such as a slack cable's compression
-    /// ratio), plus every joint's loose stiffness with its nominal constants, into `k`,
-    /// identity rows included.
+    /// ratio) into `k`, identity rows included.
     pub(crate) fn assemble_material(&self, k: &mut BlockBandMatrix, factor: impl Fn(usize) -> f64) {
         self.begin_assembly(k);
         for (m, c) in self.members.iter().enumerate() {
@@ -271,14 +371,10 @@ impl Structure {
             ];
             self.add_block(k, &c.link, &block);
         }
-        for j in &self.joints {
-            self.add_block(k, &j.link, &j.nominal.loose_tangent());
-        }
         self.set_identity_rows(k);
     }
 
-    /// Prepares `k` for [`Structure::add_block`] of every member then every joint, in
-    /// order: zeroes the blocks that none writes (the first to reach a block writes it).
+    /// Prepares `k` for [`Structure::add_block`] of every member, in order: zeroes the blocks that none writes (the first to reach a block writes it).
     #[inline]
     pub(crate) fn begin_assembly(&self, k: &mut BlockBandMatrix) {
         let storage = k.storage_mut();
@@ -365,18 +461,49 @@ impl Structure {
         }
     }
 
-    /// The member's constants for a sample with length error `error` \[mm\].
+    /// The member's constants for a sample with length error `error` \[mm\] and, for a
+    /// half of a member in clearance holes, total clearance `gap` \[mm\]: the tension-only
+    /// half's natural length is `L₀ + G`, the compression-only half's `L₀ − G`, and both
+    /// have the series stiffness `1/(L₀/(E·A) + Σ 1/k_t)` (see [`crate::joint`]).
     #[inline]
-    pub(crate) fn nominal_member(&self, m: &CompiledMember, error: f64) -> AxialMember {
+    pub(crate) fn nominal_member(&self, m: &CompiledMember, error: f64, gap: f64) -> AxialMember {
         // `AxialMember::new` with the nominal length computed once.
+        let natural_length = m.natural_length + error;
+        let (rigidity, initial_stretch) = match &m.band {
+            None => (m.rigidity, m.nominal_stretch - error),
+            Some(b) => (
+                b.member_rigidity * natural_length
+                    / (natural_length + b.compliance * b.member_rigidity),
+                m.nominal_stretch - error - m.sense * gap,
+            ),
+        };
         AxialMember {
             reference: m.reference,
             reference_length: m.reference_length,
-            natural_length: m.natural_length + error,
-            initial_stretch: m.nominal_stretch - error,
-            rigidity: m.rigidity,
+            natural_length,
+            initial_stretch,
+            rigidity,
             compression_ratio: m.compression_ratio,
+            sense: m.sense,
         }
+    }
+
+    /// The total clearance of member `m`'s joints \[mm\], each joint's from `clearance`
+    /// (per joint, model order) or, where that is empty, its nominal one.
+    #[inline]
+    pub(crate) fn band_clearance(&self, m: &CompiledMember, clearance: &[f64]) -> f64 {
+        m.band.as_ref().map_or(0.0, |b| {
+            b.joints
+                .iter()
+                .flatten()
+                .map(|&j| {
+                    clearance
+                        .get(j)
+                        .copied()
+                        .unwrap_or(self.joints[j].clearance)
+                })
+                .sum()
+        })
     }
 
     /// Number of rows of the stiffness matrix (3 per node with a free direction).
@@ -397,9 +524,9 @@ impl Structure {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// Number of members.
+    /// Number of the model's members.
     pub fn member_count(&self) -> usize {
-        self.members.len()
+        self.model_members
     }
 
     /// Number of nodes.

@@ -132,7 +132,6 @@ fn jointed() -> truss_core::ModelFile {
     let mut f = triangle();
     f.nodes.push(node("c.h", [0.0, 100.0, 0.0]));
     f.members[2].nodes[0] = "c.h".into();
-    f.supports.push(support("c.h", "z"));
     f.joints.push(truss_core::model_file::JointSpec {
         id: "joint.c".into(),
         shaft: "c".into(),
@@ -159,6 +158,7 @@ fn joint_faults_are_named() {
         (|j| j.clearance = f64::NAN, "clearance"),
         (|j| j.tension_stiffness = Some(0.0), "tension_stiffness"),
         (|j| j.compression_ratio = Some(2.0), "compression_ratio"),
+        (|j| j.compression_ratio = Some(-1e-9), "compression_ratio"),
     ];
     for (change, expected) in cases {
         let mut f = jointed();
@@ -175,4 +175,53 @@ fn joint_faults_are_named() {
     f.joints.push(twin);
     let m = message(f);
     assert!(m.contains("\"joint.c\" is used twice"), "{m}");
+}
+
+/// A hole is one member end's (see `truss_core::joint`): a hole node with two members, a
+/// support or a load, a hole shared by two joints, and a member not perpendicular to its
+/// pin are refused, naming the joint and the reason.
+#[test]
+fn joint_layout_faults_are_named() {
+    type Change = fn(&mut truss_core::ModelFile);
+    let cases: Vec<(Change, &str)> = vec![
+        (
+            |f| f.members[1].nodes[1] = "c.h".into(),
+            "carries 2 members",
+        ),
+        (|f| f.supports.push(support("c.h", "z")), "no support"),
+        (
+            |f| {
+                f.loads.push(truss_core::model_file::LoadSpec {
+                    node: "c.h".into(),
+                    force: [0.0, 0.0, 1.0],
+                })
+            },
+            "no load",
+        ),
+        (
+            |f| f.joints[0].axis = Some([0.0, 1.0, 1.0]),
+            "not perpendicular",
+        ),
+        (
+            |f| f.members[2] = member("ca", "c.h", "a", 1.0, None, Some(1e-4)),
+            "is a cable",
+        ),
+        (
+            |f| {
+                let mut twin = f.joints[0].clone();
+                twin.id = "joint.twin".into();
+                f.joints.push(twin);
+            },
+            "a hole belongs to one member end",
+        ),
+    ];
+    for (change, expected) in cases {
+        let mut f = jointed();
+        change(&mut f);
+        let m = message(f);
+        assert!(
+            m.contains("joint") && m.contains(expected),
+            "{expected}: {m}"
+        );
+    }
 }

@@ -3,16 +3,7 @@
 
 use super::Evaluation;
 use crate::element::{AxialMember, AxialState};
-use crate::joint::{JointElement, JointState};
 use crate::structure::{Link, Structure};
-
-/// A sample's joints and the buffer of their states.
-pub(super) struct Joints<'a> {
-    /// Each joint's element for the sample, model order.
-    pub elements: &'a [JointElement],
-    /// Their states, written by the evaluation.
-    pub states: &'a mut [JointState],
-}
 
 /// `r = g(u) − f` and the member states at `u`; returns max |r| and max |N|.
 #[cfg(test)]
@@ -23,15 +14,13 @@ pub(super) fn evaluate(
     u: &[f64],
     r: &mut [f64],
     states: &mut [AxialState],
-    joints: Joints<'_>,
 ) -> Evaluation {
     let k = members.iter().map(AxialMember::tension_stiffness);
-    evaluate_with(s, members, k, loads, u, r, states, joints)
+    evaluate_with(s, members, k, loads, u, r, states)
 }
 
-/// `r = g(u) − f` and the member and joint states at `u`, with each member's `k = E·A/L₀`
-/// given (in member order); returns max |r|, the largest member or joint force and the
-/// strain energy.
+/// `r = g(u) − f` and the member states at `u`, with each member's `k = E·A/L₀` given (in
+/// member order); returns max |r|, the largest member force and the strain energy.
 ///
 /// Member by member: gather `d = u_j − u_i` by node blocks (a node without a block is
 /// fixed: zero), the state, then scatter `∓N·n` into the rows of the two nodes. A member
@@ -45,7 +34,6 @@ pub(super) fn evaluate_with(
     u: &[f64],
     r: &mut [f64],
     states: &mut [AxialState],
-    joints: Joints<'_>,
 ) -> Evaluation {
     let n = s.free;
     for (ri, f) in r.iter_mut().zip(loads) {
@@ -70,23 +58,6 @@ pub(super) fn evaluate_with(
             f * st.direction[2],
         ];
         scatter(r, n, &c.link, fk);
-    }
-    // Joints: node `i` the shaft, `j` the hole, `Δ = u_j − u_i`, `∂W/∂u_j = ∂W/∂Δ`.
-    for ((c, j), st) in s
-        .joints
-        .iter()
-        .zip(joints.elements)
-        .zip(joints.states.iter_mut())
-    {
-        let [a, b] = c.link.ends;
-        let ua = ub.get(a).copied().unwrap_or([0.0; 3]);
-        let uj = ub.get(b).copied().unwrap_or([0.0; 3]);
-        *st = j.state([uj[0] - ua[0], uj[1] - ua[1], uj[2] - ua[2]]);
-        strain += st.energy;
-        let f = st.force;
-        let abs = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
-        force_scale = if abs > force_scale { abs } else { force_scale };
-        scatter(r, n, &c.link, f);
     }
     r[n] = 0.0;
     Evaluation {

@@ -2,7 +2,7 @@
 //! sufficient-decrease test, seeded by an exact minimiser of the piecewise quadratic model
 //! along the line.
 
-use super::evaluate::{Joints, dot_n, evaluate_with, max_abs};
+use super::evaluate::{dot_n, evaluate_with, max_abs};
 use super::{Evaluation, Solver};
 use crate::SolveError;
 
@@ -129,8 +129,8 @@ impl Solver {
 
     /// Predicts the minimiser of `φ(α) = Π(u + α·d)` in `(0, cap]` from a piecewise
     /// quadratic model: `φ''` starts at `dᵀK(u)d` (with the geometric stiffness) and jumps
-    /// by `±(1 − r)·k·(n·Δd)²` where a cable's linearised elongation `e + α·(n·Δd)` changes
-    /// sign, and by `k_t·(q·PΔd)²` where a loose joint comes into contact. The breakpoints
+    /// by `±(1 − r)·k·(n·Δd)²` where a one-sided member's linearised elongation `e + α·(n·Δd)` changes
+    /// sign. The breakpoints
     /// are walked in order from `φ'(0)` to the first root of `φ'`.
     pub(super) fn predict_alpha(&mut self, phi0: f64, cap: f64) -> f64 {
         let d = &self.d;
@@ -161,58 +161,6 @@ impl Solver {
                     self.breakpoints
                         .push((at, if st.slack { jump } else { -jump }));
                 }
-            }
-        }
-        // Joints: the curvature of their current piece, and where a loose joint comes
-        // into contact (`|Δ⊥ + α·PΔd| = g`), its contact stiffness `k_t·(q·PΔd)²` joins.
-        for ((c, st), j) in self
-            .structure
-            .joints
-            .iter()
-            .zip(&self.joint_states)
-            .zip(&self.joints)
-        {
-            let l = &c.link;
-            let dv = [
-                d[l.dofs[3]] - d[l.dofs[0]],
-                d[l.dofs[4]] - d[l.dofs[1]],
-                d[l.dofs[5]] - d[l.dofs[2]],
-            ];
-            let t = &st.tangent;
-            curvature += t[0] * dv[0] * dv[0]
-                + t[2] * dv[1] * dv[1]
-                + t[5] * dv[2] * dv[2]
-                + 2.0 * (t[1] * dv[1] * dv[0] + t[3] * dv[2] * dv[0] + t[4] * dv[2] * dv[1]);
-            if st.engaged {
-                continue;
-            }
-            let b = match j.axis {
-                Some(a) => {
-                    let along = a[0] * dv[0] + a[1] * dv[1] + a[2] * dv[2];
-                    [
-                        dv[0] - along * a[0],
-                        dv[1] - along * a[1],
-                        dv[2] - along * a[2],
-                    ]
-                }
-                None => dv,
-            };
-            let o = st.offset;
-            let bb = b[0] * b[0] + b[1] * b[1] + b[2] * b[2];
-            if bb == 0.0 {
-                continue;
-            }
-            let ob = o[0] * b[0] + o[1] * b[1] + o[2] * b[2];
-            let g = j.clearance;
-            let c0 = (o[0] * o[0] + o[1] * o[1] + o[2] * o[2]) - g * g;
-            let at = (-ob + (ob * ob - bb * c0).max(0.0).sqrt()) / bb;
-            if at > 0.0 && at < cap {
-                let along = ((o[0] + at * b[0]) * b[0]
-                    + (o[1] + at * b[1]) * b[1]
-                    + (o[2] + at * b[2]) * b[2])
-                    / g;
-                self.breakpoints
-                    .push((at, j.tension_stiffness * along * along));
             }
         }
         self.breakpoints
@@ -250,10 +198,6 @@ impl Solver {
             &self.trial_u,
             &mut self.trial_r,
             &mut self.trial_states,
-            Joints {
-                elements: &self.joints,
-                states: &mut self.trial_joint_states,
-            },
         )
     }
 
@@ -262,7 +206,6 @@ impl Solver {
         std::mem::swap(&mut self.u, &mut self.trial_u);
         std::mem::swap(&mut self.r, &mut self.trial_r);
         std::mem::swap(&mut self.states, &mut self.trial_states);
-        std::mem::swap(&mut self.joint_states, &mut self.trial_joint_states);
     }
 
     pub(super) fn shortest_member(&self) -> f64 {

@@ -27,9 +27,7 @@
 //!    `|φ'(α)| ≤ η·|φ'(0)|`. `φ'` is continuous because `Π` is continuously differentiable
 //!    where cables go slack.
 //! 5. **Convergence** when either the out-of-balance force is at the rounding floor,
-//!    `‖r‖∞ ≤ residual_floor·F + 16·ε·k_j·‖u‖∞` with `F` the largest member or joint
-//!    force and `k_j` the stiffest backlash joint's contact stiffness (zero without joints:
-//!    a joint's force is `k_j` times a difference of displacements), or the last step
+//!    `‖r‖∞ ≤ residual_floor·F` with `F` the largest member force, or the last step
 //!    satisfies `‖α·d‖∞ ≤ step_tolerance·‖u‖∞` and the error it leaves is no larger than the
 //!    step (a fresh tangent's quadratic convergence, or a measured contraction ≤ ½), or the
 //!    force has stopped falling within a thousand times the floor (an ill-conditioned tall
@@ -45,7 +43,7 @@
 
 use crate::block::BlockBandMatrix;
 use crate::element::{AxialMember, AxialState};
-use crate::joint::{JointElement, JointState};
+use crate::joint::{BandState, JointEnd, JointState, JointSummary, joint_state};
 use crate::linearised::ActiveSet;
 use crate::measure::{Distortion, distortion};
 use crate::structure::Structure;
@@ -117,8 +115,8 @@ pub struct SolveReport {
     pub slack_cables: u32,
     /// Evaluations of the out-of-balance force (line-search trials included).
     pub evaluations: u32,
-    /// Number of joints whose shaft does not touch its hole's edge: their position is set
-    /// by the centring stiffness (see [`crate::joint`]).
+    /// Number of joints whose shaft does not bear on its hole's edge: they carry no force
+    /// (see [`crate::joint`]).
     pub loose_joints: u32,
 }
 
@@ -156,8 +154,7 @@ pub struct Equilibrium {
     pub slack: Vec<usize>,
     /// The top surface's tilt, if the model names a top surface.
     pub distortion: Option<Distortion>,
-    /// Each joint's hole-centre offset from its shaft centre across the axis, model order
-    /// \[mm\].
+    /// Each joint's hole-centre offset from its shaft centre, model order \[mm\].
     pub joint_offsets: Vec<[f64; 3]>,
     /// Each joint's contact force (zero when loose), model order \[N\].
     pub joint_contacts: Vec<f64>,
@@ -185,16 +182,10 @@ pub struct Solver {
     tension: Vec<f64>,
     states: Vec<AxialState>,
     trial_states: Vec<AxialState>,
-    /// Each joint's element for the current sample (its clearance drawn).
-    joints: Vec<JointElement>,
-    joint_states: Vec<JointState>,
-    trial_joint_states: Vec<JointState>,
+    /// Each joint's clearance for the current sample \[mm\].
+    clearances: Vec<f64>,
     slack: Vec<bool>,
     factor_slack: Vec<bool>,
-    /// Which joints were in contact when `self.k` was last factorised by a model step: a
-    /// factorisation is reused only while this holds (a joint's stiffness jumps from `k_c`
-    /// to `k_t` at contact, so a stale factorisation gives wild steps).
-    factor_engaged: Vec<bool>,
     locked: Vec<bool>,
     failures: Vec<crate::block::PivotFailure>,
     stretch: Vec<f64>,
@@ -213,10 +204,6 @@ pub struct Solver {
     breakpoints: Vec<(f64, f64)>,
     /// Nominal length of the shortest member \[mm\] (caps a line search's steps).
     shortest: f64,
-    /// The stiffest joint's contact plus axial stiffness \[N/mm\] (zero without joints): the
-    /// out-of-balance force cannot fall below about `ε·k·‖u‖∞` once a joint this stiff is in
-    /// contact, whatever the member forces.
-    joint_stiffness: f64,
     /// The sample's largest |initial stretch| \[mm\]: the scale of its displacements
     /// (with the shortest member's 1e-6, for samples driven by loads alone).
     scale: f64,
@@ -261,12 +248,10 @@ impl Solver {
         let members: Vec<AxialMember> = structure
             .members
             .iter()
-            .map(|c| structure.nominal_member(c, 0.0))
+            .map(|c| structure.nominal_member(c, 0.0, structure.band_clearance(c, &[])))
             .collect();
         let cables = structure.members.iter().filter(|c| c.is_cable).count();
         let zero_state = members[0].state([0.0; 3]);
-        let joints: Vec<JointElement> = structure.joints.iter().map(|j| j.nominal).collect();
-        let joint_states: Vec<JointState> = joints.iter().map(|j| j.state([0.0; 3])).collect();
         Self {
             k: BlockBandMatrix::new(structure.nominal.blocks(), structure.bandwidth()),
             options,
@@ -274,12 +259,9 @@ impl Solver {
             members,
             states: vec![zero_state; m],
             trial_states: vec![zero_state; m],
-            trial_joint_states: joint_states.clone(),
-            joint_states,
-            joints,
+            clearances: structure.joints.iter().map(|j| j.clearance).collect(),
             slack: vec![false; m],
             factor_slack: vec![false; m],
-            factor_engaged: vec![false; structure.joints.len()],
             locked: vec![false; m],
             failures: Vec::with_capacity(64),
             stretch: vec![0.0; m],
@@ -296,11 +278,6 @@ impl Solver {
             evaluations: 0,
             breakpoints: Vec::with_capacity(m),
             shortest: structure.shortest_member(),
-            joint_stiffness: structure
-                .joints
-                .iter()
-                .map(|j| j.nominal.tension_stiffness + j.nominal.axial_stiffness)
-                .fold(0.0, f64::max),
             scale: 0.0,
             force_ref: 0.0,
             damping: 0.0,
@@ -344,7 +321,7 @@ impl Solver {
     /// Sets the per-sample member constants and loads, checking the input.
     fn set_sample(&mut self, p: Perturbation<'_>) -> Result<(), SolveError> {
         let s = &*self.structure;
-        let m = s.members.len();
+        let m = s.model_members;
         if !p.length_errors.is_empty() && p.length_errors.len() != m {
             return Err(SolveError::Input(format!(
                 "{} length errors for {m} members",
@@ -365,33 +342,32 @@ impl Solver {
                 s.joints.len()
             )));
         }
-        for (i, (j, c)) in self.joints.iter_mut().zip(&s.joints).enumerate() {
-            let g = p.clearances.get(i).copied().unwrap_or(c.nominal.clearance);
-            if !(g.is_finite() && g >= 0.0) {
+        for (i, (g, c)) in self.clearances.iter_mut().zip(&s.joints).enumerate() {
+            let v = p.clearances.get(i).copied().unwrap_or(c.clearance);
+            if !(v.is_finite() && v >= 0.0) {
                 return Err(SolveError::Input(format!(
-                    "joint {i}: clearance {g} mm is not a finite number ≥ 0"
+                    "joint {:?} (index {i}): clearance {v} mm is not a finite number ≥ 0",
+                    c.id
                 )));
             }
-            *j = JointElement {
-                clearance: g,
-                ..c.nominal
-            };
+            *g = v;
         }
         for (i, c) in s.members.iter().enumerate() {
-            let e = p.length_errors.get(i).copied().unwrap_or(0.0);
+            let e = p.length_errors.get(c.model_member).copied().unwrap_or(0.0);
             if !e.is_finite() || c.natural_length + e <= 0.0 {
                 return Err(SolveError::Input(format!(
-                    "member {i}: length error {e} mm leaves no positive natural length"
+                    "member {}: length error {e} mm leaves no positive natural length",
+                    c.model_member
                 )));
             }
-            self.members[i] = s.nominal_member(c, e);
+            let gap = s.band_clearance(c, &self.clearances);
+            self.members[i] = s.nominal_member(c, e, gap);
             self.tension[i] = self.members[i].tension_stiffness();
         }
         self.scale = self
             .members
             .iter()
             .map(|m| m.initial_stretch.abs())
-            .chain(self.joints.iter().map(|j| j.clearance))
             .fold(1e-6 * self.shortest, f64::max);
         self.force_ref = self
             .members
@@ -426,9 +402,16 @@ impl Solver {
         self.last
     }
 
-    /// Displacement of node `node` at the last equilibrium \[mm\].
+    /// Displacement of node `node` at the last equilibrium \[mm\]: a hole node's is its
+    /// shaft's plus its joint's offset.
     pub fn displacement(&self, node: usize) -> [f64; 3] {
-        self.structure.node_dofs[node].map(|d| {
+        let s = &self.structure;
+        if let Some(j) = s.hole_joint[node] {
+            let shaft = self.displacement(s.joints[j].shaft);
+            let o = self.joint_state(j).offset;
+            return [shaft[0] + o[0], shaft[1] + o[1], shaft[2] + o[2]];
+        }
+        s.node_dofs[node].map(|d| {
             if d == crate::structure::FIXED {
                 0.0
             } else {
@@ -437,19 +420,72 @@ impl Solver {
         })
     }
 
-    /// Axial force of member `m` at the last equilibrium, tension positive \[N\].
+    /// Axial force of model member `m` at the last equilibrium, tension positive \[N\]: for
+    /// a member in clearance holes, the sum of its two halves.
     pub fn member_force(&self, m: usize) -> f64 {
-        self.states[m].force
+        match &self.structure.members[m].band {
+            Some(b) => self.states[m].force + self.states[b.partner].force,
+            None => self.states[m].force,
+        }
     }
 
-    /// The state of joint `j` at the last equilibrium.
+    /// The state of joint `j` at the last equilibrium, from its member's (see
+    /// [`crate::joint`]).
     pub fn joint_state(&self, j: usize) -> JointState {
-        self.joint_states[j]
+        let s = &self.structure;
+        let c = &s.joints[j];
+        let half = &s.members[c.member];
+        let partner = half.band.as_ref().map_or(c.member, |b| b.partner);
+        let (t, p) = (&self.states[c.member], &self.states[partner]);
+        let gap = s.band_clearance(half, &self.clearances);
+        joint_state(
+            JointEnd {
+                at_start: c.at_start,
+                clearance: self.clearances[j],
+                tension_stiffness: c.tension_stiffness,
+            },
+            BandState {
+                direction: t.direction,
+                force: t.force + p.force,
+                elongation: t.elongation + gap,
+                total_clearance: gap,
+                bearing: !(t.slack && p.slack),
+            },
+        )
     }
 
-    /// Whether member `m` is a slack cable at the last equilibrium.
+    /// Each joint's id and summary at the last equilibrium, model order.
+    pub fn joint_summaries(&self) -> Vec<(String, JointSummary)> {
+        (0..self.structure.joints.len())
+            .map(|j| {
+                let id = self.structure.joints[j].id.clone();
+                (id, self.joint_state(j).into())
+            })
+            .collect()
+    }
+
+    /// Whether model member `m` is a slack cable at the last equilibrium.
     pub fn is_slack(&self, m: usize) -> bool {
-        self.states[m].slack
+        self.structure.members[m].band.is_none() && self.states[m].slack
+    }
+
+    /// Number of the model's cables that are slack at the current point.
+    fn slack_cable_count(&self) -> u32 {
+        (0..self.structure.model_members)
+            .filter(|&m| self.is_slack(m))
+            .count() as u32
+    }
+
+    /// Number of joints whose member bears on neither side (both halves slack).
+    fn loose_joint_count(&self) -> u32 {
+        self.structure
+            .joints
+            .iter()
+            .filter(|c| {
+                let b = self.structure.members[c.member].band.as_ref();
+                b.is_some_and(|b| self.states[c.member].slack && self.states[b.partner].slack)
+            })
+            .count() as u32
     }
 
     /// The top surface's tilt at the last equilibrium, if the model names a top surface.
@@ -468,21 +504,21 @@ impl Solver {
     /// Collects the last equilibrium; `None` before a successful solve.
     pub fn equilibrium(&self) -> Option<Equilibrium> {
         let report = self.last?;
+        let joints: Vec<JointState> = (0..self.structure.joints.len())
+            .map(|j| self.joint_state(j))
+            .collect();
+        let members = 0..self.structure.model_members;
         Some(Equilibrium {
             report,
             displacements: (0..self.structure.node_ids.len())
                 .map(|i| self.displacement(i))
                 .collect(),
-            forces: self.states.iter().map(|s| s.force).collect(),
-            slack: (0..self.states.len())
-                .filter(|&m| self.states[m].slack)
-                .collect(),
+            forces: members.clone().map(|m| self.member_force(m)).collect(),
+            slack: members.filter(|&m| self.is_slack(m)).collect(),
             distortion: self.distortion(),
-            joint_offsets: self.joint_states.iter().map(|s| s.offset).collect(),
-            joint_contacts: self.joint_states.iter().map(|s| s.contact).collect(),
-            loose_joints: (0..self.joint_states.len())
-                .filter(|&j| !self.joint_states[j].engaged)
-                .collect(),
+            joint_offsets: joints.iter().map(|s| s.offset).collect(),
+            joint_contacts: joints.iter().map(|s| s.contact).collect(),
+            loose_joints: (0..joints.len()).filter(|&j| !joints[j].engaged).collect(),
         })
     }
 
@@ -493,7 +529,6 @@ impl Solver {
             .states
             .iter()
             .map(|s| 0.5 * s.stiffness * s.elongation * s.elongation)
-            .chain(self.joint_states.iter().map(|s| s.energy))
             .sum();
         strain
             - dot_n(

@@ -1,7 +1,7 @@
 //! The iteration of the module doc: the linearised problem, then chord steps or model
 //! steps, each followed by a line search, until converged.
 
-use super::evaluate::{Joints, evaluate_with, max_abs};
+use super::evaluate::{evaluate_with, max_abs};
 use super::step::Step;
 use super::{IterationRecord, Mode, SolveReport, Solver};
 use crate::SolveError;
@@ -20,15 +20,9 @@ impl Solver {
 
         // Step 1: the linearised problem.
         let mut mode = match self.linearised(&structure, &mut factorisations) {
-            // Chord steps use the linearised stiffness, in which joints are loose: with
-            // joints in contact they would barely contract, so joint models take model steps.
             Ok(mode) => {
                 iterations += 1;
-                if structure.joints.is_empty() {
-                    mode
-                } else {
-                    Mode::Tangent
-                }
+                mode
             }
             Err(_) => {
                 self.u.fill(0.0);
@@ -43,10 +37,6 @@ impl Solver {
             &self.u,
             &mut self.r,
             &mut self.states,
-            Joints {
-                elements: &self.joints,
-                states: &mut self.joint_states,
-            },
         );
         self.update_slack();
         // Whether `self.k` holds the factorised model stiffness of `self.factor_slack`.
@@ -64,11 +54,8 @@ impl Solver {
                         .into(),
                 });
             }
-            // The force test's floor: relative to the largest force, plus the rounding of
-            // stiff joints' forces (16·ε·k·‖u‖∞: their offsets are differences of
-            // displacements, each rounded to ε·‖u‖∞).
-            let floor = opts.residual_floor * eval.force_scale.max(self.force_ref)
-                + 16.0 * f64::EPSILON * self.joint_stiffness * max_abs(&self.u[..n]);
+            // The force test's floor: relative to the largest force.
+            let floor = opts.residual_floor * eval.force_scale.max(self.force_ref);
             if eval.residual == 0.0 || eval.residual <= floor {
                 break;
             }
@@ -124,22 +111,13 @@ impl Solver {
                     let reuse = k_valid
                         && opts.reuse_factorisation
                         && !poor
-                        && self.slack == self.factor_slack
-                        && self
-                            .joint_states
-                            .iter()
-                            .zip(&self.factor_engaged)
-                            .all(|(s, &e)| s.engaged == e);
+                        && self.slack == self.factor_slack;
                     if reuse {
                         self.negate_residual_into_step();
                         self.k.solve_in_place(&mut self.d[..n]);
                     } else {
                         match self.model_step(iterations, &mut factorisations)? {
                             Step::Newton { shift: mu } => {
-                                for (e, s) in self.factor_engaged.iter_mut().zip(&self.joint_states)
-                                {
-                                    *e = s.engaged;
-                                }
                                 shift = mu;
                                 fresh = true;
                                 k_valid = true;
@@ -172,10 +150,8 @@ impl Solver {
             eval = new_eval;
             step = alpha * d_max;
             let u_max = max_abs(&self.u[..n]);
-            let far_from_floor = eval.residual
-                > 1e3
-                    * (opts.residual_floor * eval.force_scale.max(self.force_ref)
-                        + 16.0 * f64::EPSILON * self.joint_stiffness * u_max);
+            let far_from_floor =
+                eval.residual > 1e3 * opts.residual_floor * eval.force_scale.max(self.force_ref);
             if far_from_floor && step <= 1e-10 * u_max.max(self.scale) {
                 // A step that no longer moves while the force is far from balanced: damp.
                 if !self.raise_damping() {
@@ -240,9 +216,9 @@ impl Solver {
             factorisations,
             residual: eval.residual,
             step,
-            slack_cables: self.slack.iter().filter(|&&s| s).count() as u32,
+            slack_cables: self.slack_cable_count(),
             evaluations: self.evaluations,
-            loose_joints: self.joint_states.iter().filter(|s| !s.engaged).count() as u32,
+            loose_joints: self.loose_joint_count(),
         })
     }
 
@@ -318,7 +294,8 @@ impl Solver {
         }
         s.nominal.solve_in_place(&mut self.u[..n]);
         for (m, c) in s.members.iter().enumerate() {
-            self.factor_slack[m] = c.is_cable && gather_b(s, m, &self.u) + self.stretch[m] < 0.0;
+            self.factor_slack[m] =
+                c.is_cable && c.sense * (gather_b(s, m, &self.u) + self.stretch[m]) < 0.0;
         }
         for _ in 0..50 {
             let slack = &self.factor_slack;
@@ -344,7 +321,8 @@ impl Solver {
             self.k.solve_in_place(&mut self.u[..n]);
             let mut settled = true;
             for (m, c) in s.members.iter().enumerate() {
-                let slack = c.is_cable && gather_b(s, m, &self.u) + self.stretch[m] < 0.0;
+                let slack =
+                    c.is_cable && c.sense * (gather_b(s, m, &self.u) + self.stretch[m]) < 0.0;
                 if slack != self.factor_slack[m] {
                     settled = false;
                     self.factor_slack[m] = slack;

@@ -55,9 +55,13 @@ impl Solver {
         }
     }
 
-    /// Indices of the currently slack cables.
+    /// Indices of the model's currently slack cables (a member in clearance holes is never
+    /// listed: its halves' state is its joints').
     pub(super) fn slack_indices(&self) -> Vec<usize> {
-        (0..self.slack.len()).filter(|&m| self.slack[m]).collect()
+        let s = &self.structure;
+        (0..s.model_members)
+            .filter(|&m| self.slack[m] && s.members[m].band.is_none())
+            .collect()
     }
 
     /// The model step of the module doc, starting from the current slack set. Counts
@@ -150,7 +154,7 @@ impl Solver {
                     + st.direction[0] * dv[0]
                     + st.direction[1] * dv[1]
                     + st.direction[2] * dv[2];
-                let slack = e < 0.0 && c.compression_ratio < 1.0 && !self.locked[m];
+                let slack = c.sense * e < 0.0 && c.compression_ratio < 1.0 && !self.locked[m];
                 if slack != self.factor_slack[m] {
                     settled = false;
                     self.factor_slack[m] = slack;
@@ -238,9 +242,10 @@ impl Solver {
                     v[c.link.dofs[5]] - v[c.link.dofs[2]],
                 ];
                 let rate = sign
+                    * c.sense
                     * (st.direction[0] * dv[0] + st.direction[1] * dv[1] + st.direction[2] * dv[2]);
                 if rate > 0.0 {
-                    let at = (-st.elongation).max(0.0) / rate;
+                    let at = (-c.sense * st.elongation).max(0.0) / rate;
                     if first.is_none_or(|(best, _)| at < best) {
                         first = Some((at, m));
                     }
@@ -263,9 +268,6 @@ impl Solver {
         for (m, (c, st)) in s.members.iter().zip(&self.states).enumerate() {
             let stiffness = self.model_stiffness(m).unwrap_or(st.stiffness);
             s.add_block(&mut self.k, &c.link, &st.tangent_block_with(stiffness));
-        }
-        for (c, st) in s.joints.iter().zip(&self.joint_states) {
-            s.add_block(&mut self.k, &c.link, &st.tangent);
         }
         s.set_identity_rows(&mut self.k);
     }
