@@ -6,7 +6,7 @@
 #
 # Studies (jobs/): paper-3.1 (σ sweep, 50,000 samples per σ), paper-3.3 (distribution
 # type, 5,000), paper-3.4 (1–30 stages, 5,000 each), paper-4.2.3 (backlash, Fig. 16:
-# 6 σ with and without backlash, 10,000 each, and the regularisation). Each is run with `mc-shard run-all`
+# 6 σ with and without backlash, 10,000 each, and the regularisation). Each is run with `truss-mc run-all`
 # into RUNS_DIR/paper-X (shards resume if interrupted: run it again) and merged into
 # RUNS_DIR/paper-X/report; then scripts/reproduction.py writes REPRODUCTION.md. Needs
 # python3 (standard library only) for the last step. About 3 minutes on 2 cores.
@@ -14,11 +14,11 @@ set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$REPO"
 RUNS="${1:-runs}"
-cargo build --release --quiet -p mc-shard -p mc-merge
+cargo build --release --quiet -p truss-mc -p mc-merge
 for study in 3.1 3.3 3.4 4.2.3; do
     echo "reproduce: study $study" >&2
     start=$SECONDS
-    target/release/mc-shard run-all --job "jobs/paper-$study.json" --out "$RUNS/paper-$study" --no-merge
+    target/release/truss-mc run-all --job "jobs/paper-$study.json" --out "$RUNS/paper-$study" --no-merge
     target/release/mc-merge "$RUNS/paper-$study" --out "$RUNS/paper-$study/report" > "$RUNS/paper-$study/report.txt"
     echo "reproduce: study $study done in $((SECONDS - start)) s" >&2
 done

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# smoke-test.sh: the README's main command (mc-shard run-all) on a small job, checked end
+# smoke-test.sh: the README's main command (truss-mc run-all) on a small job, checked end
 # to end: shards written, merged, report.json present, and every SVG plot renders to a PNG
 # (rsvg-convert parses and rasterises it; a malformed SVG fails).
 #
-# Usage: scripts/smoke-test.sh     (needs target/release/mc-shard and rsvg-convert)
+# Usage: scripts/smoke-test.sh     (needs target/release/truss-mc and rsvg-convert)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-MC_SHARD="${MC_SHARD:-$REPO/target/release/mc-shard}"
+TRUSS_MC="${TRUSS_MC:-$REPO/target/release/truss-mc}"
 WORK="$(mktemp -d /tmp/truss-mc-smoke.XXXXXX)"
 trap 'rm -rf "$WORK"' EXIT
 
@@ -20,7 +20,7 @@ cat > "$WORK/job.json" <<'JOB'
   ]
 }
 JOB
-"$MC_SHARD" run-all --job "$WORK/job.json" --out "$WORK/run" --shards 4 --quiet > "$WORK/out.txt"
+"$TRUSS_MC" run-all --job "$WORK/job.json" --out "$WORK/run" --shards 4 --quiet > "$WORK/out.txt"
 grep -q "run-all: 4000 samples in 4 shards" "$WORK/out.txt" || { cat "$WORK/out.txt"; exit 1; }
 [[ -s "$WORK/run/report/report.json" ]] || { echo "smoke: no report.json" >&2; exit 1; }
 n=0

@@ -21,7 +21,7 @@ echo "test: cargo test --workspace" >&2
 cargo test --workspace --quiet
 
 echo "test: release binaries" >&2
-cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli
+cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-mc
 
 echo "test: Slurm end to end" >&2
 scripts/slurm/e2e-test.sh

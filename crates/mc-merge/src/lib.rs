@@ -132,19 +132,19 @@
 //! 560 MiB peak RSS (58 bytes per sample).
 
 pub mod analysis;
-pub mod bootstrap;
 pub mod cli;
 pub mod definitions;
 pub mod errors;
 pub mod gof;
 pub mod load;
 pub mod plot;
-pub mod quantile;
 pub mod rayleigh;
 pub mod report;
-pub mod rng;
 pub mod sweep;
 pub mod table;
+
+/// The statistics live in `truss-stats`, shared with the diagnosis.
+pub use truss_stats::{bootstrap, quantile, rng};
 
 pub use cli::{Args, Options, Settings};
 pub use errors::{ExitCodes, MergeError};

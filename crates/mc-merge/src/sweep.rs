@@ -30,6 +30,7 @@
 use crate::analysis::{CaseAnalysis, replicate_interval};
 use crate::cli::{ARCSEC_PER_RAD, Settings};
 use crate::report::*;
+use shard_record::parameters::{SIGMA, STAGES};
 use std::collections::BTreeMap;
 
 /// A least-squares fit's numbers.
@@ -253,7 +254,7 @@ fn sigma_series(
         .iter()
         .map(|&i| SeriesPoint {
             case: cases[i].report.name.clone(),
-            x: Real(params[i]["sigma"]),
+            x: Real(params[i][SIGMA]),
             value: cases[i].target.clone(),
         })
         .collect();
@@ -261,10 +262,7 @@ fn sigma_series(
     let used: Vec<usize> = (0..s.members.len())
         .filter(|&k| all[k].target.get().is_some())
         .collect();
-    let x: Vec<f64> = used
-        .iter()
-        .map(|&k| params[s.members[k]]["sigma"])
-        .collect();
+    let x: Vec<f64> = used.iter().map(|&k| params[s.members[k]][SIGMA]).collect();
     let y: Vec<f64> = used.iter().filter_map(|&k| all[k].target.get()).collect();
     let used_cases: Vec<&CaseAnalysis> = used.iter().map(|&k| all[k]).collect();
     let rows = replicate_rows(&used_cases);
@@ -315,7 +313,7 @@ fn stages_series(
 ) -> StagesSeries {
     let conf = settings.confidence;
     let all: Vec<&CaseAnalysis> = s.members.iter().map(|&i| &cases[i]).collect();
-    let stages = |k: usize| params[s.members[k]]["stages"];
+    let stages = |k: usize| params[s.members[k]][STAGES];
     // The reference: the smallest stage count (first in job order among equals).
     let reference = (0..all.len())
         .min_by(|&a, &b| stages(a).total_cmp(&stages(b)).then(a.cmp(&b)))
@@ -378,11 +376,11 @@ pub fn sweep(
 ) -> SweepReport {
     SweepReport {
         percentile: Real(settings.target_percentile),
-        sigma_series: series_over(params, "sigma")
+        sigma_series: series_over(params, SIGMA)
             .iter()
             .map(|s| sigma_series(s, params, cases, settings))
             .collect(),
-        stages_series: series_over(params, "stages")
+        stages_series: series_over(params, STAGES)
             .iter()
             .map(|s| stages_series(s, params, cases, settings))
             .collect(),

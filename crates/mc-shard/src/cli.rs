@@ -1,6 +1,7 @@
 //! The `mc-shard` command line: arguments, dispatch, and the exit code of each failure.
 
-use crate::errors::{JobError, RunError, ShardError};
+use crate::JobError;
+use crate::errors::{RunError, ShardError};
 use crate::job::Job;
 use crate::runner::{RunOptions, run_shard};
 use crate::select::select;
@@ -56,8 +57,6 @@ pub enum Command {
     /// Claim the next unclaimed shard, run it, and repeat until none is left (for cron on
     /// machines sharing the directory).
     Work(WorkArgs),
-    /// Run every shard on this machine as concurrent processes, then merge into DIR/report.
-    RunAll(RunAllArgs),
 }
 
 /// `mc-shard work`.
@@ -84,29 +83,6 @@ pub struct WorkArgs {
     /// Show no progress.
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// `mc-shard run-all`.
-#[derive(Debug, Args)]
-pub struct RunAllArgs {
-    /// The job file.
-    #[arg(long)]
-    pub job: PathBuf,
-    /// Directory for the shard files; the report goes to DIR/report.
-    #[arg(long)]
-    pub out: PathBuf,
-    /// Number of shards (default: the number of workers).
-    #[arg(long)]
-    pub shards: Option<u64>,
-    /// Concurrent worker processes (default: all cores).
-    #[arg(long)]
-    pub workers: Option<usize>,
-    /// Show no progress.
-    #[arg(long)]
-    pub quiet: bool,
-    /// Do not merge at the end.
-    #[arg(long)]
-    pub no_merge: bool,
 }
 
 /// `mc-shard plan`.
@@ -201,18 +177,25 @@ impl CliError {
     /// The exit code (see [`exit`]).
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Run(RunError::Usage(_)) => exit::USAGE,
-            CliError::Run(RunError::Job(JobError::Io { .. })) => exit::IO,
-            CliError::Run(RunError::Job(JobError::InFile { source, .. }))
-                if matches!(**source, JobError::Io { .. }) =>
-            {
-                exit::IO
-            }
-            CliError::Run(RunError::Job(_)) => exit::BAD_JOB,
-            CliError::Run(RunError::Shard(ShardError::Io { .. })) => exit::IO,
-            CliError::Run(RunError::Shard(_)) => exit::SHARD_CONFLICT,
+            CliError::Run(e) => run_exit_code(e),
             CliError::Output(_) => exit::IO,
         }
+    }
+}
+
+/// The exit code of a run error (see [`exit`]).
+pub fn run_exit_code(e: &RunError) -> u8 {
+    match e {
+        RunError::Usage(_) => exit::USAGE,
+        RunError::Job(JobError::Io { .. }) => exit::IO,
+        RunError::Job(JobError::InFile { source, .. })
+            if matches!(**source, JobError::Io { .. }) =>
+        {
+            exit::IO
+        }
+        RunError::Job(_) => exit::BAD_JOB,
+        RunError::Shard(ShardError::Io { .. }) => exit::IO,
+        RunError::Shard(_) => exit::SHARD_CONFLICT,
     }
 }
 
@@ -325,38 +308,6 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
                 None => Ok(()),
             }
         }
-        Command::RunAll(a) => {
-            let job = Job::read(&a.job)?;
-            let workers = a.workers.unwrap_or_else(default_threads);
-            if workers == 0 {
-                return Err(RunError::Usage("--workers must be at least 1".into()).into());
-            }
-            let options = crate::run_all::RunAllOptions {
-                job_path: a.job.clone(),
-                out: a.out.clone(),
-                shards: a.shards.unwrap_or(workers as u64),
-                workers,
-                quiet: a.quiet,
-                no_merge: a.no_merge,
-            };
-            let exe = std::env::current_exe()?;
-            let started = Instant::now();
-            crate::run_all::run_all(&exe, &job, &options, out)?;
-            writeln!(
-                out,
-                "run-all: {} samples in {} shards on {} workers, {:.2} s{}",
-                job.samples(),
-                options.shards,
-                workers,
-                started.elapsed().as_secs_f64(),
-                if a.no_merge {
-                    String::new()
-                } else {
-                    format!("; report in {}", a.out.join("report").display())
-                }
-            )?;
-            Ok(())
-        }
         Command::Status(a) => {
             let job = Job::read(&a.job)?;
             let states = shard_states(&job, &a.out, a.shards).map_err(RunError::Usage)?;
@@ -385,7 +336,8 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
 }
 
 /// The number of cores.
-fn default_threads() -> usize {
+/// The default thread or worker count: the machine's cores.
+pub fn default_threads() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 

@@ -1,56 +1,7 @@
 //! Errors of mc-shard, each carrying what is needed to find the fault.
 
 use std::path::PathBuf;
-
-/// A job that cannot be run.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum JobError {
-    /// The job file could not be read.
-    #[error("{}: cannot read: {message}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The operating system's error.
-        message: String,
-    },
-    /// A value is invalid; `path` is its JSON path (`cases[2].length_errors.longeron`).
-    #[error("{}{message}", if path.is_empty() { String::new() } else { format!("{path}: ") })]
-    Invalid {
-        /// JSON path of the fault.
-        path: String,
-        /// What is wrong.
-        message: String,
-    },
-    /// An error in a given job file.
-    #[error("{}: {source}", file.display())]
-    InFile {
-        /// The job file.
-        file: PathBuf,
-        /// The error.
-        source: Box<JobError>,
-    },
-}
-
-impl JobError {
-    /// An invalid value at JSON path `path`.
-    pub fn at(path: &str, message: &str) -> Self {
-        JobError::Invalid {
-            path: path.to_string(),
-            message: message.to_string(),
-        }
-    }
-
-    /// This error, said of the job file `file`.
-    pub fn in_file(self, file: &std::path::Path) -> Self {
-        match self {
-            e @ JobError::Io { .. } => e,
-            e => JobError::InFile {
-                file: file.to_path_buf(),
-                source: Box::new(e),
-            },
-        }
-    }
-}
+use truss_job::JobError;
 
 /// A shard that cannot be written.
 #[derive(Debug, thiserror::Error)]

@@ -27,8 +27,10 @@
 //!   complete ([`status`]).
 //! - `mc-shard work --job JOB.json --out DIR --shards K` — claim, run and repeat until no
 //!   shard is left: for cron on machines sharing DIR ([`work`]).
-//! - `mc-shard run-all --job JOB.json --out DIR [--shards K] [--workers W]` — every shard on
-//!   this machine as concurrent processes, then the merge ([`run_all`]).
+//!
+//! Running every shard on one machine and merging (`truss-mc run-all`) lives in the crate
+//! above both runner and merge, `truss-mc`: this crate, the worker that runs on every
+//! cluster node, links neither the merge nor an async runtime.
 //!
 //! ## Exit codes
 //!
@@ -42,21 +44,17 @@
 //! | 5 | the shard file is in the way: another job's, locked by another process, or damaged |
 
 pub mod cli;
-pub mod distribution;
-pub mod effects;
 pub mod errors;
-pub mod job;
 pub mod progress;
 pub mod reproduce;
-pub mod run_all;
 pub mod runner;
-pub mod sampler;
 pub mod select;
 pub mod shard;
 pub mod status;
 pub mod work;
 pub mod worker;
 
-pub use errors::{JobError, RunError, ShardError};
-pub use job::Job;
+pub use errors::{RunError, ShardError};
 pub use runner::{RunOptions, RunSummary, run_shard};
+/// The job (spec, distributions, effects, sampler) lives in `truss-job`.
+pub use truss_job::{Job, JobError, distribution, effects, job, sampler};

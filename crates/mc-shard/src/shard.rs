@@ -175,6 +175,19 @@ pub fn begin(job: &crate::job::Job, range: ShardRange) -> Begin {
         &job.id,
         range,
         job.samples(),
-        job.case_infos(),
+        case_infos(job),
     )
+}
+
+/// The job's cases as a shard header lists them.
+pub fn case_infos(job: &crate::job::Job) -> Vec<shard_record::CaseInfo> {
+    job.cases
+        .iter()
+        .map(|c| shard_record::CaseInfo {
+            name: c.name.clone(),
+            start: c.start,
+            samples: c.samples,
+            parameters: c.parameters.clone(),
+        })
+        .collect()
 }

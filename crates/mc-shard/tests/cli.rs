@@ -331,38 +331,3 @@ fn exit_codes() {
 fn mc_shard_job_id(job: &Path) -> String {
     mc_shard::Job::read(job).unwrap().id
 }
-
-/// `run-all` runs every shard as concurrent processes, then merges: the sample lines are the
-/// single run's, and the report is written.
-#[test]
-fn run_all_runs_every_shard_then_merges() {
-    let dir = tempfile::tempdir().unwrap();
-    let job = write(dir.path(), "job.json", &small_job(60));
-    let single = dir.path().join("single");
-    assert!(run(&job, &single, &[]).status.success());
-    let all = dir.path().join("all");
-    let r = mc_shard(
-        &[
-            "run-all",
-            "--job",
-            job.to_str().unwrap(),
-            "--out",
-            all.to_str().unwrap(),
-            "--shards",
-            "5",
-            "--workers",
-            "3",
-            "--quiet",
-        ],
-        &[],
-    );
-    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let stdout = String::from_utf8_lossy(&r.stdout);
-    assert!(
-        stdout.contains("run-all: 120 samples in 5 shards on 3 workers"),
-        "{stdout}"
-    );
-    assert_eq!(sample_lines(&all), sample_lines(&single));
-    assert!(all.join("report/report.json").exists());
-    assert!(all.join("report/theta_p-normal.svg").exists());
-}

@@ -64,6 +64,24 @@ mod range;
 mod scan;
 
 pub use range::{ShardRange, ShardRangeError};
+
+/// The keys of a case's `parameters` in a shard's begin record: what the merge's sweeps read
+/// to put cases on a curve. The job crate writes them (a pipeline test checks that it writes
+/// no other key).
+pub mod parameters {
+    /// The largest standard deviation of the case's length-error distributions \[mm\].
+    pub const SIGMA: &str = "sigma";
+    /// The prism's stage count.
+    pub const STAGES: &str = "stages";
+    /// 1 when any length-error distribution is uniform.
+    pub const UNIFORM: &str = "uniform";
+    /// 1 for a model with backlash joints.
+    pub const BACKLASH: &str = "backlash";
+    /// The joints' regularisation `k_c/k_t` (cases differing in it form their own series).
+    pub const JOINT_COMPRESSION_RATIO: &str = "joint_compression_ratio";
+    /// Every key, in the order above.
+    pub const ALL: [&str; 5] = [SIGMA, STAGES, UNIFORM, BACKLASH, JOINT_COMPRESSION_RATIO];
+}
 pub use scan::{ScanError, ShardScan, Tail, parse_record, read_shard, scan_shard};
 
 use serde::{Deserialize, Serialize};

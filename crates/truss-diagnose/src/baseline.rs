@@ -1,16 +1,16 @@
 //! The baseline job and case, and the jobs derived from it: the same seed and case name (so
 //! every derived case draws the same random words for the same sample: common random
-//! numbers), edited through mc-shard's own job format, validated by mc-shard.
+//! numbers), edited through the job crate's (`truss-job`) format, validated by it.
 
 use crate::errors::DiagnoseError;
-use mc_shard::Job;
-use mc_shard::distribution::DistributionSpec;
-use mc_shard::effects::EffectsSpec;
 use serde_json::{Map, Value};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use truss_core::Model;
+use truss_job::Job;
+use truss_job::distribution::DistributionSpec;
+use truss_job::effects::EffectsSpec;
 
 /// The baseline job file and the case being diagnosed.
 #[derive(Debug, Clone)]
@@ -140,7 +140,7 @@ impl Baseline {
     }
 
     /// The validated baseline case.
-    pub fn case(&self) -> &mc_shard::job::Case {
+    pub fn case(&self) -> &truss_job::job::Case {
         &self.job.cases[self.case_index]
     }
 

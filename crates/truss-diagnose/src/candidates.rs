@@ -1,5 +1,5 @@
 //! The library of candidate effects: physical mechanisms the baseline may lack, each with a
-//! few parameters in a plausible range, applied to a case through mc-shard's job format.
+//! few parameters in a plausible range, applied to a case through the job format of `truss-job`.
 //!
 //! | name | parameters | what it does to the case |
 //! |---|---|---|
@@ -19,8 +19,8 @@
 
 use crate::baseline::{Baseline, CaseEdit};
 use crate::errors::DiagnoseError;
-use mc_shard::distribution::DistributionSpec;
-use mc_shard::effects::{
+use truss_job::distribution::DistributionSpec;
+use truss_job::effects::{
     ALUMINIUM_ALPHA, ALUMINIUM_DENSITY, GravitySpec, STANDARD_GRAVITY, ThermalSpec,
 };
 
@@ -584,7 +584,7 @@ mod tests {
     }
 
     /// On the rigid prism of section 4.2.3, `backlash` makes every node a pin joint with the
-    /// fitted clearance, validated by mc-shard, keeping the baseline's node and member ids
+    /// fitted clearance, validated by the job crate, keeping the baseline's node and member ids
     /// where they were (measured coordinates and members are found by id either way) and the
     /// baseline's member distributions; at its null it leaves the case as it is.
     #[test]

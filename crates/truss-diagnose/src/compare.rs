@@ -8,7 +8,7 @@
 //! | `mean NODE AXIS`, `mean piston`, `mean tan_theta_x`, `mean tan_theta_y` | difference of means | Welch: `ȳ − x̄ ± 1.96·√(s_y²/n + s_x²/N)`, normal p |
 //! | `sd …` (same columns) | ratio of standard deviations (divisor n − 1) | `ln(s_y/s_x) ± 1.96·√((κ_y − 1)/4n + (κ_x − 1)/4N)`, κ the sample kurtosis m₄/m₂² (the large-sample variance of ln s, valid without normality) |
 //! | `cov A / B` (every pair of compared coordinates, and tan θ_x / tan θ_y) | difference of covariances | `± 1.96·√(V_y/n + V_x/N)`, `V = mean((a − ā)²(b − b̄)²) − s_ab²` |
-//! | `p50 theta_p`, `p90 …`, `p95 …`, `p99 …` | ratio of percentiles (Hyndman–Fan definition 1, `mc_merge::quantile`) | Poisson bootstrap of both samples (`mc_merge::bootstrap`, B = 1000, seeds 1 and 2), percentile interval of the ratio; p from the normal approximation of ln ratio with the replicates' standard deviation |
+//! | `p50 theta_p`, `p90 …`, `p95 …`, `p99 …` | ratio of percentiles (Hyndman–Fan definition 1, `truss_stats::quantile`) | Poisson bootstrap of both samples (`truss_stats::bootstrap`, B = 1000, seeds 1 and 2), percentile interval of the ratio; p from the normal approximation of ln ratio with the replicates' standard deviation |
 //! | `ks theta_p` | two-sample Kolmogorov–Smirnov D | asymptotic Kolmogorov p with Stephens' correction λ = (√nₑ + 0.12 + 0.11/√nₑ)·D, nₑ = nN/(n + N) |
 //! | `energy displacements` | energy distance (Székely & Rizzo 2004, unbiased U-statistic) of the displacement vectors, each coordinate divided by the measured standard deviation (floored at the noise) | permutation p with R = 199 (seeded), on the first ≤ 2000 specimens and ≤ 1000 samples |
 //!
@@ -24,10 +24,11 @@
 
 use crate::measured::{Coordinate, Measured};
 use crate::simulate::Simulation;
-use mc_merge::bootstrap::{BootstrapConfig, SortedSample, bootstrap_quantiles};
-use mc_merge::rng::mix64;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, Normal};
+use truss_stats::bootstrap::{BootstrapConfig, SortedSample, bootstrap_quantiles};
+use truss_stats::rng::mix64;
+use truss_stats::two_sample::{self, kolmogorov_smirnov, moments};
 
 /// Mean tolerance, in predicted standard deviations.
 pub const TOL_MEAN: f64 = 0.5;
@@ -109,34 +110,6 @@ fn normal_p(z: f64) -> f64 {
         return if z.is_nan() { 1.0 } else { 0.0 };
     }
     2.0 * (1.0 - Normal::standard().cdf(z.abs()))
-}
-
-struct Moments {
-    mean: f64,
-    sd: f64,
-    kurtosis: f64,
-}
-
-fn moments(v: &[f64]) -> Moments {
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let (mut m2, mut m4) = (0.0, 0.0);
-    for x in v {
-        let c = (x - mean) * (x - mean);
-        m2 += c;
-        m4 += c * c;
-    }
-    let var = m2 / (n - 1.0).max(1.0);
-    let (m2n, m4n) = (m2 / n, m4 / n);
-    Moments {
-        mean,
-        sd: var.sqrt(),
-        kurtosis: if m2n > 0.0 {
-            (m4n / (m2n * m2n)).max(1.0)
-        } else {
-            3.0
-        },
-    }
 }
 
 fn column(x: &[f64], d: usize, j: usize) -> Vec<f64> {
@@ -344,8 +317,8 @@ fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
         .iter()
         .enumerate()
         .map(|(j, &p)| {
-            let qy = mc_merge::quantile::quantile_sorted(&sy.values, p).unwrap_or(f64::NAN);
-            let qx = mc_merge::quantile::quantile_sorted(&sx.values, p).unwrap_or(f64::NAN);
+            let qy = truss_stats::quantile::quantile_sorted(&sy.values, p).unwrap_or(f64::NAN);
+            let qx = truss_stats::quantile::quantile_sorted(&sx.values, p).unwrap_or(f64::NAN);
             let mut logs: Vec<f64> = by.quantiles[j]
                 .iter()
                 .zip(&bx.quantiles[j])
@@ -356,7 +329,7 @@ fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
                 .collect();
             logs.sort_by(f64::total_cmp);
             let ratio = qy / qx;
-            let (lo, hi) = mc_merge::bootstrap::percentile_interval(&logs, 0.95)
+            let (lo, hi) = truss_stats::bootstrap::percentile_interval(&logs, 0.95)
                 .map_or((f64::NAN, f64::NAN), |(a, b)| (a.exp(), b.exp()));
             let m = logs.iter().sum::<f64>() / logs.len().max(1) as f64;
             let sd = (logs.iter().map(|v| (v - m).powi(2)).sum::<f64>()
@@ -394,30 +367,7 @@ fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
 }
 
 fn ks_statistic(y: &[f64], x: &[f64]) -> Statistic {
-    let mut a = y.to_vec();
-    let mut b = x.to_vec();
-    a.sort_by(f64::total_cmp);
-    b.sort_by(f64::total_cmp);
-    let (n, m) = (a.len() as f64, b.len() as f64);
-    let (mut i, mut j, mut d) = (0usize, 0usize, 0.0f64);
-    while i < a.len() && j < b.len() {
-        let v = a[i].min(b[j]);
-        while i < a.len() && a[i] <= v {
-            i += 1;
-        }
-        while j < b.len() && b[j] <= v {
-            j += 1;
-        }
-        d = d.max((i as f64 / n - j as f64 / m).abs());
-    }
-    let ne = n * m / (n + m);
-    let lambda = (ne.sqrt() + 0.12 + 0.11 / ne.sqrt()) * d;
-    let mut p = 0.0;
-    for k in 1..=100 {
-        let k = k as f64;
-        p += 2.0 * (-1f64).powf(k - 1.0) * (-2.0 * k * k * lambda * lambda).exp();
-    }
-    let p = p.clamp(0.0, 1.0);
+    let (d, p) = kolmogorov_smirnov(y, x);
     Statistic {
         id: "ks theta_p".into(),
         kind: "ks",
@@ -430,7 +380,7 @@ fn ks_statistic(y: &[f64], x: &[f64]) -> Statistic {
             lower: d,
             upper: d,
         },
-        p_value: if lambda < 0.2 { 1.0 } else { p },
+        p_value: p,
         p_holm: 1.0,
         disagrees: false,
         words: format!(
@@ -487,7 +437,7 @@ pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> (f64, f64) 
     let mut state = 0x5eed_u64;
     for _ in 0..replicates {
         for i in (1..total).rev() {
-            state = state.wrapping_add(mc_merge::rng::GAMMA);
+            state = state.wrapping_add(truss_stats::rng::GAMMA);
             let j = (mix64(state) % (i as u64 + 1)) as usize;
             label.swap(i, j);
         }
@@ -498,17 +448,12 @@ pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> (f64, f64) 
     (observed, (1 + exceed) as f64 / (replicates + 1) as f64)
 }
 
-/// Holm's step-down adjustment.
+/// Holm's step-down adjustment over the comparison's statistics.
 fn holm(stats: &mut [Statistic]) {
-    let mut order: Vec<usize> = (0..stats.len()).collect();
-    order.sort_by(|&a, &b| stats[a].p_value.total_cmp(&stats[b].p_value));
-    let m = stats.len();
-    let mut running = 0.0f64;
-    for (rank, &i) in order.iter().enumerate() {
-        let adj = ((m - rank) as f64 * stats[i].p_value).min(1.0);
-        running = running.max(adj);
-        stats[i].p_holm = running;
-        stats[i].disagrees = running < 0.05;
+    let p: Vec<f64> = stats.iter().map(|s| s.p_value).collect();
+    for (s, adjusted) in stats.iter_mut().zip(two_sample::holm(&p)) {
+        s.p_holm = adjusted;
+        s.disagrees = adjusted < 0.05;
     }
 }
 
@@ -675,16 +620,5 @@ mod tests {
             p1 < 0.01 && e1 > 5.0 * e0.abs(),
             "shift missed: e = {e1}, p = {p1}"
         );
-    }
-
-    /// KS: identical samples give D = 0; disjoint samples D = 1 and a tiny p.
-    #[test]
-    fn ks_extremes() {
-        let a: Vec<f64> = (0..50).map(f64::from).collect();
-        assert_eq!(ks_statistic(&a, &a).measured, 0.0);
-        let b: Vec<f64> = (100..150).map(f64::from).collect();
-        let s = ks_statistic(&a, &b);
-        assert_eq!(s.measured, 1.0);
-        assert!(s.p_value < 1e-10);
     }
 }

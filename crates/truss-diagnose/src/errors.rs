@@ -7,7 +7,7 @@ use std::path::PathBuf;
 pub enum DiagnoseError {
     /// The baseline job is invalid.
     #[error(transparent)]
-    Job(#[from] mc_shard::JobError),
+    Job(#[from] truss_job::JobError),
     /// The job has no case of that name.
     #[error("the job has no case {name:?} (its cases: {available})")]
     NoCase {
@@ -71,7 +71,7 @@ impl DiagnoseError {
             self,
             DiagnoseError::Io { .. }
                 | DiagnoseError::Plot { .. }
-                | DiagnoseError::Job(mc_shard::JobError::Io { .. })
+                | DiagnoseError::Job(truss_job::JobError::Io { .. })
         )
     }
 

@@ -162,7 +162,7 @@ impl Gaussian {
 /// a derived case's model may number them differently (backlash adds joints and nodes), so
 /// they are found by id.
 pub fn member_log_likelihood(
-    case: &mc_shard::job::Case,
+    case: &truss_job::job::Case,
     measured: &truss_core::Model,
     data: &MemberData,
     sigma_m: f64,

@@ -93,7 +93,7 @@ pub(crate) struct Evaluator<'a> {
 
 impl Evaluator<'_> {
     /// The one-case job of an edit, N samples, the baseline's seed.
-    pub fn job(&self, edit: &CaseEdit) -> Result<mc_shard::Job, DiagnoseError> {
+    pub fn job(&self, edit: &CaseEdit) -> Result<truss_job::Job, DiagnoseError> {
         self.baseline.job_of(edit, self.samples as u64, None)
     }
 
@@ -105,7 +105,7 @@ impl Evaluator<'_> {
     }
 
     /// The terms of ℓ: each specimen's, then each member observation's.
-    pub fn score(&self, job: &mc_shard::Job, sim: &Simulation) -> Result<Terms, DiagnoseError> {
+    pub fn score(&self, job: &truss_job::Job, sim: &Simulation) -> Result<Terms, DiagnoseError> {
         let g = Gaussian::from_simulation(sim, self.sigma_m)?;
         let mut terms = g.log_densities(&self.measured.y);
         if let Some(m) = &self.measured.members {

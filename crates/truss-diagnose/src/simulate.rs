@@ -1,4 +1,4 @@
-//! Running a derived case: `N` samples solved by mc-shard's own [`Worker`] (the same draws
+//! Running a derived case: `N` samples solved by the job crate's own [`SampleSolver`] (the same draws
 //! and solver as a shard run), each sample's displacements at the measured coordinates
 //! collected, and, when asked, the instrument's noise added and the top surface's angles
 //! computed from the noisy positions, exactly as they are from a measured specimen.
@@ -7,17 +7,16 @@
 //!
 //! The value added to coordinate `j` of sample `k` is `σ_m·z` with `z` a standard normal
 //! from the Box–Muller transform of two counter-based uniforms
-//! (`mc_merge::rng`, stream `Synthetic`, key `(noise seed, k)`, counters `2j`, `2j + 1`):
+//! (`truss_stats::rng`, stream `Synthetic`, key `(noise seed, k)`, counters `2j`, `2j + 1`):
 //! a pure function of (seed, k, j), so every derived case sees the same noise (common random
 //! numbers here too) and the result does not depend on the thread count.
 
 use crate::errors::DiagnoseError;
 use crate::measured::Coordinate;
-use mc_merge::rng::{Stream, bits, open01, replicate_key};
-use mc_shard::Job;
-use mc_shard::worker::Worker;
-use shard_record::Status;
 use truss_core::measure::distortion;
+use truss_job::Job;
+use truss_job::solve::{Outcome, SampleSolver};
+use truss_stats::rng::{Stream, bits, box_muller, open01, replicate_key};
 
 /// The simulated samples of one case.
 #[derive(Debug, Clone, Default)]
@@ -56,7 +55,7 @@ pub fn noise_normal(seed: u64, k: u64, j: u64) -> f64 {
     let key = replicate_key(seed, Stream::Synthetic, k);
     let u1 = open01(bits(key, 2 * j));
     let u2 = open01(bits(key, 2 * j + 1));
-    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+    box_muller(u1, u2)
 }
 
 /// Worker threads to use.
@@ -116,15 +115,14 @@ pub fn simulate(
         let handles: Vec<_> = (0..threads)
             .map(|t| {
                 scope.spawn(move || {
-                    let mut worker = Worker::new(job);
+                    let mut worker = SampleSolver::new(job);
                     let range = (t * chunk)..((t + 1) * chunk).min(samples);
                     range
                         .map(|k| {
-                            let s = worker.sample(k as u64);
-                            if s.status != Status::Converged {
+                            if let Outcome::Failed(reason) = worker.solve(k as u64).outcome {
                                 return Row {
                                     x: Vec::new(),
-                                    failure: Some(s.reason.unwrap_or_default()),
+                                    failure: Some(reason),
                                 };
                             }
                             let solver = worker.solver(0).expect("the case was solved");

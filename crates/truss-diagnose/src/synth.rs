@@ -3,7 +3,7 @@
 //!
 //! The specimens are samples `0..N` of the baseline case with the effect applied, under the
 //! seed `S` given (not the job's: their member errors are independent of the diagnosis's
-//! simulation), solved by mc-shard's worker; each written coordinate gets the instrument's
+//! simulation), solved by the job crate's per-sample solve; each written coordinate gets the instrument's
 //! noise σ_m·z (z standard normal from the counter-based generator, keyed by `S`). Rows are
 //! `specimen,node,x,y,z` (positions in mm, nominal plus displacement plus noise), specimens
 //! `S0001`, `S0002`, …; a sample whose solve fails is skipped. With a member file, every
@@ -99,11 +99,11 @@ pub fn synth(options: &SynthOptions, out: &mut dyn Write) -> Result<usize, Diagn
     }
     if let Some(path) = &options.members_out {
         let case = &job.cases[0];
-        let key = mc_shard::sampler::stream_key(options.seed, &case.name);
+        let key = truss_job::sampler::stream_key(options.seed, &case.name);
         let mut text = String::from("specimen,member,length_error\n");
         let mut errors = Vec::new();
         for k in 0..sim.n {
-            mc_shard::sampler::draw_length_errors(&key, case, k as u64, &mut errors);
+            truss_job::sampler::draw_length_errors(&key, case, k as u64, &mut errors);
             for (m, member) in model.members().iter().enumerate() {
                 if case.member_errors[m].is_some() {
                     let e = errors[m]

@@ -1,32 +1,13 @@
-//! Shared helpers of the integration tests: a small deterministic normal generator (so the
-//! tests need nothing of mc-shard) and model builders.
+//! Shared helpers of the integration tests: the deterministic normal generator of
+//! `truss-stats` (so the tests need nothing of mc-shard) and model builders.
 
 #![allow(dead_code)]
 
 use truss_core::model_file::{BehaviourSpec, MemberSpec, ModelFile, NodeSpec, SupportSpec};
 
-/// SplitMix64 uniforms in (0, 1) and Box–Muller normals: deterministic test data.
-pub struct Normals(u64);
-
-impl Normals {
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    pub fn normal(&mut self) -> f64 {
-        let (a, b) = (self.uniform(), self.uniform());
-        (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
-    }
-}
+/// SplitMix64 uniforms in (0, 1) and Box–Muller normals: deterministic test data, from
+/// the statistics crate's one definition.
+pub use truss_stats::rng::SplitMix64 as Normals;
 
 /// Length errors \[mm\] with standard deviation `sigma` on the members whose group is in
 /// `groups`, zero elsewhere.

@@ -1,21 +1,34 @@
-//! `mc-shard run-all`: the whole job on this machine, as concurrent shard processes, then the
+//! `truss-mc run-all`: the whole job on this machine, as concurrent shard processes, then the
 //! merge. What the README's main command runs.
 //!
 //! The job is split into `K` shards (default: as many as workers); up to `W` workers
-//! (default: the number of cores) run at once, each a child process `mc-shard run --shard
-//! i/K --threads 1 --quiet` (so a crash of one loses only its sample in flight, and a rerun
+//! (default: the number of cores) run at once, each a child process `truss-mc run --shard
+//! i/K --threads 1 --quiet` (mc-shard's `run`) (so a crash of one loses only its sample in flight, and a rerun
 //! resumes every shard where it stopped). tokio runs the children and a single progress
 //! display that counts the sample lines the shard files have gained. When all shards are
 //! complete the directory is merged with mc-merge into `DIR/report`.
 
-use crate::errors::RunError;
-use crate::job::Job;
-use crate::progress::Progress;
+use mc_shard::progress::Progress;
+use mc_shard::{Job, RunError};
 use shard_record::ShardRange;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Duration;
+
+/// Why `run-all` stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum RunAllError {
+    /// The job, the shard directory or the arguments.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// Shard processes failed (each with its stderr).
+    #[error("{} shard process(es) failed: {}; run the same command again to resume them", .0.len(), .0.join("; "))]
+    Workers(Vec<String>),
+    /// The merge failed.
+    #[error("merge failed: {0}")]
+    Merge(mc_merge::MergeError),
+}
 
 /// Options of `run-all`.
 #[derive(Debug, Clone)]
@@ -41,12 +54,14 @@ pub fn run_all(
     job: &Job,
     options: &RunAllOptions,
     out: &mut dyn Write,
-) -> Result<(), RunError> {
+) -> Result<(), RunAllError> {
     let ranges = ShardRange::partition(options.shards, job.samples())
         .map_err(|e| RunError::Usage(e.to_string()))?;
-    std::fs::create_dir_all(&options.out).map_err(|source| crate::ShardError::Io {
-        path: options.out.clone(),
-        source,
+    std::fs::create_dir_all(&options.out).map_err(|source| {
+        RunError::Shard(mc_shard::ShardError::Io {
+            path: options.out.clone(),
+            source,
+        })
     })?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -55,11 +70,7 @@ pub fn run_all(
         .map_err(|e| RunError::Usage(format!("cannot start the async runtime: {e}")))?;
     let failures = runtime.block_on(run_children(exe, job, &ranges, options))?;
     if !failures.is_empty() {
-        return Err(RunError::Usage(format!(
-            "{} shard process(es) failed: {}; run the same command again to resume them",
-            failures.len(),
-            failures.join("; ")
-        )));
+        return Err(RunAllError::Workers(failures));
     }
     if options.no_merge {
         return Ok(());
@@ -70,7 +81,7 @@ pub fn run_all(
         plots: true,
         settings: mc_merge::Settings::default(),
     };
-    mc_merge::run(&merge, out).map_err(|e| RunError::Usage(format!("merge failed: {e}")))?;
+    mc_merge::run(&merge, out).map_err(RunAllError::Merge)?;
     Ok(())
 }
 

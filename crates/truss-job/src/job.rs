@@ -385,19 +385,6 @@ impl Job {
     pub fn case_named(&self, name: &str) -> Option<usize> {
         self.cases.iter().position(|c| c.name == name)
     }
-
-    /// The cases as a shard header lists them.
-    pub fn case_infos(&self) -> Vec<shard_record::CaseInfo> {
-        self.cases
-            .iter()
-            .map(|c| shard_record::CaseInfo {
-                name: c.name.clone(),
-                start: c.start,
-                samples: c.samples,
-                parameters: c.parameters.clone(),
-            })
-            .collect()
-    }
 }
 
 /// A model and its compiled structure, with the prism's stage count if it is one.
@@ -503,5 +490,8 @@ fn job_id(seed: u64, cases: &[Case]) -> String {
             .collect(),
     };
     let text = serde_json::to_string(&canonical).expect("the canonical form always serialises");
-    shard_record::hex(&Sha256::digest(text.as_bytes()))
+    Sha256::digest(text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }

@@ -1,0 +1,162 @@
+//! The per-sample solve: draw a sample's length errors and clearances, apply the case's
+//! effects, solve, and measure the top surface. Everything that runs samples (the shard
+//! runner, `reproduce`, the diagnosis) goes through [`SampleSolver`], so they see the same
+//! numbers; the runner turns a [`SampleResult`] into its wire record.
+
+use crate::job::Job;
+use crate::sampler::{draw_sample, stream_key};
+use truss_core::measure::Distortion;
+use truss_core::solver::Perturbation;
+use truss_core::{SolveError, SolveOptions, Solver};
+
+/// A converged sample's measurements.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Converged {
+    /// The top surface's tilt (θ_P \[rad\], tan θ_x, tan θ_y).
+    pub distortion: Distortion,
+    /// Final out-of-balance force, max over free DOFs \[N\].
+    pub residual: f64,
+    /// Number of the model's cables that ended slack.
+    pub slack_cables: u32,
+    /// Number of loose backlash joints, for a model with joints.
+    pub loose_joints: Option<u32>,
+}
+
+/// How a sample ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Outcome {
+    /// Solved and measured.
+    Converged(Converged),
+    /// Not solved, or not measurable; the reason in words.
+    Failed(String),
+}
+
+/// One sample's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SampleResult {
+    /// Global sample index in the job.
+    pub index: u64,
+    /// Index of its case.
+    pub case: usize,
+    /// Index within the case.
+    pub sample: u64,
+    /// Newton iterations (linear solves) it took.
+    pub iterations: u32,
+    /// How it ended.
+    pub outcome: Outcome,
+}
+
+/// Per-thread state: a solver per case (created on first use) and scratch.
+pub struct SampleSolver<'j> {
+    job: &'j Job,
+    keys: Vec<[u8; 32]>,
+    solvers: Vec<Option<Solver>>,
+    errors: Vec<f64>,
+    clearances: Vec<f64>,
+    options: SolveOptions,
+}
+
+impl<'j> SampleSolver<'j> {
+    /// A sample solver for `job`.
+    pub fn new(job: &'j Job) -> Self {
+        Self::with_options(job, SolveOptions::default())
+    }
+
+    /// A sample solver with given solver options (for example, recording iterations).
+    pub fn with_options(job: &'j Job, options: SolveOptions) -> Self {
+        Self {
+            job,
+            keys: job
+                .cases
+                .iter()
+                .map(|c| stream_key(job.seed, &c.name))
+                .collect(),
+            solvers: job.cases.iter().map(|_| None).collect(),
+            errors: Vec::new(),
+            clearances: Vec::new(),
+            options,
+        }
+    }
+
+    /// The job.
+    pub fn job(&self) -> &'j Job {
+        self.job
+    }
+
+    /// Solves global sample `index`. A solve that fails gives [`Outcome::Failed`] with its
+    /// reason, never nothing.
+    ///
+    /// # Panics
+    /// If `index` is beyond the job (a bug in the caller).
+    pub fn solve(&mut self, index: u64) -> SampleResult {
+        let (c, k) = self.job.case_of(index).expect("index within the job");
+        let case = &self.job.cases[c];
+        draw_sample(
+            &self.keys[c],
+            case,
+            k,
+            &mut self.errors,
+            &mut self.clearances,
+        );
+        for (e, t) in self.errors.iter_mut().zip(&case.applied.length_changes) {
+            *e += t;
+        }
+        let options = &self.options;
+        let solver = self.solvers[c]
+            .get_or_insert_with(|| Solver::with_structure(case.structure.clone(), options.clone()));
+        let result = solver.solve_perturbed(Perturbation {
+            length_errors: &self.errors,
+            extra_loads: &case.applied.loads,
+            clearances: &self.clearances,
+        });
+        let has_joints = !case.model.joints().is_empty();
+        let (iterations, outcome) = match result {
+            Ok(report) => (
+                report.iterations,
+                match solver.distortion() {
+                    Some(d) if d.theta_p.is_finite() => Outcome::Converged(Converged {
+                        distortion: d,
+                        residual: report.residual,
+                        slack_cables: report.slack_cables,
+                        loose_joints: has_joints.then_some(report.loose_joints),
+                    }),
+                    Some(_) => Outcome::Failed("the top surface's angles are not finite".into()),
+                    None => Outcome::Failed("the model names no top surface to measure".into()),
+                },
+            ),
+            Err(e) => (
+                match &e {
+                    SolveError::NotConverged { iterations, .. } => *iterations,
+                    SolveError::Mechanism { iteration, .. }
+                    | SolveError::NonFinite { iteration, .. } => *iteration,
+                    SolveError::Input(_) => 0,
+                },
+                Outcome::Failed(e.to_string()),
+            ),
+        };
+        SampleResult {
+            index,
+            case: c,
+            sample: k,
+            iterations,
+            outcome,
+        }
+    }
+
+    /// The length errors of the last sample \[mm\], model order: the drawn ones plus any
+    /// thermal length change.
+    pub fn last_errors(&self) -> &[f64] {
+        &self.errors
+    }
+
+    /// The joint clearances the last sample drew \[mm\], model order (empty when its case
+    /// draws none).
+    pub fn last_clearances(&self) -> &[f64] {
+        &self.clearances
+    }
+
+    /// The solver of case `c`, after it solved a sample of that case.
+    pub fn solver(&self, c: usize) -> Option<&Solver> {
+        self.solvers[c].as_ref()
+    }
+}

@@ -1,0 +1,123 @@
+//! The command line: `run-all`, and every command of `mc-shard` as it is.
+
+use crate::run_all::{RunAllError, RunAllOptions, run_all};
+use clap::{Args, Parser, Subcommand};
+use mc_shard::cli::{CliError, default_threads, run_exit_code};
+use mc_shard::{Job, RunError};
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// The command line of `truss-mc`.
+#[derive(Debug, Parser)]
+#[command(
+    name = "truss-mc",
+    version,
+    about = "The truss Monte Carlo on one machine: every shard as a concurrent process, then the merge; and mc-shard's commands",
+    after_help = "Exit codes: 0 success, 1 internal error, 2 usage error, 3 invalid job, 4 I/O error, 5 shard file in the way (another job's, locked, or damaged); run-all also: 6 a shard process failed (rerun to resume), and mc-merge's codes for a failed merge."
+)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run every shard on this machine as concurrent processes, then merge into DIR/report.
+    RunAll(RunAllArgs),
+    /// mc-shard's commands.
+    #[command(flatten)]
+    Shard(mc_shard::cli::Command),
+}
+
+/// `truss-mc run-all`.
+#[derive(Debug, Args)]
+pub struct RunAllArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// Directory for the shard files; the report goes to DIR/report.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Number of shards (default: the number of workers).
+    #[arg(long)]
+    pub shards: Option<u64>,
+    /// Concurrent worker processes (default: all cores).
+    #[arg(long)]
+    pub workers: Option<usize>,
+    /// Show no progress.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Do not merge at the end.
+    #[arg(long)]
+    pub no_merge: bool,
+}
+
+/// An error of a command, with its exit code.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// From one of mc-shard's commands.
+    #[error(transparent)]
+    Shard(#[from] CliError),
+    /// From `run-all`.
+    #[error(transparent)]
+    RunAll(#[from] RunAllError),
+}
+
+/// Exit code of a failed shard process in `run-all`.
+pub const WORKER_FAILED: u8 = 6;
+
+impl Error {
+    /// The process exit code (see `--help`).
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            Error::Shard(e) => e.exit_code(),
+            Error::RunAll(RunAllError::Run(e)) => run_exit_code(e),
+            Error::RunAll(RunAllError::Workers(_)) => WORKER_FAILED,
+            Error::RunAll(RunAllError::Merge(e)) => u8::try_from(e.exit_code()).unwrap_or(1),
+        }
+    }
+}
+
+/// Runs a command, writing its report to `out`; progress goes to stderr.
+pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
+    match cli.command {
+        Command::Shard(command) => Ok(mc_shard::cli::run(mc_shard::cli::Cli { command }, out)?),
+        Command::RunAll(a) => {
+            let job = Job::read(&a.job).map_err(CliError::from)?;
+            let workers = a.workers.unwrap_or_else(default_threads);
+            if workers == 0 {
+                let usage = RunError::Usage("--workers must be at least 1".into());
+                return Err(CliError::Run(usage).into());
+            }
+            let options = RunAllOptions {
+                job_path: a.job.clone(),
+                out: a.out.clone(),
+                shards: a.shards.unwrap_or(workers as u64),
+                workers,
+                quiet: a.quiet,
+                no_merge: a.no_merge,
+            };
+            let exe = std::env::current_exe().map_err(CliError::from)?;
+            let started = Instant::now();
+            run_all(&exe, &job, &options, out)?;
+            writeln!(
+                out,
+                "run-all: {} samples in {} shards on {} workers, {:.2} s{}",
+                job.samples(),
+                options.shards,
+                workers,
+                started.elapsed().as_secs_f64(),
+                if a.no_merge {
+                    String::new()
+                } else {
+                    format!("; report in {}", a.out.join("report").display())
+                }
+            )
+            .map_err(CliError::from)?;
+            Ok(())
+        }
+    }
+}

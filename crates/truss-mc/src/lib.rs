@@ -1,0 +1,24 @@
+//! # truss-mc: the paper's Monte Carlo on one machine, from job to report
+//!
+//! `truss-mc run-all --job JOB.json --out DIR` splits the job into shards, runs them as
+//! concurrent child processes (each `truss-mc run --shard i/K`, mc-shard's runner), shows
+//! one progress display, and merges the directory into `DIR/report` ([`run_all`]). Every
+//! other command of `mc-shard` (`plan`, `run`, `reproduce`, `status`, `work`) is available
+//! here too, unchanged, so this one binary is all a single machine needs.
+//!
+//! ## Why this crate
+//!
+//! `run-all` is the one command that needs both the runner and the merge. It lives above
+//! both so that neither depends on the other: `mc-shard`, the worker binary that runs on
+//! every cluster node, links neither the merge's statistics and plots nor an async runtime,
+//! and a change to the merge never rebuilds it; `mc-merge` never links the solver. The
+//! dependency graph is drawn in the README ("The pieces") and checked by
+//! `tests/layers.rs` of the workspace's pipeline tests.
+//!
+//! ## Exit codes
+//!
+//! Those of `mc-shard` for its commands; for `run-all` also those of `mc-merge` for a failed
+//! merge, and the verification code when a shard process failed (see `--help`).
+
+pub mod cli;
+pub mod run_all;

@@ -1,0 +1,112 @@
+//! The workspace's dependency graph points one way (README, "The pieces"): this test reads
+//! `cargo metadata` and fails if a forbidden edge comes back. Normal dependencies only, and
+//! transitively: tests and benchmarks may reach further.
+//!
+//! - the runner (`mc-shard`) never links the merge (`mc-merge`) nor an async runtime;
+//! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
+//! - the solver links nothing of ours; nor do the statistics and the wire format;
+//! - the diagnosis links neither the runner, the merge nor the wire format.
+
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Each workspace package's normal dependencies (any package, by name).
+fn normal_dependencies() -> BTreeMap<String, BTreeSet<String>> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let out = std::process::Command::new(cargo)
+        .args([
+            "metadata",
+            "--format-version",
+            "1",
+            "--no-deps",
+            "--offline",
+        ])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo metadata runs");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let meta: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    meta["packages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let deps = p["dependencies"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .filter(|d| d["kind"].is_null())
+                .map(|d| d["name"].as_str().unwrap().to_string())
+                .collect();
+            (p["name"].as_str().unwrap().to_string(), deps)
+        })
+        .collect()
+}
+
+/// Everything `package` links, through workspace packages.
+fn closure(graph: &BTreeMap<String, BTreeSet<String>>, package: &str) -> BTreeSet<String> {
+    let mut seen = BTreeSet::new();
+    let mut stack = vec![package.to_string()];
+    while let Some(p) = stack.pop() {
+        for d in graph.get(&p).into_iter().flatten() {
+            if seen.insert(d.clone()) {
+                stack.push(d.clone());
+            }
+        }
+    }
+    seen
+}
+
+#[test]
+fn dependencies_point_one_way() {
+    let graph = normal_dependencies();
+    let ours: BTreeSet<String> = graph.keys().cloned().collect();
+    for name in [
+        "truss-core",
+        "truss-stats",
+        "truss-job",
+        "mc-shard",
+        "mc-merge",
+    ] {
+        assert!(ours.contains(name), "workspace package {name} is missing");
+    }
+    let forbidden: [(&str, &[&str]); 6] = [
+        (
+            "mc-shard",
+            &["mc-merge", "tokio", "plotters", "statrs", "truss-stats"],
+        ),
+        ("mc-merge", &["truss-core", "truss-job", "mc-shard"]),
+        ("truss-core", &[]),
+        ("truss-stats", &[]),
+        ("shard-record", &[]),
+        (
+            "truss-diagnose",
+            &["mc-shard", "mc-merge", "shard-record", "truss-mc"],
+        ),
+    ];
+    for (package, banned) in forbidden {
+        let links = closure(&graph, package);
+        for b in banned {
+            assert!(
+                !links.contains(*b),
+                "{package} must not link {b} (README, The pieces)"
+            );
+        }
+        if banned.is_empty() {
+            let own: Vec<&String> = links.intersection(&ours).collect();
+            assert!(
+                own.is_empty(),
+                "{package} must link nothing of ours, links {own:?}"
+            );
+        }
+    }
+    // truss-job sits directly on the solver and on nothing else of ours.
+    let job: Vec<String> = closure(&graph, "truss-job")
+        .intersection(&ours)
+        .cloned()
+        .collect();
+    assert_eq!(job, ["truss-core"]);
+}
