@@ -78,7 +78,7 @@ def backlash_section(runs, w):
       "a longeron with its two joints is a bar with a dead band ±(g₁ + g₂), solved as a tension-only half in parallel "
       "with a compression-only half by the same active-set steps that find the slack cables, with no regularisation "
       "by default (see `crates/truss-core/src/joint.rs`). The paper's demonstrations are tests in "
-      "`crates/truss-core/tests/backlash.rs`: the 30 mm panel of Figs. 12/13 (diagonals 445.1 mm) shortens to L − 2g "
+      "`crates/truss-core/tests/it/backlash.rs`: the 30 mm panel of Figs. 12/13 (diagonals 445.1 mm) shortens to L − 2g "
       "with every shaft on its hole's edge along the longeron; the 1-stage truss of Figs. 14/15 does not twist and its "
       "shafts rest on the hole edges — with diagonals of 490 mm, because the paper's 428.1 mm, with Table 1's sections, "
       "pretension the pin-jointed prism past its twisting limit. A third, by hand: the 5-stage truss with every "

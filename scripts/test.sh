@@ -4,7 +4,8 @@
 # Usage: scripts/test.sh
 #
 # 1. cargo test --workspace: unit, verification, property and CLI tests of every crate and
-#    the cross-crate pipeline (tests/). A few minutes.
+#    the cross-crate pipeline (tests/), then the slow statistical checks that the default run
+#    ignores (cargo test --release -- --ignored).
 # 2. The release binaries, then the end-to-end checks with real parts:
 #    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
 #      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted;
@@ -19,6 +20,9 @@ command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null || scripts
 
 echo "test: cargo test --workspace" >&2
 cargo test --workspace --quiet
+
+echo "test: the slow statistical checks (#[ignore]d in the default run), in release" >&2
+cargo test --workspace --release --quiet -- --ignored
 
 echo "test: release binaries" >&2
 cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-mc

@@ -2,7 +2,7 @@
 //! bootstrap replicates and 1000 goodness-of-fit null samples, the brief's yardstick (< 1 s),
 //! and the bootstrap alone. The shards are written once into a temporary directory.
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/it/common/mod.rs"]
 mod common;
 
 use common::{SynthCase, SynthJob};

@@ -9,7 +9,7 @@
 //! paper: σ_t = 3.96e-5 at σ = 6.30e-3 mm), with `--stages` a stages sweep is added, and with
 //! `--backlash` a second σ-series with backlash = 1 and loose joints recorded.
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/it/common/mod.rs"]
 mod common;
 
 use clap::Parser;

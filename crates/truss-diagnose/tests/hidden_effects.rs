@@ -160,6 +160,7 @@ fn check_recovered(v: &serde_json::Value, effect: &str, truth: &[(&str, f64)]) {
 }
 
 #[test]
+#[ignore = "slow statistical check (tens of seconds): scripts/test.sh runs it in release"]
 fn hidden_thermal_gradient_is_named_and_recovered() {
     let dir = tempfile::tempdir().unwrap();
     let m = make(
@@ -284,6 +285,7 @@ fn hidden_diagonal_pretension_is_recovered_whatever_the_csv_details() {
 /// bias is still named, its interval contains the truth and is narrower than from the node
 /// positions alone (each longeron's length error is seen directly).
 #[test]
+#[ignore = "slow statistical check (tens of seconds): scripts/test.sh runs it in release"]
 fn member_measurements_narrow_a_length_effect() {
     let dir = tempfile::tempdir().unwrap();
     let members = dir.path().join("members.csv");
@@ -329,14 +331,14 @@ fn member_measurements_narrow_a_length_effect() {
 ///   clearance then stands for an effective common one (`scripts/diagnose-check.sh` prints
 ///   it against the mean).
 ///
-/// The second is a check of power, not a certainty: on ten data sets (seeds 31–40, the
-/// default N = 4000) backlash was named in 8; in the other two no candidate was significant
-/// (backlash p = 0.011 and 0.027 against α/K = 0.0083: in this model, with the default joint
-/// regularisation, the joints shift the top surface by about 13 µm against a 34 µm scatter).
-/// This test uses seed 32 of those. With top-node positions alone, a joint effect shortens
+/// The second is a check of power, not a certainty: with the earlier, centred joints, ten
+/// data sets (seeds 31–40, the default N = 4000) named backlash in 8. The joints now have
+/// free play (a loaded pin bears on its hole's edge), which makes backlash a larger effect;
+/// the power study has not been redone. This test uses seed 32. With top-node positions alone, a joint effect shortens
 /// the longerons much as a length error does: backlash is then listed as indistinguishable
 /// from the length effects (the check script reports it).
 #[test]
+#[ignore = "slow statistical check (tens of seconds): scripts/test.sh runs it in release"]
 fn hidden_backlash_is_named_with_member_measurements() {
     let dir = tempfile::tempdir().unwrap();
     let paper = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../jobs/paper-4.2.3.json");

@@ -13,7 +13,7 @@
 //! every cluster node, links neither the merge's statistics and plots nor an async runtime,
 //! and a change to the merge never rebuilds it; `mc-merge` never links the solver. The
 //! dependency graph is drawn in the README ("The pieces") and checked by
-//! `tests/layers.rs` of the workspace's pipeline tests.
+//! `tests/tests/it/layers.rs` of the workspace's pipeline tests.
 //!
 //! ## Exit codes
 //!

@@ -6,9 +6,7 @@
 //! 95th percentile is σ_t·√(−2 ln 0.05) (eq. 28) and the slope is c·√(−2 ln 0.05). The paper's
 //! numbers fix c: σ_t = 3.96e-5 at σ = 6.30e-3 mm.
 
-mod common;
-
-use common::{SynthCase, SynthJob};
+use crate::common::{SynthCase, SynthJob};
 use mc_merge::Settings;
 
 fn settings() -> Settings {

@@ -1,7 +1,6 @@
 //! Bad model files are refused with an error naming the item.
 
-mod common;
-use common::*;
+use crate::common::*;
 use truss_core::{Model, ModelError};
 
 fn triangle() -> truss_core::ModelFile {

@@ -7,9 +7,7 @@
 //! crate doc of `shard-record` (file format). Shards are synthetic (see `common`), written with
 //! `shard_record`'s own types so that they verify by construction unless a test breaks them.
 
-mod common;
-
-use common::{SynthCase, SynthJob};
+use crate::common::{SynthCase, SynthJob};
 use serde_json::Value;
 use shard_record::ShardRange;
 use std::path::{Path, PathBuf};

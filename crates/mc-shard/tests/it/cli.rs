@@ -1,8 +1,7 @@
 //! The `mc-shard` binary as users run it: crash and resume, conflicts, reproduce, status,
 //! batch-system environments, and exit codes.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 use std::process::{Command, Output};
 

@@ -1,7 +1,6 @@
 //! The paper's N-stage prism (section 2.1, Fig. 1, Table 1): its generator, and a hand
 //! estimate of the tilt one long longeron gives.
 
-mod common;
 use truss_core::prism::PrismOptions;
 use truss_core::{Behaviour, SolveOptions, Solver};
 

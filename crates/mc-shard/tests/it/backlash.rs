@@ -1,8 +1,7 @@
 //! Backlash in jobs: the model option, the per-case clearance distribution, its faults, and
 //! its draws joining each sample's deterministic stream.
 
-mod common;
-use common::*;
+use crate::common::*;
 use mc_shard::{Job, RunOptions, run_shard};
 use shard_record::ShardRange;
 use std::path::Path;

@@ -10,8 +10,7 @@
 //! - Compression ratio: θ_P statistics do not move, beyond their sampling noise, for cable
 //!   compression ratios from 1e-6 to 1e-3.
 
-mod common;
-use common::*;
+use crate::common::*;
 use proptest::prelude::*;
 use truss_core::model_file::ModelFile;
 use truss_core::prism::PrismOptions;

@@ -3,8 +3,7 @@
 //! shard is completed exactly once, every sample computed once (the line in flight at the
 //! kill at most twice), and the merged report is byte-identical to a single run's.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Stdio};

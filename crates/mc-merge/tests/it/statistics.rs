@@ -6,8 +6,6 @@
 //! Data are simulated from the crate's counter-based generator (stream `Synthetic`), one key per
 //! repeat, so every run sees the same numbers.
 
-mod common;
-
 use mc_merge::bootstrap::{self, BootstrapConfig, SortedSample, bootstrap_quantiles};
 use mc_merge::gof::{CalibrationCache, GofConfig, MAX_CALIBRATION_N, rayleigh_gof};
 use mc_merge::quantile::{order_statistic_interval, quantile_sorted};

@@ -1,8 +1,7 @@
 //! A sample's line depends only on the job and its index: the same bytes for any split of
 //! the job into shards, any thread count, any order of the cases, and a fresh process.
 
-mod common;
-use common::*;
+use crate::common::*;
 use mc_shard::{Job, RunOptions, run_shard};
 use proptest::prelude::*;
 use shard_record::ShardRange;

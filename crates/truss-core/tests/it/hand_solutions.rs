@@ -11,8 +11,7 @@
 //!   fixed                    free in x only                     fixed
 //! ```
 
-mod common;
-use common::*;
+use crate::common::*;
 use truss_core::{Model, SolveOptions, Solver};
 
 const L: f64 = 380.0;

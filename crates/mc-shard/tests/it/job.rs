@@ -1,7 +1,6 @@
 //! Job validation (errors name the JSON path of the fault) and the job id (a canonical form).
 
-mod common;
-use common::*;
+use crate::common::*;
 use mc_shard::Job;
 use std::path::Path;
 

@@ -13,8 +13,7 @@
 //! `L_longeron − 2g` above the bottom ones (Fig. 13: "the total height of the truss is
 //! shortened").
 
-mod common;
-use common::*;
+use crate::common::*;
 use truss_core::model_file::{JointSpec, ModelFile};
 use truss_core::prism::{BacklashOptions, PrismOptions};
 use truss_core::solver::Perturbation;

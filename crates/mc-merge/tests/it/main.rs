@@ -1,0 +1,6 @@
+//! mc-merge's integration tests, one binary: statistics, sweeps and the command line.
+
+mod cli;
+mod common;
+mod statistics;
+mod sweep;

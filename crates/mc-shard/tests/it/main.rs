@@ -1,0 +1,10 @@
+//! mc-shard's integration tests, one binary: jobs, sampling, determinism, backlash, the
+//! command line, and concurrent cron workers.
+
+mod backlash;
+mod cli;
+mod common;
+mod determinism;
+mod job;
+mod sampling;
+mod work;

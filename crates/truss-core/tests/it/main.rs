@@ -1,0 +1,9 @@
+//! truss-core's integration tests, one binary (as ripgrep does): verification against
+//! hand solutions and the paper, invariances, model faults, the prism, and backlash.
+
+mod backlash;
+mod common;
+mod hand_solutions;
+mod invariance;
+mod model_errors;
+mod prism;
