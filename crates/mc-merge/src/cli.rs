@@ -15,14 +15,14 @@ pub const DEFAULT_TARGET_ANGLE: f64 = 9.69e-5;
 pub const ARCSEC_PER_RAD: f64 = 648_000.0 / std::f64::consts::PI;
 
 const AFTER_HELP: &str = "\
-Exit codes:
+Exit codes (the scheme every truss-mc binary shares):
   0  the shards verified and the report was written
   1  internal error (a bug)
   2  usage error (bad flag or value)
-  3  verification failure: a torn, corrupt or incomplete shard, another job id, a wrong digest,
+  4  I/O error reading shards or writing the report
+  6  verification failure: a torn, corrupt or incomplete shard, another job id, a wrong digest,
      a missing index range, or overlapping shards that disagree
-  4  failed samples present (give --allow-failed to compute on the converged ones)
-  5  I/O error reading shards or writing the report
+  7  failed samples present (give --allow-failed to compute on the converged ones)
 
 Every number is reproducible: the bootstrap weights are a function of (seed, replicate, global
 sample index), so the report is byte-identical however the job was split and in whatever order

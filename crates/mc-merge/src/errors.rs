@@ -14,18 +14,18 @@ pub struct ExitCodes;
 
 impl ExitCodes {
     /// The merge verified its input and wrote its report.
-    pub const OK: i32 = 0;
+    pub const OK: u8 = truss_exit::OK;
     /// An internal error (a bug): for example the report could not be serialised.
-    pub const INTERNAL: i32 = 1;
+    pub const INTERNAL: u8 = truss_exit::INTERNAL;
     /// The command line is wrong (unknown flag, bad number, percentile outside 0..100).
-    pub const USAGE: i32 = 2;
+    pub const USAGE: u8 = truss_exit::USAGE;
+    /// A file or directory could not be read or written.
+    pub const IO: u8 = truss_exit::IO;
     /// The shards do not verify: torn, corrupt, incomplete, another job, a wrong digest,
     /// a missing range, or overlapping copies that disagree.
-    pub const VERIFICATION: i32 = 3;
+    pub const VERIFICATION: u8 = truss_exit::VERIFICATION;
     /// Failed samples are present and `--allow-failed` was not given.
-    pub const FAILED_SAMPLES: i32 = 4;
-    /// A file or directory could not be read or written.
-    pub const IO: i32 = 5;
+    pub const FAILED_SAMPLES: u8 = truss_exit::FAILED_SAMPLES;
 }
 
 /// A run of global sample indices `start..end` that no shard holds, inside one case.
@@ -217,7 +217,7 @@ fn failed_message(total: u64, cases: &[FailedCase]) -> String {
 
 impl MergeError {
     /// The process exit code for this error (see [`ExitCodes`]).
-    pub fn exit_code(&self) -> i32 {
+    pub fn exit_code(&self) -> u8 {
         match self {
             MergeError::Usage { .. } => ExitCodes::USAGE,
             MergeError::Shard(ScanError::Io { .. }) | MergeError::Io { .. } => ExitCodes::IO,

@@ -111,14 +111,16 @@
 //!
 //! ## 5. Exit codes ([`ExitCodes`])
 //!
+//! The scheme every truss-mc binary shares (`truss-exit`):
+//!
 //! | code | meaning |
 //! | --- | --- |
 //! | 0 | verified and reported |
 //! | 1 | internal error (a bug) |
 //! | 2 | usage error |
-//! | 3 | verification failure: torn, corrupt or incomplete shard, other job id, wrong digest, missing range, disagreeing overlap |
-//! | 4 | failed samples present without `--allow-failed` |
-//! | 5 | I/O error |
+//! | 4 | I/O error |
+//! | 6 | verification failure: torn, corrupt or incomplete shard, other job id, wrong digest, missing range, disagreeing overlap |
+//! | 7 | failed samples present without `--allow-failed` |
 //!
 //! ## 6. Cost
 //!

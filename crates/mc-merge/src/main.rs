@@ -13,10 +13,10 @@ fn main() -> ExitCode {
         .validate()
         .and_then(|options| mc_merge::run(&options, &mut std::io::stdout().lock()));
     match result {
-        Ok(_) => ExitCode::from(ExitCodes::OK as u8),
+        Ok(_) => ExitCode::from(ExitCodes::OK),
         Err(e) => {
             eprintln!("mc-merge: error: {e}");
-            ExitCode::from(e.exit_code() as u8)
+            ExitCode::from(e.exit_code())
         }
     }
 }

@@ -11,21 +11,8 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Exit codes of `mc-shard` (also in `--help`).
-pub mod exit {
-    /// Success.
-    pub const OK: u8 = 0;
-    /// An internal error (a bug).
-    pub const INTERNAL: u8 = 1;
-    /// Bad arguments, or a range outside the job.
-    pub const USAGE: u8 = 2;
-    /// The job file is invalid (the message gives the JSON path).
-    pub const BAD_JOB: u8 = 3;
-    /// A file or directory could not be read or written.
-    pub const IO: u8 = 4;
-    /// The shard file is in the way: another job's, locked by another process, or damaged.
-    pub const SHARD_CONFLICT: u8 = 5;
-}
+/// Exit codes: the scheme every truss-mc binary shares (also in `--help`).
+pub use truss_exit as exit;
 
 /// Runs seeded Monte Carlo shards of a truss job and writes them as JSON Lines. Units: mm,
 /// N, rad.
@@ -34,7 +21,7 @@ pub mod exit {
     name = "mc-shard",
     version,
     about,
-    after_help = "Exit codes: 0 success, 1 internal error, 2 usage error, 3 invalid job, 4 I/O error, 5 shard file in the way (another job's, locked, or damaged)."
+    after_help = truss_exit::SUMMARY
 )]
 pub struct Cli {
     /// What to do.
@@ -193,9 +180,9 @@ pub fn run_exit_code(e: &RunError) -> u8 {
         {
             exit::IO
         }
-        RunError::Job(_) => exit::BAD_JOB,
+        RunError::Job(_) => exit::INVALID_INPUT,
         RunError::Shard(ShardError::Io { .. }) => exit::IO,
-        RunError::Shard(_) => exit::SHARD_CONFLICT,
+        RunError::Shard(_) => exit::IN_THE_WAY,
     }
 }
 

@@ -15,13 +15,16 @@
 //!
 //! ## Exit codes
 //!
+//! The scheme every truss-mc binary shares (`truss-exit`):
+//!
 //! | code | meaning |
 //! |---|---|
 //! | 0 | success |
-//! | 1 | the solve failed (not converged, mechanism); the JSON result says why; or a diagnosis's simulation failed |
+//! | 1 | internal error (a bug) |
 //! | 2 | usage error (bad arguments) |
 //! | 3 | the model file, job or measured data is invalid (the message names the item or line) |
 //! | 4 | a file could not be read or written |
+//! | 7 | the solve failed (not converged, mechanism; the JSON result says why), or a diagnosis's simulation failed |
 
 pub mod diagnose;
 pub mod solve;
@@ -32,13 +35,13 @@ use std::path::PathBuf;
 use truss_core::prism::{BacklashOptions, PrismOptions, TABLE1_DIAGONAL_LENGTH};
 
 /// Exit code: the solve failed.
-pub const EXIT_SOLVE_FAILED: u8 = 1;
+pub const EXIT_SOLVE_FAILED: u8 = truss_exit::FAILED_SAMPLES;
 /// Exit code: bad arguments.
-pub const EXIT_USAGE: u8 = 2;
-/// Exit code: invalid model.
-pub const EXIT_BAD_MODEL: u8 = 3;
+pub const EXIT_USAGE: u8 = truss_exit::USAGE;
+/// Exit code: invalid model, job or measured data.
+pub const EXIT_BAD_MODEL: u8 = truss_exit::INVALID_INPUT;
 /// Exit code: I/O error.
-pub const EXIT_IO: u8 = 4;
+pub const EXIT_IO: u8 = truss_exit::IO;
 
 /// Generate, solve and diagnose truss models. Units: mm, N, MPa, rad.
 #[derive(Debug, Parser)]
@@ -46,7 +49,7 @@ pub const EXIT_IO: u8 = 4;
     name = "truss",
     version,
     about,
-    after_help = "Exit codes: 0 success, 1 solve failed, 2 usage error, 3 invalid model, 4 I/O error."
+    after_help = truss_exit::SUMMARY
 )]
 pub struct Cli {
     /// What to do.
@@ -205,7 +208,8 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
         Some(CliError::Model(_)) => EXIT_BAD_MODEL,
         Some(CliError::Solve(_)) => EXIT_SOLVE_FAILED,
         Some(CliError::Diagnose(e)) => diagnose::exit_code(e),
-        None => EXIT_IO,
+        // Anything unclassified is a bug, not an I/O error.
+        None => truss_exit::INTERNAL,
     }
 }
 

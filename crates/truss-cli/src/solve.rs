@@ -21,7 +21,7 @@
 //!
 //! Displacements are in mm per node id, forces in N per member id (tension positive), both
 //! in model order. The angles are absent when the model names no top surface. A failed
-//! solve prints `"converged": false` with `"error"`, and exits with code 1.
+//! solve prints `"converged": false` with `"error"`, and exits with code 7 (failed samples).
 
 use crate::{CliError, SolveArgs};
 use serde::Serialize;

@@ -108,7 +108,7 @@ fn exit_codes_distinguish_usage_model_and_io_errors() {
 }
 
 #[test]
-fn a_failed_solve_prints_why_and_exits_1() {
+fn a_failed_solve_prints_why_and_exits_7() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("p.json");
     std::fs::write(&path, truss(&["model", "prism", "--stages", "1"]).stdout).unwrap();
@@ -119,7 +119,7 @@ fn a_failed_solve_prints_why_and_exits_1() {
         "--length-error",
         "longeron.1.0=-400",
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(7), "failed samples (truss-exit)");
     let r = json(&out);
     assert_eq!(r["converged"], false);
     assert!(r["error"].as_str().unwrap().contains("natural length"));

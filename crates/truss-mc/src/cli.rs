@@ -14,7 +14,7 @@ use std::time::Instant;
     name = "truss-mc",
     version,
     about = "The truss Monte Carlo on one machine: every shard as a concurrent process, then the merge; and mc-shard's commands",
-    after_help = "Exit codes: 0 success, 1 internal error, 2 usage error, 3 invalid job, 4 I/O error, 5 shard file in the way (another job's, locked, or damaged); run-all also: 6 a shard process failed (rerun to resume), and mc-merge's codes for a failed merge."
+    after_help = truss_exit::SUMMARY
 )]
 pub struct Cli {
     /// What to do.
@@ -66,17 +66,14 @@ pub enum Error {
     RunAll(#[from] RunAllError),
 }
 
-/// Exit code of a failed shard process in `run-all`.
-pub const WORKER_FAILED: u8 = 6;
-
 impl Error {
     /// The process exit code (see `--help`).
     pub fn exit_code(&self) -> u8 {
         match self {
             Error::Shard(e) => e.exit_code(),
             Error::RunAll(RunAllError::Run(e)) => run_exit_code(e),
-            Error::RunAll(RunAllError::Workers(_)) => WORKER_FAILED,
-            Error::RunAll(RunAllError::Merge(e)) => u8::try_from(e.exit_code()).unwrap_or(1),
+            Error::RunAll(RunAllError::Workers(_)) => truss_exit::VERIFICATION,
+            Error::RunAll(RunAllError::Merge(e)) => e.exit_code(),
         }
     }
 }

@@ -17,8 +17,9 @@
 //!
 //! ## Exit codes
 //!
-//! Those of `mc-shard` for its commands; for `run-all` also those of `mc-merge` for a failed
-//! merge, and the verification code when a shard process failed (see `--help`).
+//! The scheme every truss-mc binary shares (`truss-exit`); `run-all` exits with the
+//! verification code (6) when a shard process failed, and with the merge's code when the
+//! merge failed.
 
 pub mod cli;
 pub mod run_all;

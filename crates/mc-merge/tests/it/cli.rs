@@ -157,7 +157,7 @@ fn missing_range_is_refused_naming_ranges_and_cases() {
     let files = job().write_split(dir.path(), 6);
     std::fs::remove_file(&files[2]).unwrap(); // 600..900: case s2
     let o = mc_merge(&[], &[dir.path().to_path_buf()]);
-    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert_eq!(o.code, 6, "{}", o.stderr);
     assert!(o.stderr.contains("600..900 (case \"s2\""), "{}", o.stderr);
     assert!(o.stderr.contains("1500 of 1800"), "{}", o.stderr);
 }
@@ -220,7 +220,7 @@ fn disagreeing_overlap_names_both_files_and_first_index() {
     let b = SynthJob::write_bytes(dir.path(), "b.jsonl", &bytes);
     for order in [vec![a.clone(), b.clone()], vec![b.clone(), a.clone()]] {
         let o = mc_merge(&[], &order);
-        assert_eq!(o.code, 3, "{}", o.stderr);
+        assert_eq!(o.code, 6, "{}", o.stderr);
         assert!(o.stderr.contains("sample 700"), "{}", o.stderr);
         assert!(
             o.stderr.contains("a.jsonl") && o.stderr.contains("b.jsonl"),
@@ -247,7 +247,7 @@ fn same_range_with_different_bytes_is_refused() {
         }),
     );
     let o = mc_merge(&[], &[a, b]);
-    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert_eq!(o.code, 6, "{}", o.stderr);
     assert!(
         o.stderr.contains("a.jsonl") && o.stderr.contains("b.jsonl"),
         "{}",
@@ -266,7 +266,7 @@ fn torn_line_is_refused_naming_file_and_line() {
     torn.extend_from_slice(&lines[11][..20]);
     let p = SynthJob::write_bytes(dir.path(), "torn.jsonl", &torn);
     let o = mc_merge(&[], &[p]);
-    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert_eq!(o.code, 6, "{}", o.stderr);
     assert!(
         o.stderr.contains("torn.jsonl:12: torn line"),
         "{}",
@@ -282,14 +282,14 @@ fn incomplete_and_corrupt_files_are_refused() {
     let lines: Vec<&str> = bytes.split_inclusive('\n').collect();
     let inc = SynthJob::write_bytes(dir.path(), "inc.jsonl", lines[..50].concat().as_bytes());
     let o = mc_merge(&[], &[inc]);
-    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert_eq!(o.code, 6, "{}", o.stderr);
     assert!(o.stderr.contains("inc.jsonl: incomplete"), "{}", o.stderr);
 
     let mut bad = lines.clone();
     bad[30] = "{\"record\":\"sample\",\"index\":29,\n";
     let p = SynthJob::write_bytes(dir.path(), "bad.jsonl", bad.concat().as_bytes());
     let o = mc_merge(&[], &[p]);
-    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert_eq!(o.code, 6, "{}", o.stderr);
     assert!(o.stderr.contains("bad.jsonl:31:"), "{}", o.stderr);
 }
 
@@ -303,7 +303,7 @@ fn digest_mismatch_is_refused() {
     lines[4] = lines[4].replacen("\"iterations\":", "\"iterations\":1", 1);
     let p = SynthJob::write_bytes(dir.path(), "d.jsonl", lines.concat().as_bytes());
     let o = mc_merge(&[], &[p]);
-    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert_eq!(o.code, 6, "{}", o.stderr);
     assert!(
         o.stderr.contains("d.jsonl:1802:") && o.stderr.contains("sha256"),
         "{}",
@@ -328,7 +328,7 @@ fn other_job_id_is_refused_naming_file_and_line() {
         &other.shard_bytes(ShardRange::new(900, 1800)),
     );
     let o = mc_merge(&[], &[a, b]);
-    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert_eq!(o.code, 6, "{}", o.stderr);
     assert!(o.stderr.contains("b.jsonl:1: job id abab"), "{}", o.stderr);
     assert!(o.stderr.contains("a.jsonl"), "{}", o.stderr);
 }
@@ -341,7 +341,7 @@ fn failed_samples_are_refused_by_default_and_counted_when_allowed() {
     j.cases[1].fail_every = Some(100); // samples 99, 199, … of s2: global 699, 799, …
     j.write_split(dir.path(), 3);
     let o = mc_merge(&[], &[dir.path().to_path_buf()]);
-    assert_eq!(o.code, 4, "{}", o.stderr);
+    assert_eq!(o.code, 7, "{}", o.stderr);
     assert!(o.stderr.contains("6 failed samples"), "{}", o.stderr);
     assert!(
         o.stderr.contains("case \"s2\": 6 failed, indices 699, 799"),
@@ -429,10 +429,10 @@ fn usage_and_io_errors_have_their_codes() {
     let o = mc_merge(&["--no-such-flag"], &[PathBuf::from(".")]);
     assert_eq!(o.code, 2, "{}", o.stderr);
     let o = mc_merge(&[], &[PathBuf::from("/nonexistent/shards")]);
-    assert_eq!(o.code, 5, "{}", o.stderr);
+    assert_eq!(o.code, 4, "{}", o.stderr);
     let empty = tempfile::tempdir().unwrap();
     let o = mc_merge(&[], &[empty.path().to_path_buf()]);
-    assert_eq!(o.code, 3, "{}", o.stderr);
+    assert_eq!(o.code, 6, "{}", o.stderr);
     assert!(o.stderr.contains("no shard files"), "{}", o.stderr);
 }
 
@@ -444,9 +444,9 @@ fn help_documents_exit_codes() {
     for code in [
         "0  ",
         "2  usage",
-        "3  verification",
-        "4  failed samples",
-        "5  I/O",
+        "4  I/O",
+        "6  verification",
+        "7  failed samples",
     ] {
         assert!(text.contains(code), "{code}: {text}");
     }
