@@ -82,35 +82,40 @@ pub enum ModelKind {
     Prism(PrismArgs),
 }
 
+/// Table 1's values, the one place they are written ([`PrismOptions::default`]).
+fn table1() -> PrismOptions {
+    PrismOptions::default()
+}
+
 /// Options of `truss model prism`; defaults are the paper's Table 1.
 #[derive(Debug, Args)]
 pub struct PrismArgs {
     /// Number of stages N.
-    #[arg(long, default_value_t = 5)]
+    #[arg(long, default_value_t = table1().stages)]
     pub stages: usize,
     /// Batten length l, the triangle's side \[mm\].
-    #[arg(long, default_value_t = 380.0)]
+    #[arg(long, default_value_t = table1().side)]
     pub side: f64,
     /// Stage height h, the longeron length \[mm\].
-    #[arg(long, default_value_t = 380.0)]
+    #[arg(long, default_value_t = table1().height)]
     pub height: f64,
     /// Batten cross-section \[mm²\].
-    #[arg(long, default_value_t = 14.9)]
+    #[arg(long, default_value_t = table1().batten_area)]
     pub batten_area: f64,
     /// Batten Young's modulus \[MPa\].
-    #[arg(long, default_value_t = 70_000.0)]
+    #[arg(long, default_value_t = table1().batten_modulus)]
     pub batten_modulus: f64,
     /// Longeron cross-section \[mm²\].
-    #[arg(long, default_value_t = 14.9)]
+    #[arg(long, default_value_t = table1().longeron_area)]
     pub longeron_area: f64,
     /// Longeron Young's modulus \[MPa\].
-    #[arg(long, default_value_t = 70_000.0)]
+    #[arg(long, default_value_t = table1().longeron_modulus)]
     pub longeron_modulus: f64,
     /// Diagonal cable cross-section \[mm²\].
-    #[arg(long, default_value_t = 3.1)]
+    #[arg(long, default_value_t = table1().diagonal_area)]
     pub diagonal_area: f64,
     /// Diagonal cable Young's modulus \[MPa\].
-    #[arg(long, default_value_t = 70_000.0)]
+    #[arg(long, default_value_t = table1().diagonal_modulus)]
     pub diagonal_modulus: f64,
     /// Diagonal natural length \[mm\] (Table 1: 537.4).
     #[arg(long, default_value_t = TABLE1_DIAGONAL_LENGTH, conflicts_with = "exact_diagonals")]
@@ -121,8 +126,8 @@ pub struct PrismArgs {
     /// Cables' compression stiffness / tension stiffness.
     #[arg(long, default_value_t = truss_core::DEFAULT_COMPRESSION_RATIO)]
     pub compression_ratio: f64,
-    /// Model the batten–longeron pin joints with backlash (paper section 4): each joint
-    /// gets a shaft node and a hole node joined by a virtual cable.
+    /// Model the batten–longeron pin joints with backlash (paper section 4): each longeron
+    /// end gets its own hole on the batten's shaft, with free play.
     #[arg(long)]
     pub backlash: bool,
     /// Clearance of every joint \[mm\] (with `--backlash`).

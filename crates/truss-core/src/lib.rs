@@ -82,6 +82,7 @@ pub mod model;
 pub mod model_file;
 mod ordering;
 pub mod prism;
+pub mod prism_spec;
 pub mod solver;
 mod structure;
 

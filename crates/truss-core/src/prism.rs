@@ -54,7 +54,8 @@ use crate::{DEFAULT_COMPRESSION_RATIO, Model, ModelError};
 /// The diagonal natural length of the paper's Table 1 \[mm\].
 pub const TABLE1_DIAGONAL_LENGTH: f64 = 537.4;
 
-/// Options of the prism generator; the defaults are the paper's Table 1.
+/// Options of the prism generator; the defaults are the paper's Table 1. A job file writes
+/// them as JSON (see [`crate::prism_spec`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PrismOptions {
     /// Number of stages N ≥ 1.
@@ -83,8 +84,10 @@ pub struct PrismOptions {
     pub backlash: Option<BacklashOptions>,
 }
 
-/// The joints of a prism with backlash.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The joints of a prism with backlash (in a job: any field may be left out for its
+/// default).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct BacklashOptions {
     /// Nominal clearance of every joint \[mm\] (a job may draw one per joint and sample).
     pub clearance: f64,

@@ -3,7 +3,6 @@
 //! numbers), edited through the job crate's (`truss-job`) format, validated by it.
 
 use crate::errors::DiagnoseError;
-use serde_json::{Map, Value};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -11,14 +10,15 @@ use truss_core::Model;
 use truss_job::Job;
 use truss_job::distribution::DistributionSpec;
 use truss_job::effects::EffectsSpec;
+use truss_job::job::{CaseSpec, JobSpec, ModelSpec};
 
 /// The baseline job file and the case being diagnosed.
 #[derive(Debug, Clone)]
 pub struct Baseline {
     /// The job file.
     pub path: PathBuf,
-    /// The job as JSON, model file paths made absolute.
-    pub raw: Value,
+    /// The job as written, model file paths made absolute.
+    pub spec: JobSpec,
     /// Index of the case.
     pub case_index: usize,
     /// The case's name.
@@ -29,15 +29,15 @@ pub struct Baseline {
     pub job: Job,
 }
 
-/// A case being edited: its JSON object and its effective model's JSON (the job's default
-/// model unless the case has its own). A candidate effect edits either; see
+/// A case being edited, as a typed spec: the case and its effective model (the job's
+/// default model unless the case has its own). A candidate effect edits either; see
 /// [`Baseline::derived_case`].
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct CaseEdit {
-    /// The case object (`name`, `samples`, `length_errors`, `effects`, …).
-    pub case: Map<String, Value>,
-    /// The case's model, `{"prism": {...}}` or a model file reference.
-    pub model: Value,
+    /// The case (`name`, `samples`, `length_errors`, `effects`, `backlash`).
+    pub case: CaseSpec,
+    /// The case's model.
+    pub model: ModelSpec,
     /// Whether `model` was edited (then written into the case).
     pub model_edited: bool,
 }
@@ -45,57 +45,22 @@ pub struct CaseEdit {
 impl CaseEdit {
     /// The distribution of `group`'s length errors, if the case gives one.
     pub fn distribution(&self, group: &str) -> Option<DistributionSpec> {
-        self.case
-            .get("length_errors")
-            .and_then(|l| l.get(group))
-            .and_then(|v| serde_json::from_value(v.clone()).ok())
+        self.case.length_errors.get(group).copied()
     }
 
     /// Sets `group`'s distribution.
     pub fn set_distribution(&mut self, group: &str, d: DistributionSpec) {
-        let errors = self
-            .case
-            .entry("length_errors")
-            .or_insert_with(|| Value::Object(Map::new()));
-        if let Value::Object(m) = errors {
-            m.insert(
-                group.to_string(),
-                serde_json::to_value(d).expect("a distribution serialises"),
-            );
-        }
+        self.case.length_errors.insert(group.to_string(), d);
     }
 
     /// The case's effects.
     pub fn effects(&self) -> EffectsSpec {
-        self.case
-            .get("effects")
-            .and_then(|v| serde_json::from_value(v.clone()).ok())
-            .unwrap_or_default()
+        self.case.effects.clone()
     }
 
     /// Sets the case's effects.
     pub fn set_effects(&mut self, e: &EffectsSpec) {
-        if e.is_empty() {
-            self.case.remove("effects");
-        } else {
-            self.case.insert(
-                "effects".into(),
-                serde_json::to_value(e).expect("effects serialise"),
-            );
-        }
-    }
-}
-
-fn absolute_model(value: &mut Value, base: &Path) {
-    let fix = |s: &str| base.join(s).display().to_string();
-    match value {
-        Value::String(s) => *s = fix(s),
-        Value::Object(m) => {
-            if let Some(Value::String(s)) = m.get_mut("file") {
-                *s = fix(s);
-            }
-        }
-        _ => {}
+        self.case.effects = e.clone();
     }
 }
 
@@ -104,7 +69,6 @@ impl Baseline {
     pub fn read(path: &Path, case: &str) -> Result<Self, DiagnoseError> {
         let job = Job::read(path)?;
         let text = std::fs::read_to_string(path).map_err(|e| DiagnoseError::io(path, e))?;
-        let mut raw: Value = serde_json::from_str(&text).map_err(|e| DiagnoseError::io(path, e))?;
         let base = path
             .parent()
             .filter(|p| !p.as_os_str().is_empty())
@@ -112,13 +76,10 @@ impl Baseline {
         let base = base
             .canonicalize()
             .map_err(|e| DiagnoseError::io(base, e))?;
-        absolute_model(&mut raw["model"], &base);
-        if let Some(cases) = raw["cases"].as_array_mut() {
-            for c in cases {
-                if let Some(m) = c.get_mut("model") {
-                    absolute_model(m, &base);
-                }
-            }
+        let mut spec = JobSpec::from_json(&text).map_err(|e| e.in_file(path))?;
+        spec.model = spec.model.absolute(&base);
+        for c in &mut spec.cases {
+            c.model = c.model.take().map(|m| m.absolute(&base));
         }
         let case_index = job.case_named(case).ok_or_else(|| DiagnoseError::NoCase {
             name: case.to_string(),
@@ -132,7 +93,7 @@ impl Baseline {
         Ok(Self {
             path: path.to_path_buf(),
             seed: job.seed,
-            raw,
+            spec,
             case_index,
             case_name: case.to_string(),
             job,
@@ -156,14 +117,11 @@ impl Baseline {
 
     /// A fresh edit of the baseline case.
     pub fn derived_case(&self) -> CaseEdit {
-        let case = self.raw["cases"][self.case_index]
-            .as_object()
-            .cloned()
-            .unwrap_or_default();
+        let case = self.spec.cases[self.case_index].clone();
         let model = case
-            .get("model")
-            .cloned()
-            .unwrap_or_else(|| self.raw["model"].clone());
+            .model
+            .clone()
+            .unwrap_or_else(|| self.spec.model.clone());
         CaseEdit {
             case,
             model,
@@ -171,40 +129,39 @@ impl Baseline {
         }
     }
 
-    /// The case object an edit stands for, its model written in when edited.
-    fn case_object(&self, edit: &CaseEdit) -> Map<String, Value> {
+    /// The case an edit stands for, its model written in when edited.
+    fn case_spec(&self, edit: &CaseEdit) -> CaseSpec {
         let mut case = edit.case.clone();
         if edit.model_edited {
-            case.insert("model".into(), edit.model.clone());
+            case.model = Some(edit.model.clone());
         }
         case
     }
 
     /// A one-case job of `samples` samples of the edited case, under the baseline's seed
-    /// (common random numbers) or `seed`.
+    /// (common random numbers) or `seed`: validated from the typed spec, no JSON between.
     pub fn job_of(
         &self,
         edit: &CaseEdit,
         samples: u64,
         seed: Option<u64>,
     ) -> Result<Job, DiagnoseError> {
-        let mut case = self.case_object(edit);
-        case.insert("samples".into(), Value::from(samples));
-        let job = serde_json::json!({
-            "model": self.raw["model"],
-            "seed": seed.unwrap_or(self.seed),
-            "cases": [Value::Object(case)],
-        });
-        Ok(Job::from_json(&job.to_string(), Path::new("."))?)
+        let spec = JobSpec {
+            model: self.spec.model.clone(),
+            seed: seed.unwrap_or(self.seed),
+            cases: vec![CaseSpec {
+                samples,
+                ..self.case_spec(edit)
+            }],
+        };
+        Ok(Job::new(&spec, Path::new("."))?)
     }
 
     /// The baseline job with the case replaced by the edited one (same name and sample
     /// count), as pretty JSON: the updated job mc-shard and mc-merge run like any other.
     pub fn updated_job_json(&self, edit: &CaseEdit) -> String {
-        let mut raw = self.raw.clone();
-        raw["cases"][self.case_index] = Value::Object(self.case_object(edit));
-        let mut s = serde_json::to_string_pretty(&raw).expect("JSON serialises");
-        s.push('\n');
-        s
+        let mut spec = self.spec.clone();
+        spec.cases[self.case_index] = self.case_spec(edit);
+        spec.to_json()
     }
 }

@@ -19,10 +19,12 @@
 
 use crate::baseline::{Baseline, CaseEdit};
 use crate::errors::DiagnoseError;
+use truss_core::prism::BacklashOptions;
 use truss_job::distribution::DistributionSpec;
 use truss_job::effects::{
     ALUMINIUM_ALPHA, ALUMINIUM_DENSITY, GravitySpec, STANDARD_GRAVITY, ThermalSpec,
 };
+use truss_job::job::{CaseBacklash, ModelSpec};
 
 /// One parameter of a candidate and its plausible range.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -451,10 +453,9 @@ impl Backlash {
         if !baseline.model().joints().is_empty() {
             return Err("the baseline's model already has pin joints with clearance".into());
         }
-        let edit = baseline.derived_case();
-        match edit.model.get("prism") {
-            Some(p) if p.is_object() => Ok(()),
-            _ => Err(
+        match baseline.derived_case().model {
+            ModelSpec::Prism(_) => Ok(()),
+            ModelSpec::File(_) => Err(
                 "the baseline's model is a model file without joints[]: there is no pin joint to loosen (give the model joints, or use a prism job)"
                     .into(),
             ),
@@ -479,19 +480,16 @@ impl Candidate for Backlash {
         if clearance <= 0.0 {
             return Ok(());
         }
-        let Some(serde_json::Value::Object(prism)) = edit.model.get_mut("prism") else {
+        let ModelSpec::Prism(prism) = &mut edit.model else {
             return Err(DiagnoseError::Usage(
                 "backlash: the case's model is not a prism the job generates".into(),
             ));
         };
-        prism
-            .entry("backlash")
-            .or_insert(serde_json::Value::Bool(true));
+        prism.backlash.get_or_insert_with(BacklashOptions::default);
         edit.model_edited = true;
-        edit.case.insert(
-            "backlash".into(),
-            serde_json::json!({ "clearance": DistributionSpec::Constant { value: clearance } }),
-        );
+        edit.case.backlash = Some(CaseBacklash {
+            clearance: DistributionSpec::Constant { value: clearance },
+        });
         Ok(())
     }
 }

@@ -49,83 +49,166 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use truss_core::model_file::ModelFile;
-use truss_core::prism::{BacklashOptions, PrismOptions};
+use truss_core::prism::PrismOptions;
 use truss_core::{Model, Structure};
 
 /// Version of the numerics: bumped whenever the solver or the sampling would give different
 /// numbers for the same job, so that the job id changes and old and new shards never mix.
 pub const NUMERICS_VERSION: u32 = 2;
 
-/// A job file as written.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct JobSpec {
+/// A job file as written: read with [`JobSpec::from_json`], written with
+/// [`JobSpec::to_json`], validated into a [`Job`] by [`Job::new`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, bound(deserialize = "M: Deserialize<'de>"))]
+pub struct JobSpec<M = ModelSpec> {
     /// The default model of every case.
-    pub model: serde_json::Value,
+    pub model: M,
     /// The seed of all random draws.
     pub seed: u64,
     /// The cases, in order.
-    pub cases: Vec<CaseSpec>,
+    pub cases: Vec<CaseSpec<M>>,
 }
 
 /// One case as written.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct CaseSpec {
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, bound(deserialize = "M: Deserialize<'de>"))]
+pub struct CaseSpec<M = ModelSpec> {
     /// Unique name.
     pub name: String,
     /// Number of samples.
     pub samples: u64,
     /// This case's own model, if any.
-    #[serde(default)]
-    pub model: Option<serde_json::Value>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<M>,
     /// Length-error distribution per member group \[mm\].
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub length_errors: BTreeMap<String, DistributionSpec>,
     /// Deterministic effects: self-weight, a temperature field (see [`crate::effects`]).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "EffectsSpec::is_empty")]
     pub effects: EffectsSpec,
     /// Joint clearances drawn per joint and sample; needs a model with joints.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backlash: Option<CaseBacklash>,
 }
 
-/// The prism generator's options as a job writes them; absent fields take Table 1's values.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PrismSpec {
-    stages: usize,
-    side: Option<f64>,
-    height: Option<f64>,
-    batten_area: Option<f64>,
-    batten_modulus: Option<f64>,
-    longeron_area: Option<f64>,
-    longeron_modulus: Option<f64>,
-    diagonal_area: Option<f64>,
-    diagonal_modulus: Option<f64>,
-    diagonal_length: Option<DiagonalLength>,
-    compression_ratio: Option<f64>,
-    backlash: Option<BacklashSpec>,
+/// A model as a job writes it: `{"prism": {...}}` (the paper's prism, any Table 1 value
+/// overridden: see [`truss_core::prism_spec`]), or a model file, `"path.json"` or
+/// `{"file": "path.json"}`, relative to the job file.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ModelSpec {
+    /// The paper's prism with these options.
+    Prism(PrismOptions),
+    /// A model file.
+    File(PathBuf),
 }
 
-/// The prism's backlash joints as a job writes them: `true` for the defaults, or an object
-/// overriding some of `clearance` (mm, the model's own clearance, used when a case draws
-/// none), `tension_factor` (contact stiffness over a longeron's `E·A/h`) and
-/// `compression_ratio` (a loose joint's regularising stiffness over its contact stiffness;
-/// default 0, none).
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(untagged)]
-enum BacklashSpec {
-    Enabled(bool),
-    Options(BacklashFields),
+impl Serialize for ModelSpec {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(Some(1))?;
+        match self {
+            ModelSpec::Prism(o) => m.serialize_entry("prism", o)?,
+            ModelSpec::File(p) => m.serialize_entry("file", p)?,
+        }
+        m.end()
+    }
 }
 
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct BacklashFields {
-    clearance: Option<f64>,
-    tension_factor: Option<f64>,
-    compression_ratio: Option<f64>,
+impl ModelSpec {
+    /// Parses a model as written, naming faults by their JSON path under `path`.
+    pub fn parse(value: &serde_json::Value, path: &str) -> Result<Self, JobError> {
+        let bad = || {
+            JobError::at(
+                path,
+                "expected {\"prism\": {...}}, a model file path, or {\"file\": \"path\"}",
+            )
+        };
+        match value {
+            serde_json::Value::String(file) => Ok(ModelSpec::File(PathBuf::from(file))),
+            serde_json::Value::Object(map) if map.len() == 1 => {
+                let (key, inner) = map.iter().next().expect("one entry");
+                match key.as_str() {
+                    "file" => inner
+                        .as_str()
+                        .map(|f| ModelSpec::File(PathBuf::from(f)))
+                        .ok_or_else(|| JobError::at(&format!("{path}.file"), "expected a path")),
+                    "prism" => {
+                        let at = format!("{path}.prism");
+                        let options: PrismOptions = serde_path_to_error::deserialize(inner)
+                            .map_err(|e| {
+                                let sub = e.path().to_string();
+                                JobError::at(
+                                    &if sub == "." {
+                                        at.clone()
+                                    } else {
+                                        format!("{at}.{sub}")
+                                    },
+                                    &e.into_inner().to_string(),
+                                )
+                            })?;
+                        Ok(ModelSpec::Prism(options))
+                    }
+                    _ => Err(bad()),
+                }
+            }
+            _ => Err(bad()),
+        }
+    }
+
+    /// The model file paths made absolute against `base` (for a job written elsewhere).
+    pub fn absolute(self, base: &Path) -> Self {
+        match self {
+            ModelSpec::File(p) if p.is_relative() => ModelSpec::File(base.join(p)),
+            other => other,
+        }
+    }
+}
+
+impl JobSpec {
+    /// Parses a job's text, naming faults by their JSON path.
+    pub fn from_json(text: &str) -> Result<Self, JobError> {
+        let de = &mut serde_json::Deserializer::from_str(text);
+        let raw: JobSpec<serde_json::Value> =
+            serde_path_to_error::deserialize(de).map_err(|e| {
+                let path = e.path().to_string();
+                let inner = e.into_inner();
+                JobError::Invalid {
+                    path: if path == "." { String::new() } else { path },
+                    message: format!("{inner}"),
+                }
+            })?;
+        let cases = raw
+            .cases
+            .into_iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let model = c
+                    .model
+                    .map(|m| ModelSpec::parse(&m, &format!("cases[{i}].model")))
+                    .transpose()?;
+                Ok(CaseSpec {
+                    name: c.name,
+                    samples: c.samples,
+                    model,
+                    length_errors: c.length_errors,
+                    effects: c.effects,
+                    backlash: c.backlash,
+                })
+            })
+            .collect::<Result<_, JobError>>()?;
+        Ok(JobSpec {
+            model: ModelSpec::parse(&raw.model, "model")?,
+            seed: raw.seed,
+            cases,
+        })
+    }
+
+    /// The job as pretty JSON (a trailing newline included), as `from_json` reads it.
+    pub fn to_json(&self) -> String {
+        let mut s = serde_json::to_string_pretty(self).expect("a job spec always serialises");
+        s.push('\n');
+        s
+    }
 }
 
 /// A case's backlash: the distribution of each joint's clearance \[mm\], drawn per joint
@@ -135,55 +218,6 @@ struct BacklashFields {
 pub struct CaseBacklash {
     /// Clearance distribution \[mm\]; its support must not go below zero.
     pub clearance: DistributionSpec,
-}
-
-/// A diagonal natural length: a number of mm, or `"exact"`.
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(untagged)]
-enum DiagonalLength {
-    Value(f64),
-    Word(Exact),
-}
-
-#[derive(Debug, Clone, Copy, Deserialize)]
-#[serde(rename_all = "snake_case")]
-enum Exact {
-    Exact,
-}
-
-impl PrismSpec {
-    fn options(&self) -> PrismOptions {
-        let d = PrismOptions::with_stages(self.stages);
-        PrismOptions {
-            stages: self.stages,
-            side: self.side.unwrap_or(d.side),
-            height: self.height.unwrap_or(d.height),
-            batten_area: self.batten_area.unwrap_or(d.batten_area),
-            batten_modulus: self.batten_modulus.unwrap_or(d.batten_modulus),
-            longeron_area: self.longeron_area.unwrap_or(d.longeron_area),
-            longeron_modulus: self.longeron_modulus.unwrap_or(d.longeron_modulus),
-            diagonal_area: self.diagonal_area.unwrap_or(d.diagonal_area),
-            diagonal_modulus: self.diagonal_modulus.unwrap_or(d.diagonal_modulus),
-            diagonal_length: match self.diagonal_length {
-                None => d.diagonal_length,
-                Some(DiagonalLength::Value(v)) => Some(v),
-                Some(DiagonalLength::Word(Exact::Exact)) => None,
-            },
-            compression_ratio: self.compression_ratio.unwrap_or(d.compression_ratio),
-            backlash: match self.backlash {
-                None | Some(BacklashSpec::Enabled(false)) => None,
-                Some(BacklashSpec::Enabled(true)) => Some(BacklashOptions::default()),
-                Some(BacklashSpec::Options(f)) => {
-                    let b = BacklashOptions::default();
-                    Some(BacklashOptions {
-                        clearance: f.clearance.unwrap_or(b.clearance),
-                        tension_factor: f.tension_factor.unwrap_or(b.tension_factor),
-                        compression_ratio: f.compression_ratio.unwrap_or(b.compression_ratio),
-                    })
-                }
-            },
-        }
-    }
 }
 
 /// A validated case.
@@ -241,16 +275,7 @@ impl Job {
 
     /// Parses and validates a job's text; model file paths are relative to `base`.
     pub fn from_json(text: &str, base: &Path) -> Result<Self, JobError> {
-        let de = &mut serde_json::Deserializer::from_str(text);
-        let spec: JobSpec = serde_path_to_error::deserialize(de).map_err(|e| {
-            let path = e.path().to_string();
-            let inner = e.into_inner();
-            JobError::Invalid {
-                path: if path == "." { String::new() } else { path },
-                message: format!("{inner}"),
-            }
-        })?;
-        Self::new(&spec, base)
+        Self::new(&JobSpec::from_json(text)?, base)
     }
 
     /// Validates a parsed job.
@@ -391,53 +416,22 @@ impl Job {
 type Resolved = (Arc<Model>, Arc<Structure>, Option<usize>);
 
 /// Builds the model a job names at JSON path `path`.
-fn resolve_model(value: &serde_json::Value, path: &str, base: &Path) -> Result<Resolved, JobError> {
-    let bad = || {
-        JobError::at(
-            path,
-            "expected {\"prism\": {...}}, a model file path, or {\"file\": \"path\"}",
-        )
-    };
-    let (model, stages) = match value {
-        serde_json::Value::String(file) => (read_model(file, path, base)?, None),
-        serde_json::Value::Object(map) if map.len() == 1 => {
-            let (key, inner) = map.iter().next().expect("one entry");
-            match key.as_str() {
-                "file" => {
-                    let file = inner
-                        .as_str()
-                        .ok_or_else(|| JobError::at(&format!("{path}.file"), "expected a path"))?;
-                    (read_model(file, &format!("{path}.file"), base)?, None)
-                }
-                "prism" => {
-                    let at = format!("{path}.prism");
-                    let spec: PrismSpec = serde_path_to_error::deserialize(inner).map_err(|e| {
-                        let sub = e.path().to_string();
-                        JobError::at(
-                            &if sub == "." {
-                                at.clone()
-                            } else {
-                                format!("{at}.{sub}")
-                            },
-                            &e.into_inner().to_string(),
-                        )
-                    })?;
-                    let options = spec.options();
-                    let model = options
-                        .model()
-                        .map_err(|e| JobError::at(&at, &e.to_string()))?;
-                    (model, Some(spec.stages))
-                }
-                _ => return Err(bad()),
-            }
+fn resolve_model(spec: &ModelSpec, path: &str, base: &Path) -> Result<Resolved, JobError> {
+    let (model, stages) = match spec {
+        ModelSpec::File(file) => (read_model(file, path, base)?, None),
+        ModelSpec::Prism(options) => {
+            let at = format!("{path}.prism");
+            let model = options
+                .model()
+                .map_err(|e| JobError::at(&at, &e.to_string()))?;
+            (model, Some(options.stages))
         }
-        _ => return Err(bad()),
     };
     let structure = Structure::new(&model).map_err(|e| JobError::at(path, &e.to_string()))?;
     Ok((Arc::new(model), Arc::new(structure), stages))
 }
 
-fn read_model(file: &str, path: &str, base: &Path) -> Result<Model, JobError> {
+fn read_model(file: &Path, path: &str, base: &Path) -> Result<Model, JobError> {
     let full = base.join(file);
     let text = std::fs::read_to_string(&full).map_err(|e| {
         JobError::at(
