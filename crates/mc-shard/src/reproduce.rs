@@ -15,49 +15,21 @@
 use crate::job::Job;
 use crate::worker::Worker;
 use serde::Serialize;
-use serde::ser::{SerializeMap, Serializer};
 use truss_core::SolveOptions;
-use truss_core::joint::JointSummary;
-
-/// Pairs serialised as a JSON object in their order.
-struct Ordered<T>(Vec<(String, T)>);
-
-impl<T: Serialize> Serialize for Ordered<T> {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut map = s.serialize_map(Some(self.0.len()))?;
-        for (k, v) in &self.0 {
-            map.serialize_entry(k, v)?;
-        }
-        map.end()
-    }
-}
-
-#[derive(Serialize)]
-struct Iteration {
-    iteration: u32,
-    residual: f64,
-    step: f64,
-    alpha: f64,
-    refactorised: bool,
-    slack: Vec<String>,
-}
+use truss_core::output::{EquilibriumById, IterationLine, Ordered, UNITS, Units};
 
 #[derive(Serialize)]
 struct Detail<'a> {
     line: &'a str,
-    units: serde_json::Value,
+    units: Units,
     length_errors: Ordered<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     clearances: Option<Ordered<f64>>,
-    iterations: Vec<Iteration>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    displacements: Option<Ordered<[f64; 3]>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    forces: Option<Ordered<f64>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    slack_cables: Option<Vec<String>>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    joints: Option<Ordered<JointSummary>>,
+    iterations: Vec<IterationLine>,
+    /// The equilibrium by id, when the sample converged (the same type `truss solve`
+    /// prints).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    equilibrium: Option<EquilibriumById>,
 }
 
 /// The line of sample `k` of case `c` (with its newline), and with `detail` the JSON detail.
@@ -79,7 +51,7 @@ pub fn reproduce(job: &Job, c: usize, k: u64, detail: bool) -> String {
     let converged = sample.angles().is_some();
     let detail = Detail {
         line: line.trim_end(),
-        units: serde_json::json!({"length": "mm", "force": "N", "angle": "rad"}),
+        units: UNITS,
         length_errors: Ordered(
             worker
                 .last_errors()
@@ -98,40 +70,8 @@ pub fn reproduce(job: &Job, c: usize, k: u64, detail: bool) -> String {
                     .collect(),
             )
         }),
-        iterations: solver
-            .iteration_log()
-            .iter()
-            .map(|r| Iteration {
-                iteration: r.iteration,
-                residual: r.residual,
-                step: r.step,
-                alpha: r.alpha,
-                refactorised: r.refactorised,
-                slack: r.slack.iter().map(|&m| member_id(m)).collect(),
-            })
-            .collect(),
-        displacements: converged.then(|| {
-            Ordered(
-                (0..model.nodes().len())
-                    .map(|i| (model.nodes()[i].id.clone(), solver.displacement(i)))
-                    .collect(),
-            )
-        }),
-        forces: converged.then(|| {
-            Ordered(
-                (0..model.members().len())
-                    .map(|m| (member_id(m), solver.member_force(m)))
-                    .collect(),
-            )
-        }),
-        slack_cables: converged.then(|| {
-            (0..model.members().len())
-                .filter(|&m| solver.is_slack(m))
-                .map(member_id)
-                .collect()
-        }),
-        joints: (converged && !model.joints().is_empty())
-            .then(|| Ordered(solver.joint_summaries())),
+        iterations: IterationLine::log(model, solver),
+        equilibrium: converged.then(|| EquilibriumById::of(model, solver)),
     };
     let mut text = serde_json::to_string_pretty(&detail).expect("the detail always serialises");
     text.push('\n');

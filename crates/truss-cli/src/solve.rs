@@ -25,40 +25,9 @@
 
 use crate::{CliError, SolveArgs};
 use serde::Serialize;
-use serde::ser::{SerializeMap, Serializer};
 use std::io::Write;
-use truss_core::joint::JointSummary;
-use truss_core::solver::IterationRecord;
+use truss_core::output::{EquilibriumById, IterationLine, UNITS, Units};
 use truss_core::{Model, SolveOptions, Solver};
-
-/// Pairs serialised as a JSON object in their order.
-#[derive(Debug)]
-pub struct Ordered<T>(pub Vec<(String, T)>);
-
-impl<T: Serialize> Serialize for Ordered<T> {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        let mut map = s.serialize_map(Some(self.0.len()))?;
-        for (k, v) in &self.0 {
-            map.serialize_entry(k, v)?;
-        }
-        map.end()
-    }
-}
-
-/// Units of the output.
-#[derive(Debug, Serialize)]
-pub struct Units {
-    length: &'static str,
-    force: &'static str,
-    angle: &'static str,
-}
-
-/// Units used everywhere: mm, N, rad.
-pub const UNITS: Units = Units {
-    length: "mm",
-    force: "N",
-    angle: "rad",
-};
 
 /// The JSON printed by `truss solve`.
 #[derive(Debug, Serialize)]
@@ -88,50 +57,12 @@ pub struct SolveOutput {
     pub tan_theta_y: Option<f64>,
     /// Units.
     pub units: Units,
-    /// Node displacements \[mm\].
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub displacements: Option<Ordered<[f64; 3]>>,
-    /// Member axial forces, tension positive \[N\].
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub forces: Option<Ordered<f64>>,
-    /// Ids of the slack cables.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub slack_cables: Option<Vec<String>>,
-    /// Backlash joints' states, per joint id.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub joints: Option<Ordered<JointSummary>>,
+    /// The equilibrium by id: displacements, forces, slack cables, joints.
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub equilibrium: Option<EquilibriumById>,
     /// Every Newton iteration, with `--iterations`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub iteration_log: Option<Vec<IterationLine>>,
-}
-
-/// One iteration, as printed.
-#[derive(Debug, Serialize)]
-pub struct IterationLine {
-    iteration: u32,
-    residual: f64,
-    step: f64,
-    alpha: f64,
-    refactorised: bool,
-    slack: Vec<String>,
-}
-
-impl IterationLine {
-    /// An iteration record with member ids.
-    pub fn new(model: &Model, r: &IterationRecord) -> Self {
-        Self {
-            iteration: r.iteration,
-            residual: r.residual,
-            step: r.step,
-            alpha: r.alpha,
-            refactorised: r.refactorised,
-            slack: r
-                .slack
-                .iter()
-                .map(|&m| model.members()[m].id.clone())
-                .collect(),
-        }
-    }
 }
 
 /// Parses `ID=MM` length errors into a per-member vector.
@@ -168,17 +99,10 @@ pub fn run(args: &SolveArgs, out: &mut dyn Write) -> Result<(), CliError> {
     };
     let mut solver = Solver::new(&model, options)?;
     let result = solver.solve(&errors);
-    let log = args.iterations.then(|| {
-        solver
-            .iteration_log()
-            .iter()
-            .map(|r| IterationLine::new(&model, r))
-            .collect()
-    });
+    let log = args.iterations.then(|| IterationLine::log(&model, &solver));
     let output = match &result {
         Ok(report) => {
             let d = solver.distortion();
-            let n = model.nodes().len();
             SolveOutput {
                 converged: true,
                 error: None,
@@ -189,26 +113,7 @@ pub fn run(args: &SolveArgs, out: &mut dyn Write) -> Result<(), CliError> {
                 tan_theta_x: d.map(|d| d.tan_theta_x),
                 tan_theta_y: d.map(|d| d.tan_theta_y),
                 units: UNITS,
-                displacements: Some(Ordered(
-                    (0..n)
-                        .map(|i| (model.nodes()[i].id.clone(), solver.displacement(i)))
-                        .collect(),
-                )),
-                forces: Some(Ordered(
-                    model
-                        .members()
-                        .iter()
-                        .enumerate()
-                        .map(|(m, member)| (member.id.clone(), solver.member_force(m)))
-                        .collect(),
-                )),
-                slack_cables: Some(
-                    (0..model.members().len())
-                        .filter(|&m| solver.is_slack(m))
-                        .map(|m| model.members()[m].id.clone())
-                        .collect(),
-                ),
-                joints: (!model.joints().is_empty()).then(|| Ordered(solver.joint_summaries())),
+                equilibrium: Some(EquilibriumById::of(&model, &solver)),
                 iteration_log: log,
             }
         }
@@ -222,10 +127,7 @@ pub fn run(args: &SolveArgs, out: &mut dyn Write) -> Result<(), CliError> {
             tan_theta_x: None,
             tan_theta_y: None,
             units: UNITS,
-            displacements: None,
-            forces: None,
-            slack_cables: None,
-            joints: None,
+            equilibrium: None,
             iteration_log: log,
         },
     };

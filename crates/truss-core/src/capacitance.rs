@@ -9,11 +9,11 @@
 //! L_ij = (C_ij − Σ_{k<j} L_ik·L_jk) / L_jj   (j < i),     L_ii = √(C_ii − Σ_{k<i} L_ik²)
 //! ```
 //!
-//! with the inner products of the `band` module (four interleaved partial sums in a fixed
-//! order), so the factor is the one of a `BandMatrix` of full bandwidth, without its
+//! with inner products of four interleaved partial sums ([`dot`], in a fixed summation
+//! order), so the factor is the one of a banded Cholesky of full bandwidth, without its
 //! padding and without allocating when the slack set changes.
 
-use crate::band::{PIVOT_TOLERANCE, dot};
+use crate::block::PIVOT_TOLERANCE;
 
 /// A symmetric positive-definite matrix of order at most `capacity`, factorisable in place.
 #[derive(Debug, Clone)]
@@ -113,4 +113,24 @@ impl Capacitance {
             }
         }
     }
+}
+
+/// Inner product with four interleaved partial sums, summed in a fixed order.
+#[inline]
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    debug_assert_eq!(a.len(), b.len());
+    let mut s = [0.0f64; 4];
+    let ca = a.chunks_exact(4);
+    let cb = b.chunks_exact(4);
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        s[0] += x[0] * y[0];
+        s[1] += x[1] * y[1];
+        s[2] += x[2] * y[2];
+        s[3] += x[3] * y[3];
+    }
+    for (x, y) in ra.iter().zip(rb) {
+        s[0] += x * y;
+    }
+    (s[0] + s[1]) + (s[2] + s[3])
 }

@@ -70,7 +70,6 @@
 //! our own (no run-time SIMD dispatch), and the pure-Rust `libm` for `atan2`, so the same
 //! input gives the same bits on every x86-64 machine, whatever the thread count.
 
-pub mod band;
 pub mod block;
 mod capacitance;
 pub mod element;
@@ -81,6 +80,7 @@ pub mod measure;
 pub mod model;
 pub mod model_file;
 mod ordering;
+pub mod output;
 pub mod prism;
 pub mod prism_spec;
 pub mod solver;

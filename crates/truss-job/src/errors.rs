@@ -3,15 +3,15 @@
 use std::path::PathBuf;
 
 /// A job that cannot be run.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum JobError {
     /// The job file could not be read.
-    #[error("{}: cannot read: {message}", path.display())]
+    #[error("{}: cannot read: {source}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// The operating system's error.
-        message: String,
+        source: std::io::Error,
     },
     /// A value is invalid; `path` is its JSON path (`cases[2].length_errors.longeron`).
     #[error("{}{message}", if path.is_empty() { String::new() } else { format!("{path}: ") })]

@@ -263,9 +263,9 @@ pub struct Job {
 impl Job {
     /// Reads and validates a job file.
     pub fn read(path: &Path) -> Result<Self, JobError> {
-        let text = std::fs::read_to_string(path).map_err(|e| JobError::Io {
+        let text = std::fs::read_to_string(path).map_err(|source| JobError::Io {
             path: path.to_path_buf(),
-            message: e.to_string(),
+            source,
         })?;
         let base = path.parent().unwrap_or(Path::new("."));
         let mut job = Self::from_json(&text, base).map_err(|e| e.in_file(path))?;
