@@ -9,6 +9,43 @@ use crate::linearised::{ActiveSetFailure, gather_b, scatter_b};
 use crate::structure::Structure;
 use std::sync::Arc;
 
+/// The force "has stopped falling" when it has not halved in this many iterations.
+const STALL_ITERATIONS: u32 = 3;
+
+/// A stalled force is accepted within this factor of the rounding floor (1e-10 of the
+/// largest member force with the default floor): an ill-conditioned tall tower's rounding
+/// noise keeps the steps from shrinking further.
+const STALL_FLOOR_FACTOR: f64 = 1e3;
+
+/// A step that no longer moves (at most this fraction of the displacements) while the
+/// force is more than [`STALL_FLOOR_FACTOR`] times its floor raises the damping.
+const STUCK_STEP: f64 = 1e-10;
+
+/// A line search that takes at least this fraction of the step counts as a full step: the
+/// damping is relaxed, and a switching step that came this far is not followed by a plain
+/// one.
+const FULL_STEP: f64 = 0.5;
+
+/// Relaxing damping multiplies it by this, until it drops below [`DAMPING_OFF`].
+const DAMPING_RELAX: f64 = 0.1;
+
+/// Damping below this is switched off (Newton's method again).
+const DAMPING_OFF: f64 = 1e-8;
+
+/// Raising damping multiplies it by this, starting from [`DAMPING_START`].
+const DAMPING_RAISE: f64 = 10.0;
+
+/// The first damping μ of model steps that stall.
+const DAMPING_START: f64 = 1e-6;
+
+/// Beyond this damping a model step is a scaled steepest descent; if that does not move,
+/// the solve fails.
+const DAMPING_MAX: f64 = 1e8;
+
+/// Converged on the step when it is small and the error it leaves is no larger than it:
+/// a fresh tangent's step, or one whose measured contraction is at most this.
+const CONVERGED_CONTRACTION: f64 = 0.5;
+
 impl Solver {
     /// Steps 1–5 of the module doc.
     pub(super) fn newton(&mut self) -> Result<SolveReport, SolveError> {
@@ -68,7 +105,7 @@ impl Solver {
             } else {
                 stalled += 1;
             }
-            if stalled >= 3 && eval.residual <= 1e3 * floor {
+            if stalled >= STALL_ITERATIONS && eval.residual <= STALL_FLOOR_FACTOR * floor {
                 break;
             }
             if iterations >= opts.max_iterations {
@@ -150,9 +187,9 @@ impl Solver {
             eval = new_eval;
             step = alpha * d_max;
             let u_max = max_abs(&self.u[..n]);
-            let far_from_floor =
-                eval.residual > 1e3 * opts.residual_floor * eval.force_scale.max(self.force_ref);
-            if far_from_floor && step <= 1e-10 * u_max.max(self.scale) {
+            let far_from_floor = eval.residual
+                > STALL_FLOOR_FACTOR * opts.residual_floor * eval.force_scale.max(self.force_ref);
+            if far_from_floor && step <= STUCK_STEP * u_max.max(self.scale) {
                 // A step that no longer moves while the force is far from balanced: damp.
                 if !self.raise_damping() {
                     return Err(SolveError::NotConverged {
@@ -163,12 +200,12 @@ impl Solver {
                 }
                 mode = Mode::Tangent;
                 k_valid = false;
-            } else if self.damping > 0.0 && alpha >= 0.5 {
+            } else if self.damping > 0.0 && alpha >= FULL_STEP {
                 // Full steps again: relax the damping back towards Newton's method.
-                self.damping = if self.damping < 1e-8 {
+                self.damping = if self.damping < DAMPING_OFF {
                     0.0
                 } else {
-                    self.damping * 0.1
+                    self.damping * DAMPING_RELAX
                 };
                 k_valid = false;
             }
@@ -190,7 +227,7 @@ impl Solver {
             // step on the current piece.
             self.update_slack();
             let switched = fresh && self.factor_slack != self.step_slack;
-            self.plain_step = switched && alpha < 0.5 && self.slack == self.step_slack;
+            self.plain_step = switched && alpha < FULL_STEP && self.slack == self.step_slack;
             // Pin the cables whose switch failed for the next (plain) step, release the rest.
             for ((p, f), s) in self
                 .pinned
@@ -205,7 +242,7 @@ impl Solver {
             let contraction = step / prev_step;
             let small = step <= opts.step_tolerance * u_max;
             let undamped = self.damping == 0.0;
-            if small && !curved && undamped && (fresh || contraction <= 0.5) {
+            if small && !curved && undamped && (fresh || contraction <= CONVERGED_CONTRACTION) {
                 break;
             }
             poor = !fresh && !curved && contraction > opts.reuse_contraction;
@@ -222,14 +259,15 @@ impl Solver {
         })
     }
 
-    /// Raises the Levenberg damping of model steps tenfold (from 1e-6); false once it is
-    /// beyond 1e8, where a model step is a scaled steepest descent and still does not move.
+    /// Raises the Levenberg damping of model steps by [`DAMPING_RAISE`] (from
+    /// [`DAMPING_START`]); false once it is beyond [`DAMPING_MAX`], where a model step is a
+    /// scaled steepest descent and still does not move.
     fn raise_damping(&mut self) -> bool {
-        self.damping = (self.damping * 10.0).max(1e-6);
+        self.damping = (self.damping * DAMPING_RAISE).max(DAMPING_START);
         // A damped step is a plain descent step: no cable pinned or switched.
         self.pinned.fill(false);
         self.plain_step = false;
-        self.damping <= 1e8
+        self.damping <= DAMPING_MAX
     }
 
     /// `d = −r` (the zero slot kept zero).
