@@ -161,7 +161,27 @@ fn another_jobs_file_and_a_held_lock_are_refused() {
     assert_eq!(blocked.status.code(), Some(5));
     assert!(String::from_utf8_lossy(&blocked.stderr).contains("another process is writing"));
     drop(holder);
-    assert!(run(&a, &out, &["--range", "10..40"]).status.success());
+    // Another test of this binary may have forked a child while `holder` was open: the
+    // child shares the lock until it execs (the descriptor is close-on-exec). Wait until
+    // the lock is free, as the next writer would find it.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(10);
+    while std::fs::File::open(&locked_path)
+        .unwrap()
+        .try_lock()
+        .is_err()
+    {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the lock was never released"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let after = run(&a, &out, &["--range", "10..40"]);
+    assert!(
+        after.status.success(),
+        "{}",
+        String::from_utf8_lossy(&after.stderr)
+    );
 }
 
 /// `reproduce` prints exactly the shard's line; `--detail` carries that line, the draws and

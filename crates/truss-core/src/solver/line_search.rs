@@ -7,8 +7,8 @@ use super::{Evaluation, Solver};
 use crate::SolveError;
 
 impl Solver {
-    /// Line search along `self.d` from `self.u` (see the module doc); moves `self.u`,
-    /// `self.r` and `self.states` to the accepted point and returns α, its evaluation and
+    /// Line search along `self.work.d` from `self.work.u` (see the module doc); moves `self.work.u`,
+    /// `self.work.r` and `self.work.states` to the accepted point and returns α, its evaluation and
     /// `max |d|`.
     ///
     /// Keeps a bracket: `a`, the largest α seen with `φ' < 0` and sufficient decrease, and
@@ -40,12 +40,12 @@ impl Solver {
         const ETA: f64 = 0.5;
         const C1: f64 = 1e-4;
         let n = self.structure.free;
-        let phi0 = dot_n(&self.r[..n], &self.d[..n]);
-        let d_max = max_abs(&self.d[..n]);
-        let u_max = max_abs(&self.u[..n]);
-        let trust = (4.0 * u_max.max(self.scale)).min(0.2 * self.shortest_member());
+        let phi0 = dot_n(&self.work.r[..n], &self.work.d[..n]);
+        let d_max = max_abs(&self.work.d[..n]);
+        let u_max = max_abs(&self.work.u[..n]);
+        let trust = (4.0 * u_max.max(self.sample.scale)).min(0.2 * self.shortest_member());
         let cap = trust / d_max.max(f64::MIN_POSITIVE);
-        let work0 = dot_n(&self.loads[..n], &self.u[..n]);
+        let work0 = dot_n(&self.sample.loads[..n], &self.work.u[..n]);
         let energy0 = current.strain - work0;
         let noise = 1e-11 * (current.strain.abs() + work0.abs());
         if !expand && (phi0 >= 0.0 || phi0.is_nan()) {
@@ -82,8 +82,8 @@ impl Solver {
                 0.5 * (a + b)
             };
             let eval = self.try_step(alpha);
-            let phi = dot_n(&self.trial_r[..n], &self.d[..n]);
-            let energy = eval.strain - dot_n(&self.loads[..n], &self.trial_u[..n]);
+            let phi = dot_n(&self.work.trial_r[..n], &self.work.d[..n]);
+            let energy = eval.strain - dot_n(&self.sample.loads[..n], &self.work.trial_u[..n]);
             let decrease = energy <= energy0 + C1 * alpha * phi0.min(0.0) + noise;
             if phi.is_finite() && decrease {
                 steepest = steepest.min(phi);
@@ -133,16 +133,16 @@ impl Solver {
     /// sign. The breakpoints
     /// are walked in order from `φ'(0)` to the first root of `φ'`.
     pub(super) fn predict_alpha(&mut self, phi0: f64, cap: f64) -> f64 {
-        let d = &self.d;
+        let d = &self.work.d;
         let mut curvature = 0.0;
-        self.breakpoints.clear();
+        self.work.breakpoints.clear();
         for (((c, st), m), &k) in self
             .structure
             .members
             .iter()
-            .zip(&self.states)
-            .zip(&self.members)
-            .zip(&self.tension)
+            .zip(&self.work.states)
+            .zip(&self.sample.members)
+            .zip(&self.sample.tension)
         {
             let dv = [
                 d[c.link.dofs[3]] - d[c.link.dofs[0]],
@@ -158,15 +158,17 @@ impl Solver {
                 if at > 0.0 && at < cap {
                     let jump = (1.0 - m.compression_ratio) * k * along * along;
                     // Slack → taut stiffens; taut → slack softens.
-                    self.breakpoints
+                    self.work
+                        .breakpoints
                         .push((at, if st.slack { jump } else { -jump }));
                 }
             }
         }
-        self.breakpoints
+        self.work
+            .breakpoints
             .sort_unstable_by(|x, y| x.0.partial_cmp(&y.0).unwrap_or(std::cmp::Ordering::Equal));
         let (mut alpha, mut slope, mut phi) = (0.0, curvature, phi0);
-        for &(at, jump) in &self.breakpoints {
+        for &(at, jump) in &self.work.breakpoints {
             if slope > 0.0 {
                 let root = alpha - phi / slope;
                 if root <= at {
@@ -187,25 +189,31 @@ impl Solver {
     /// Evaluates the trial point `u + α·d` into the trial buffers.
     pub(super) fn try_step(&mut self, alpha: f64) -> Evaluation {
         self.evaluations += 1;
-        for ((t, u), d) in self.trial_u.iter_mut().zip(&self.u).zip(&self.d) {
+        for ((t, u), d) in self
+            .work
+            .trial_u
+            .iter_mut()
+            .zip(&self.work.u)
+            .zip(&self.work.d)
+        {
             *t = u + alpha * d;
         }
         evaluate_with(
             &self.structure,
-            &self.members,
-            self.tension.iter().copied(),
-            &self.loads,
-            &self.trial_u,
-            &mut self.trial_r,
-            &mut self.trial_states,
+            &self.sample.members,
+            self.sample.tension.iter().copied(),
+            &self.sample.loads,
+            &self.work.trial_u,
+            &mut self.work.trial_r,
+            &mut self.work.trial_states,
         )
     }
 
     /// Makes the trial point current.
     pub(super) fn accept(&mut self) {
-        std::mem::swap(&mut self.u, &mut self.trial_u);
-        std::mem::swap(&mut self.r, &mut self.trial_r);
-        std::mem::swap(&mut self.states, &mut self.trial_states);
+        std::mem::swap(&mut self.work.u, &mut self.work.trial_u);
+        std::mem::swap(&mut self.work.r, &mut self.work.trial_r);
+        std::mem::swap(&mut self.work.states, &mut self.work.trial_states);
     }
 
     pub(super) fn shortest_member(&self) -> f64 {

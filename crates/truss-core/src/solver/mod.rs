@@ -177,39 +177,69 @@ enum Mode {
 pub struct Solver {
     structure: Arc<Structure>,
     options: SolveOptions,
-    members: Vec<AxialMember>,
-    /// Each member's `k = E·A/L₀` for the current sample \[N/mm\].
-    tension: Vec<f64>,
-    states: Vec<AxialState>,
-    trial_states: Vec<AxialState>,
-    /// Each joint's clearance for the current sample \[mm\].
-    clearances: Vec<f64>,
-    slack: Vec<bool>,
-    factor_slack: Vec<bool>,
-    locked: Vec<bool>,
-    failures: Vec<crate::block::PivotFailure>,
-    stretch: Vec<f64>,
-    active: ActiveSet,
-    loads: Vec<f64>,
-    u: Vec<f64>,
-    r: Vec<f64>,
-    d: Vec<f64>,
-    trial_u: Vec<f64>,
-    trial_r: Vec<f64>,
-    scratch: Vec<f64>,
-    k: BlockBandMatrix,
+    /// Nominal length of the shortest member \[mm\] (caps a line search's steps).
+    shortest: f64,
+    /// The current sample's constants.
+    sample: SampleConstants,
+    /// The point, its states and the vectors the iteration works in.
+    work: Workspace,
+    /// The factorised stiffness and the slack set it belongs to.
+    factor: FactorCache,
+    /// What the next step carries over from the last one.
+    step: StepState,
     log: Vec<IterationRecord>,
     last: Option<SolveReport>,
     evaluations: u32,
-    breakpoints: Vec<(f64, f64)>,
-    /// Nominal length of the shortest member \[mm\] (caps a line search's steps).
-    shortest: f64,
+}
+
+/// What a sample sets: members, loads and clearances, and its scales.
+#[derive(Debug, Clone)]
+struct SampleConstants {
+    members: Vec<AxialMember>,
+    /// Each member's `k = E·A/L₀` for the current sample \[N/mm\].
+    tension: Vec<f64>,
+    /// Each joint's clearance for the current sample \[mm\].
+    clearances: Vec<f64>,
+    loads: Vec<f64>,
     /// The sample's largest |initial stretch| \[mm\]: the scale of its displacements
     /// (with the shortest member's 1e-6, for samples driven by loads alone).
     scale: f64,
     /// The sample's force scale \[N\]: the largest `k·|s₀|` of its members and of its
     /// loads, so that a solution whose forces all vanish still has a rounding floor.
     force_ref: f64,
+}
+
+/// The current point `u`, its out-of-balance force `r` and member states, the step `d`,
+/// a trial point's, and scratch.
+#[derive(Debug, Clone)]
+struct Workspace {
+    states: Vec<AxialState>,
+    trial_states: Vec<AxialState>,
+    slack: Vec<bool>,
+    u: Vec<f64>,
+    r: Vec<f64>,
+    d: Vec<f64>,
+    trial_u: Vec<f64>,
+    trial_r: Vec<f64>,
+    scratch: Vec<f64>,
+    stretch: Vec<f64>,
+    breakpoints: Vec<(f64, f64)>,
+    failures: Vec<crate::block::PivotFailure>,
+}
+
+/// The factorised model stiffness in `k` and the slack set it was assembled for; the
+/// linearised problem's active set and its capacitance factor.
+#[derive(Debug, Clone)]
+struct FactorCache {
+    k: BlockBandMatrix,
+    factor_slack: Vec<bool>,
+    locked: Vec<bool>,
+    active: ActiveSet,
+}
+
+/// What the next step carries over from the last one.
+#[derive(Debug, Clone)]
+struct StepState {
     /// Levenberg damping μ of model steps (`K + μ·diag(K)`): 0, until steps stall.
     damping: f64,
     /// The next model step keeps the current slack set (the last one's switching did not
@@ -253,37 +283,45 @@ impl Solver {
         let cables = structure.members.iter().filter(|c| c.is_cable).count();
         let zero_state = members[0].state([0.0; 3]);
         Self {
-            k: BlockBandMatrix::new(structure.nominal.blocks(), structure.bandwidth()),
             options,
-            tension: members.iter().map(AxialMember::tension_stiffness).collect(),
-            members,
-            states: vec![zero_state; m],
-            trial_states: vec![zero_state; m],
-            clearances: structure.joints.iter().map(|j| j.clearance).collect(),
-            slack: vec![false; m],
-            factor_slack: vec![false; m],
-            locked: vec![false; m],
-            failures: Vec::with_capacity(64),
-            stretch: vec![0.0; m],
-            active: ActiveSet::new(cables),
-            loads: vec![0.0; n + 1],
-            u: vec![0.0; n + 1],
-            r: vec![0.0; n + 1],
-            d: vec![0.0; n + 1],
-            trial_u: vec![0.0; n + 1],
-            trial_r: vec![0.0; n + 1],
-            scratch: vec![0.0; n + 1],
+            shortest: structure.shortest_member(),
+            sample: SampleConstants {
+                tension: members.iter().map(AxialMember::tension_stiffness).collect(),
+                members,
+                clearances: structure.joints.iter().map(|j| j.clearance).collect(),
+                loads: vec![0.0; n + 1],
+                scale: 0.0,
+                force_ref: 0.0,
+            },
+            work: Workspace {
+                states: vec![zero_state; m],
+                trial_states: vec![zero_state; m],
+                slack: vec![false; m],
+                u: vec![0.0; n + 1],
+                r: vec![0.0; n + 1],
+                d: vec![0.0; n + 1],
+                trial_u: vec![0.0; n + 1],
+                trial_r: vec![0.0; n + 1],
+                scratch: vec![0.0; n + 1],
+                stretch: vec![0.0; m],
+                breakpoints: Vec::with_capacity(m),
+                failures: Vec::with_capacity(64),
+            },
+            factor: FactorCache {
+                k: BlockBandMatrix::new(structure.nominal.blocks(), structure.bandwidth()),
+                factor_slack: vec![false; m],
+                locked: vec![false; m],
+                active: ActiveSet::new(cables),
+            },
+            step: StepState {
+                damping: 0.0,
+                plain_step: false,
+                step_slack: vec![false; m],
+                pinned: vec![false; m],
+            },
             log: Vec::new(),
             last: None,
             evaluations: 0,
-            breakpoints: Vec::with_capacity(m),
-            shortest: structure.shortest_member(),
-            scale: 0.0,
-            force_ref: 0.0,
-            damping: 0.0,
-            plain_step: false,
-            step_slack: vec![false; m],
-            pinned: vec![false; m],
             structure,
         }
     }
@@ -342,7 +380,7 @@ impl Solver {
                 s.joints.len()
             )));
         }
-        for (i, (g, c)) in self.clearances.iter_mut().zip(&s.joints).enumerate() {
+        for (i, (g, c)) in self.sample.clearances.iter_mut().zip(&s.joints).enumerate() {
             let v = p.clearances.get(i).copied().unwrap_or(c.clearance);
             if !(v.is_finite() && v >= 0.0) {
                 return Err(SolveError::Input(format!(
@@ -360,26 +398,28 @@ impl Solver {
                     c.model_member
                 )));
             }
-            let gap = s.band_clearance(c, &self.clearances);
-            self.members[i] = s.nominal_member(c, e, gap);
-            self.tension[i] = self.members[i].tension_stiffness();
+            let gap = s.band_clearance(c, &self.sample.clearances);
+            self.sample.members[i] = s.nominal_member(c, e, gap);
+            self.sample.tension[i] = self.sample.members[i].tension_stiffness();
         }
-        self.scale = self
+        self.sample.scale = self
+            .sample
             .members
             .iter()
             .map(|m| m.initial_stretch.abs())
             .fold(1e-6 * self.shortest, f64::max);
-        self.force_ref = self
+        self.sample.force_ref = self
+            .sample
             .members
             .iter()
-            .zip(&self.tension)
+            .zip(&self.sample.tension)
             .map(|(m, k)| k * m.initial_stretch.abs())
-            .chain(self.loads.iter().map(|f| f.abs()))
+            .chain(self.sample.loads.iter().map(|f| f.abs()))
             .fold(0.0, f64::max);
-        self.damping = 0.0;
-        self.plain_step = false;
-        self.pinned.fill(false);
-        self.loads.copy_from_slice(&s.loads);
+        self.step.damping = 0.0;
+        self.step.plain_step = false;
+        self.step.pinned.fill(false);
+        self.sample.loads.copy_from_slice(&s.loads);
         for (node, f) in p.extra_loads.iter().enumerate() {
             if f.iter().any(|x| !x.is_finite()) {
                 return Err(SolveError::Input(format!(
@@ -390,7 +430,7 @@ impl Solver {
             for (dir, &fd) in f.iter().enumerate() {
                 let dof = s.node_dofs[node][dir];
                 if dof != crate::structure::FIXED {
-                    self.loads[dof as usize] += fd;
+                    self.sample.loads[dof as usize] += fd;
                 }
             }
         }
@@ -415,7 +455,7 @@ impl Solver {
             if d == crate::structure::FIXED {
                 0.0
             } else {
-                self.u[d as usize]
+                self.work.u[d as usize]
             }
         })
     }
@@ -424,8 +464,8 @@ impl Solver {
     /// a member in clearance holes, the sum of its two halves.
     pub fn member_force(&self, m: usize) -> f64 {
         match &self.structure.members[m].band {
-            Some(b) => self.states[m].force + self.states[b.partner].force,
-            None => self.states[m].force,
+            Some(b) => self.work.states[m].force + self.work.states[b.partner].force,
+            None => self.work.states[m].force,
         }
     }
 
@@ -436,12 +476,12 @@ impl Solver {
         let c = &s.joints[j];
         let half = &s.members[c.member];
         let partner = half.band.as_ref().map_or(c.member, |b| b.partner);
-        let (t, p) = (&self.states[c.member], &self.states[partner]);
-        let gap = s.band_clearance(half, &self.clearances);
+        let (t, p) = (&self.work.states[c.member], &self.work.states[partner]);
+        let gap = s.band_clearance(half, &self.sample.clearances);
         joint_state(
             JointEnd {
                 at_start: c.at_start,
-                clearance: self.clearances[j],
+                clearance: self.sample.clearances[j],
                 tension_stiffness: c.tension_stiffness,
             },
             BandState {
@@ -466,7 +506,7 @@ impl Solver {
 
     /// Whether model member `m` is a slack cable at the last equilibrium.
     pub fn is_slack(&self, m: usize) -> bool {
-        self.structure.members[m].band.is_none() && self.states[m].slack
+        self.structure.members[m].band.is_none() && self.work.states[m].slack
     }
 
     /// Number of the model's cables that are slack at the current point.
@@ -483,7 +523,9 @@ impl Solver {
             .iter()
             .filter(|c| {
                 let b = self.structure.members[c.member].band.as_ref();
-                b.is_some_and(|b| self.states[c.member].slack && self.states[b.partner].slack)
+                b.is_some_and(|b| {
+                    self.work.states[c.member].slack && self.work.states[b.partner].slack
+                })
             })
             .count() as u32
     }
@@ -526,14 +568,15 @@ impl Solver {
     /// tests: Π is minimal at a stable equilibrium).
     pub fn potential_energy(&self) -> f64 {
         let strain: f64 = self
+            .work
             .states
             .iter()
             .map(|s| 0.5 * s.stiffness * s.elongation * s.elongation)
             .sum();
         strain
             - dot_n(
-                &self.loads[..self.structure.free],
-                &self.u[..self.structure.free],
+                &self.sample.loads[..self.structure.free],
+                &self.work.u[..self.structure.free],
             )
     }
 }

@@ -62,21 +62,21 @@ impl Solver {
                 mode
             }
             Err(_) => {
-                self.u.fill(0.0);
+                self.work.u.fill(0.0);
                 Mode::Tangent
             }
         };
         let mut eval = evaluate_with(
             &structure,
-            &self.members,
-            self.tension.iter().copied(),
-            &self.loads,
-            &self.u,
-            &mut self.r,
-            &mut self.states,
+            &self.sample.members,
+            self.sample.tension.iter().copied(),
+            &self.sample.loads,
+            &self.work.u,
+            &mut self.work.r,
+            &mut self.work.states,
         );
         self.update_slack();
-        // Whether `self.k` holds the factorised model stiffness of `self.factor_slack`.
+        // Whether `self.factor.k` holds the factorised model stiffness of `self.factor.factor_slack`.
         let mut k_valid = false;
         let mut prev_step = f64::INFINITY;
         let mut step = 0.0;
@@ -92,7 +92,7 @@ impl Solver {
                 });
             }
             // The force test's floor: relative to the largest force.
-            let floor = opts.residual_floor * eval.force_scale.max(self.force_ref);
+            let floor = opts.residual_floor * eval.force_scale.max(self.sample.force_ref);
             if eval.residual == 0.0 || eval.residual <= floor {
                 break;
             }
@@ -118,7 +118,7 @@ impl Solver {
             iterations += 1;
 
             // Choose the step.
-            self.step_slack.copy_from_slice(&self.slack);
+            self.step.step_slack.copy_from_slice(&self.work.slack);
             let mut fresh = false;
             let mut shift = 0.0;
             let mut curved = false;
@@ -128,12 +128,13 @@ impl Solver {
             }
             if mode == Mode::Chord {
                 let basis = structure.basis.as_ref().expect("chord mode needs a basis");
-                let states = &self.states;
+                let states = &self.work.states;
                 let nc = basis.cables.len();
                 if self
+                    .factor
                     .active
                     .set_slack_from(|c| states[basis.cables[c]].slack, nc)
-                    && self.active.factor(basis).is_err()
+                    && self.factor.active.factor(basis).is_err()
                 {
                     mode = Mode::Tangent;
                 }
@@ -142,16 +143,18 @@ impl Solver {
                 Mode::Chord => {
                     let basis = structure.basis.as_ref().expect("chord mode needs a basis");
                     self.negate_residual_into_step();
-                    self.active.apply_inverse(&structure, basis, &mut self.d);
+                    self.factor
+                        .active
+                        .apply_inverse(&structure, basis, &mut self.work.d);
                 }
                 Mode::Tangent => {
                     let reuse = k_valid
                         && opts.reuse_factorisation
                         && !poor
-                        && self.slack == self.factor_slack;
+                        && self.work.slack == self.factor.factor_slack;
                     if reuse {
                         self.negate_residual_into_step();
-                        self.k.solve_in_place(&mut self.d[..n]);
+                        self.factor.k.solve_in_place(&mut self.work.d[..n]);
                     } else {
                         match self.model_step(iterations, &mut factorisations)? {
                             Step::Newton { shift: mu } => {
@@ -186,10 +189,12 @@ impl Solver {
             };
             eval = new_eval;
             step = alpha * d_max;
-            let u_max = max_abs(&self.u[..n]);
+            let u_max = max_abs(&self.work.u[..n]);
             let far_from_floor = eval.residual
-                > STALL_FLOOR_FACTOR * opts.residual_floor * eval.force_scale.max(self.force_ref);
-            if far_from_floor && step <= STUCK_STEP * u_max.max(self.scale) {
+                > STALL_FLOOR_FACTOR
+                    * opts.residual_floor
+                    * eval.force_scale.max(self.sample.force_ref);
+            if far_from_floor && step <= STUCK_STEP * u_max.max(self.sample.scale) {
                 // A step that no longer moves while the force is far from balanced: damp.
                 if !self.raise_damping() {
                     return Err(SolveError::NotConverged {
@@ -200,12 +205,12 @@ impl Solver {
                 }
                 mode = Mode::Tangent;
                 k_valid = false;
-            } else if self.damping > 0.0 && alpha >= FULL_STEP {
+            } else if self.step.damping > 0.0 && alpha >= FULL_STEP {
                 // Full steps again: relax the damping back towards Newton's method.
-                self.damping = if self.damping < DAMPING_OFF {
+                self.step.damping = if self.step.damping < DAMPING_OFF {
                     0.0
                 } else {
-                    self.damping * DAMPING_RELAX
+                    self.step.damping * DAMPING_RELAX
                 };
                 k_valid = false;
             }
@@ -226,22 +231,24 @@ impl Solver {
             // search stopped short and the slack set is unchanged) is followed by a plain
             // step on the current piece.
             self.update_slack();
-            let switched = fresh && self.factor_slack != self.step_slack;
-            self.plain_step = switched && alpha < FULL_STEP && self.slack == self.step_slack;
+            let switched = fresh && self.factor.factor_slack != self.step.step_slack;
+            self.step.plain_step =
+                switched && alpha < FULL_STEP && self.work.slack == self.step.step_slack;
             // Pin the cables whose switch failed for the next (plain) step, release the rest.
             for ((p, f), s) in self
+                .step
                 .pinned
                 .iter_mut()
-                .zip(&self.factor_slack)
-                .zip(&self.step_slack)
+                .zip(&self.factor.factor_slack)
+                .zip(&self.step.step_slack)
             {
-                *p = self.plain_step && f != s;
+                *p = self.step.plain_step && f != s;
             }
 
             // Convergence on the step.
             let contraction = step / prev_step;
             let small = step <= opts.step_tolerance * u_max;
-            let undamped = self.damping == 0.0;
+            let undamped = self.step.damping == 0.0;
             if small && !curved && undamped && (fresh || contraction <= CONVERGED_CONTRACTION) {
                 break;
             }
@@ -263,23 +270,23 @@ impl Solver {
     /// [`DAMPING_START`]); false once it is beyond [`DAMPING_MAX`], where a model step is a
     /// scaled steepest descent and still does not move.
     fn raise_damping(&mut self) -> bool {
-        self.damping = (self.damping * DAMPING_RAISE).max(DAMPING_START);
+        self.step.damping = (self.step.damping * DAMPING_RAISE).max(DAMPING_START);
         // A damped step is a plain descent step: no cable pinned or switched.
-        self.pinned.fill(false);
-        self.plain_step = false;
-        self.damping <= DAMPING_MAX
+        self.step.pinned.fill(false);
+        self.step.plain_step = false;
+        self.step.damping <= DAMPING_MAX
     }
 
     /// `d = −r` (the zero slot kept zero).
     fn negate_residual_into_step(&mut self) {
         let n = self.structure.free;
-        for (d, r) in self.d[..n].iter_mut().zip(&self.r[..n]) {
+        for (d, r) in self.work.d[..n].iter_mut().zip(&self.work.r[..n]) {
             *d = -r;
         }
-        self.d[n] = 0.0;
+        self.work.d[n] = 0.0;
     }
 
-    /// Step 1: solves the linearised problem into `self.u`, and says how to go on: chord
+    /// Step 1: solves the linearised problem into `self.work.u`, and says how to go on: chord
     /// steps with the active set's Woodbury inverse when the model has a cable basis and
     /// the final slack set leaves no soft direction, model steps otherwise.
     fn linearised(
@@ -287,19 +294,19 @@ impl Solver {
         structure: &Structure,
         factorisations: &mut u32,
     ) -> Result<Mode, ActiveSetFailure> {
-        for (st, m) in self.stretch.iter_mut().zip(&self.members) {
+        for (st, m) in self.work.stretch.iter_mut().zip(&self.sample.members) {
             *st = m.initial_stretch;
         }
         match &structure.basis {
             Some(basis) => {
-                self.active.solve_linearised(
+                self.factor.active.solve_linearised(
                     structure,
                     basis,
-                    &self.stretch,
-                    &self.loads,
-                    &mut self.u,
+                    &self.work.stretch,
+                    &self.sample.loads,
+                    &mut self.work.u,
                 )?;
-                Ok(if self.active.is_soft() {
+                Ok(if self.factor.active.is_soft() {
                     Mode::Tangent
                 } else {
                     Mode::Chord
@@ -321,49 +328,50 @@ impl Solver {
     ) -> Result<(), ActiveSetFailure> {
         let n = s.free;
         // Start from the all-taut solution's slack set.
-        self.u.copy_from_slice(&self.loads);
+        self.work.u.copy_from_slice(&self.sample.loads);
         for (m, c) in s.members.iter().enumerate() {
             scatter_b(
                 s,
                 m,
-                -c.rigidity / c.natural_length * self.stretch[m],
-                &mut self.u,
+                -c.rigidity / c.natural_length * self.work.stretch[m],
+                &mut self.work.u,
             );
         }
-        s.nominal.solve_in_place(&mut self.u[..n]);
+        s.nominal.solve_in_place(&mut self.work.u[..n]);
         for (m, c) in s.members.iter().enumerate() {
-            self.factor_slack[m] =
-                c.is_cable && c.sense * (gather_b(s, m, &self.u) + self.stretch[m]) < 0.0;
+            self.factor.factor_slack[m] =
+                c.is_cable && c.sense * (gather_b(s, m, &self.work.u) + self.work.stretch[m]) < 0.0;
         }
         for _ in 0..50 {
-            let slack = &self.factor_slack;
-            s.assemble_material(&mut self.k, |m| {
+            let slack = &self.factor.factor_slack;
+            s.assemble_material(&mut self.factor.k, |m| {
                 if slack[m] {
                     s.members[m].compression_ratio
                 } else {
                     1.0
                 }
             });
-            self.u.copy_from_slice(&self.loads);
+            self.work.u.copy_from_slice(&self.sample.loads);
             for (m, c) in s.members.iter().enumerate() {
                 let mut k = c.rigidity / c.natural_length;
-                if self.factor_slack[m] {
+                if self.factor.factor_slack[m] {
                     k *= c.compression_ratio;
                 }
-                scatter_b(s, m, -k * self.stretch[m], &mut self.u);
+                scatter_b(s, m, -k * self.work.stretch[m], &mut self.work.u);
             }
             *factorisations += 1;
-            self.k
+            self.factor
+                .k
                 .factor()
                 .map_err(|_| ActiveSetFailure::NotPositiveDefinite)?;
-            self.k.solve_in_place(&mut self.u[..n]);
+            self.factor.k.solve_in_place(&mut self.work.u[..n]);
             let mut settled = true;
             for (m, c) in s.members.iter().enumerate() {
-                let slack =
-                    c.is_cable && c.sense * (gather_b(s, m, &self.u) + self.stretch[m]) < 0.0;
-                if slack != self.factor_slack[m] {
+                let slack = c.is_cable
+                    && c.sense * (gather_b(s, m, &self.work.u) + self.work.stretch[m]) < 0.0;
+                if slack != self.factor.factor_slack[m] {
                     settled = false;
-                    self.factor_slack[m] = slack;
+                    self.factor.factor_slack[m] = slack;
                 }
             }
             if settled {

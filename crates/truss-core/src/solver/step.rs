@@ -37,20 +37,20 @@ const PIN_FACTOR: f64 = 1e3;
 /// What a model step produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum Step {
-    /// `self.d` is the model's step, and `self.k` the factorised `K(S)` of the slack set in
-    /// `self.factor_slack` (plus a Levenberg shift `μ`, usually 0).
+    /// `self.work.d` is the model's step, and `self.factor.k` the factorised `K(S)` of the slack set in
+    /// `self.factor.factor_slack` (plus a Levenberg shift `μ`, usually 0).
     Newton {
         /// The shift μ.
         shift: f64,
     },
-    /// `self.d` is a direction of negative curvature of `K(S)`; `self.k` is not usable.
+    /// `self.work.d` is a direction of negative curvature of `K(S)`; `self.factor.k` is not usable.
     Curvature,
 }
 
 impl Solver {
     /// Records which cables are slack at the current point.
     pub(super) fn update_slack(&mut self) {
-        for (s, st) in self.slack.iter_mut().zip(&self.states) {
+        for (s, st) in self.work.slack.iter_mut().zip(&self.work.states) {
             *s = st.slack;
         }
     }
@@ -60,7 +60,7 @@ impl Solver {
     pub(super) fn slack_indices(&self) -> Vec<usize> {
         let s = &self.structure;
         (0..s.model_members)
-            .filter(|&m| self.slack[m] && s.members[m].band.is_none())
+            .filter(|&m| self.work.slack[m] && s.members[m].band.is_none())
             .collect()
     }
 
@@ -78,31 +78,32 @@ impl Solver {
         factorisations: &mut u32,
     ) -> Result<Step, SolveError> {
         let n = self.structure.free;
-        self.factor_slack.copy_from_slice(&self.slack);
-        self.locked.fill(false);
+        self.factor.factor_slack.copy_from_slice(&self.work.slack);
+        self.factor.locked.fill(false);
         let mut pieces = 0;
         let mut engagements = 0;
         while pieces < MAX_MODEL_PIECES {
             self.assemble_model();
-            if self.damping > 0.0 {
-                self.k.scale_diagonal(1.0 + self.damping);
+            if self.step.damping > 0.0 {
+                self.factor.k.scale_diagonal(1.0 + self.step.damping);
             }
             *factorisations += 1;
-            self.k.factor_collecting(&mut self.failures, 1);
-            let mut shift = self.damping;
+            self.factor.k.factor_collecting(&mut self.work.failures, 1);
+            let mut shift = self.step.damping;
             // Plain steps (the current slack set, no switching): while damped, and after a
             // switching step that did not come true.
-            let damped = self.damping > 0.0 || self.plain_step;
-            if let Some(&first) = self.failures.first() {
+            let damped = self.step.damping > 0.0 || self.step.plain_step;
+            if let Some(&first) = self.work.failures.first() {
                 if !damped && first.pivot < 0.0 && engagements < self.structure.members.len() {
-                    self.k
-                        .failed_pivot_direction(first.index, &mut self.scratch);
+                    self.factor
+                        .k
+                        .failed_pivot_direction(first.index, &mut self.work.scratch);
                     if self.engage_first_cable() {
                         engagements += 1;
                         continue;
                     }
-                    self.d.copy_from_slice(&self.scratch);
-                    self.d[n] = 0.0;
+                    self.work.d.copy_from_slice(&self.work.scratch);
+                    self.work.d[n] = 0.0;
                     if self.negative_curvature() {
                         return Ok(Step::Curvature);
                     }
@@ -114,23 +115,23 @@ impl Solver {
             pieces += 1;
             // Right-hand side: −r, corrected for the cables switched in the model.
             for i in 0..n {
-                self.d[i] = -self.r[i];
+                self.work.d[i] = -self.work.r[i];
             }
-            self.d[n] = 0.0;
+            self.work.d[n] = 0.0;
             let s = &*self.structure;
             for (m, c) in s.members.iter().enumerate() {
                 if let Some(k_model) = self.model_stiffness(m) {
-                    let st = &self.states[m];
+                    let st = &self.work.states[m];
                     let extra = (k_model - st.stiffness) * st.elongation;
                     for d in 0..3 {
                         let f = extra * st.direction[d];
-                        self.d[c.link.dofs[d]] += f;
-                        self.d[c.link.dofs[3 + d]] -= f;
+                        self.work.d[c.link.dofs[d]] += f;
+                        self.work.d[c.link.dofs[3 + d]] -= f;
                     }
                 }
             }
-            self.d[n] = 0.0;
-            self.k.solve_in_place(&mut self.d[..n]);
+            self.work.d[n] = 0.0;
+            self.factor.k.solve_in_place(&mut self.work.d[..n]);
             if damped {
                 // Plain steps keep the current slack set: with no switched cables the
                 // direction −(K + μ·diag K)⁻¹·r descends, whatever the model says, and
@@ -144,63 +145,66 @@ impl Solver {
                 if !c.is_cable {
                     continue;
                 }
-                let st = &self.states[m];
+                let st = &self.work.states[m];
                 let dv = [
-                    self.d[c.link.dofs[3]] - self.d[c.link.dofs[0]],
-                    self.d[c.link.dofs[4]] - self.d[c.link.dofs[1]],
-                    self.d[c.link.dofs[5]] - self.d[c.link.dofs[2]],
+                    self.work.d[c.link.dofs[3]] - self.work.d[c.link.dofs[0]],
+                    self.work.d[c.link.dofs[4]] - self.work.d[c.link.dofs[1]],
+                    self.work.d[c.link.dofs[5]] - self.work.d[c.link.dofs[2]],
                 ];
                 let e = st.elongation
                     + st.direction[0] * dv[0]
                     + st.direction[1] * dv[1]
                     + st.direction[2] * dv[2];
-                let slack = c.sense * e < 0.0 && c.compression_ratio < 1.0 && !self.locked[m];
-                if slack != self.factor_slack[m] {
+                let slack =
+                    c.sense * e < 0.0 && c.compression_ratio < 1.0 && !self.factor.locked[m];
+                if slack != self.factor.factor_slack[m] {
                     settled = false;
-                    self.factor_slack[m] = slack;
+                    self.factor.factor_slack[m] = slack;
                 }
             }
             if settled {
                 return Ok(Step::Newton { shift });
             }
         }
-        // No settled set: refactorise for the last set so that `self.k` matches
-        // `self.factor_slack`, and keep the step computed before (the line search copes).
-        self.scratch.copy_from_slice(&self.d);
+        // No settled set: refactorise for the last set so that `self.factor.k` matches
+        // `self.factor.factor_slack`, and keep the step computed before (the line search copes).
+        self.work.scratch.copy_from_slice(&self.work.d);
         let shift = self
             .factor_model(iteration, factorisations, false)?
             .expect("a shifted factorisation never stops at a curvature");
-        self.d.copy_from_slice(&self.scratch);
+        self.work.d.copy_from_slice(&self.work.scratch);
         Ok(Step::Newton { shift })
     }
 
-    /// Assembles the model's `K(S)` for `S = self.factor_slack` and factorises it (with the
+    /// Assembles the model's `K(S)` for `S = self.factor.factor_slack` and factorises it (with the
     /// solver's current damping μ₀ as a Levenberg shift `K + μ·diag(K)`); where it is not
     /// positive definite, retries with μ = 1e-9 (or 100·μ₀), ×100 each time, up to
     /// max(1, 1000·μ₀). Returns `Some(μ)` (the `Option` is for callers that stop at a curvature;
     /// this one never does unless `allow_curvature`, which leaves the direction of the first
-    /// negative pivot in `self.d` and returns `None`).
+    /// negative pivot in `self.work.d` and returns `None`).
     pub(super) fn factor_model(
         &mut self,
         iteration: u32,
         factorisations: &mut u32,
         allow_curvature: bool,
     ) -> Result<Option<f64>, SolveError> {
-        let mut shift = self.damping;
-        let limit = (1e3 * self.damping).max(1.0);
+        let mut shift = self.step.damping;
+        let limit = (1e3 * self.step.damping).max(1.0);
         loop {
             self.assemble_model();
             let s = &*self.structure;
             if shift > 0.0 {
-                self.k.scale_diagonal(1.0 + shift);
+                self.factor.k.scale_diagonal(1.0 + shift);
             }
             *factorisations += 1;
-            match self.k.factor() {
+            match self.factor.k.factor() {
                 Ok(()) => return Ok(Some(shift)),
                 Err(e) => {
                     if allow_curvature && shift == 0.0 && e.pivot < 0.0 {
-                        self.k.failed_pivot_direction(e.index, &mut self.d);
-                        self.d[s.free] = 0.0;
+                        self.factor
+                            .k
+                            .failed_pivot_direction(e.index, &mut self.work.d);
+                        self.work.d[s.free] = 0.0;
                         return Ok(None);
                     }
                     shift = if shift == 0.0 { 1e-9 } else { shift * 100.0 };
@@ -217,14 +221,14 @@ impl Solver {
         }
     }
 
-    /// With `self.scratch` a direction of negative curvature `v` of `K(S)`, finds the slack
+    /// With `self.work.scratch` a direction of negative curvature `v` of `K(S)`, finds the slack
     /// cable of `S` that engages first along `±v` (the sign that lowers the energy first,
     /// else the other), makes it taut and locked in `S`, and returns true; false if no slack
     /// cable engages.
     fn engage_first_cable(&mut self) -> bool {
         let n = self.structure.free;
-        let v = &self.scratch;
-        let descent = if dot_n(&self.r[..n], &v[..n]) > 0.0 {
+        let v = &self.work.scratch;
+        let descent = if dot_n(&self.work.r[..n], &v[..n]) > 0.0 {
             -1.0
         } else {
             1.0
@@ -232,10 +236,10 @@ impl Solver {
         for sign in [descent, -descent] {
             let mut first: Option<(f64, usize)> = None;
             for (m, c) in self.structure.members.iter().enumerate() {
-                if !(c.is_cable && self.factor_slack[m]) {
+                if !(c.is_cable && self.factor.factor_slack[m]) {
                     continue;
                 }
-                let st = &self.states[m];
+                let st = &self.work.states[m];
                 let dv = [
                     v[c.link.dofs[3]] - v[c.link.dofs[0]],
                     v[c.link.dofs[4]] - v[c.link.dofs[1]],
@@ -252,24 +256,28 @@ impl Solver {
                 }
             }
             if let Some((_, m)) = first {
-                self.factor_slack[m] = false;
-                self.locked[m] = true;
+                self.factor.factor_slack[m] = false;
+                self.factor.locked[m] = true;
                 return true;
             }
         }
         false
     }
 
-    /// Assembles into `self.k` the model stiffness `K(S)` of the module doc at the current
-    /// point, for `S = self.factor_slack`: the true tangent when `S` is the current slack set.
+    /// Assembles into `self.factor.k` the model stiffness `K(S)` of the module doc at the current
+    /// point, for `S = self.factor.factor_slack`: the true tangent when `S` is the current slack set.
     pub(super) fn assemble_model(&mut self) {
         let s = &*self.structure;
-        s.begin_assembly(&mut self.k);
-        for (m, (c, st)) in s.members.iter().zip(&self.states).enumerate() {
+        s.begin_assembly(&mut self.factor.k);
+        for (m, (c, st)) in s.members.iter().zip(&self.work.states).enumerate() {
             let stiffness = self.model_stiffness(m).unwrap_or(st.stiffness);
-            s.add_block(&mut self.k, &c.link, &st.tangent_block_with(stiffness));
+            s.add_block(
+                &mut self.factor.k,
+                &c.link,
+                &st.tangent_block_with(stiffness),
+            );
         }
-        s.set_identity_rows(&mut self.k);
+        s.set_identity_rows(&mut self.factor.k);
     }
 
     /// A cable's axial stiffness in the model when it differs from its present one: pinned
@@ -281,11 +289,11 @@ impl Solver {
         if !c.is_cable {
             return None;
         }
-        let k = self.tension[m];
-        if self.pinned[m] {
+        let k = self.sample.tension[m];
+        if self.step.pinned[m] {
             Some(PIN_FACTOR * k)
-        } else if self.factor_slack[m] != self.states[m].slack {
-            Some(if self.factor_slack[m] {
+        } else if self.factor.factor_slack[m] != self.work.states[m].slack {
+            Some(if self.factor.factor_slack[m] {
                 c.compression_ratio * k
             } else {
                 k
@@ -295,21 +303,21 @@ impl Solver {
         }
     }
 
-    /// Turns the direction left in `self.d` by a failed factorisation (whose curvature
+    /// Turns the direction left in `self.work.d` by a failed factorisation (whose curvature
     /// `dᵀK d` is the negative pivot) into a step direction: scaled to max |d| = 1 mm and
     /// signed so that the energy decreases along it. Returns false if it is unusable.
     pub(super) fn negative_curvature(&mut self) -> bool {
         let n = self.structure.free;
-        let scale = max_abs(&self.d[..n]);
+        let scale = max_abs(&self.work.d[..n]);
         if !(scale.is_finite() && scale > 0.0) {
             return false;
         }
-        let sign = if dot_n(&self.r[..n], &self.d[..n]) > 0.0 {
+        let sign = if dot_n(&self.work.r[..n], &self.work.d[..n]) > 0.0 {
             -1.0
         } else {
             1.0
         };
-        for x in &mut self.d[..n] {
+        for x in &mut self.work.d[..n] {
             *x *= sign / scale;
         }
         true

@@ -54,13 +54,13 @@ fn residual_and_energy(solver: &mut Solver, u: &[f64]) -> (Vec<f64>, f64) {
     let mut r = vec![0.0; u.len()];
     evaluate(
         &solver.structure,
-        &solver.members,
-        &solver.loads,
+        &solver.sample.members,
+        &solver.sample.loads,
         u,
         &mut r,
-        &mut solver.states,
+        &mut solver.work.states,
     );
-    solver.u.copy_from_slice(u);
+    solver.work.u.copy_from_slice(u);
     (r, solver.potential_energy())
 }
 
@@ -119,7 +119,10 @@ fn tangent_is_the_residual_jacobian() {
         let (mut solver, u) = solver_with(seed, backlash);
         let (_, _) = residual_and_energy(&mut solver, &u);
         solver.update_slack();
-        solver.factor_slack.copy_from_slice(&solver.slack);
+        solver
+            .factor
+            .factor_slack
+            .copy_from_slice(&solver.work.slack);
         solver.assemble_model();
         let n = solver.structure.free;
         let h = 1e-7;
@@ -134,9 +137,9 @@ fn tangent_is_the_residual_jacobian() {
                 let k = if is_fixed(&solver, i) {
                     0.0 // identity rows of fixed directions are not part of the Jacobian
                 } else {
-                    solver.k.get(i, j)
+                    solver.factor.k.get(i, j)
                 };
-                let scale = solver.k.get(i, i).abs().max(1.0);
+                let scale = solver.factor.k.get(i, i).abs().max(1.0);
                 assert!(
                     (fd - k).abs() <= 1e-6 * scale,
                     "seed {seed} K[{i}][{j}]: fd {fd} vs {k}"
