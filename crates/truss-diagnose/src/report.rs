@@ -257,19 +257,32 @@ pub fn markdown(
     plots: &[String],
 ) -> String {
     let mut m = String::new();
-    let push = |m: &mut String, s: &str| {
-        m.push_str(s);
-        m.push('\n');
-    };
+    verdict_section(&mut m, baseline, d);
+    data_section(&mut m, baseline, measured, d);
+    disagreement_section(&mut m, d);
+    effect_section(&mut m, baseline, d);
+    before_after_section(&mut m, d);
+    method_section(&mut m, d, plots);
+    m
+}
+
+/// Appends `s` and a newline.
+fn push(m: &mut String, s: &str) {
+    m.push_str(s);
+    m.push('\n');
+}
+
+/// The title, the verdict and the fitted values.
+fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
     push(
-        &mut m,
+        m,
         &format!(
             "# Diagnosis of case `{}` against the measurements\n",
             baseline.case_name
         ),
     );
     push(
-        &mut m,
+        m,
         &format!(
             "**Verdict: {}** — named effect: `{}`.\n",
             match d.verdict {
@@ -281,11 +294,11 @@ pub fn markdown(
             named_effect(d)
         ),
     );
-    push(&mut m, &format!("{}.\n", d.reason));
+    push(m, &format!("{}.\n", d.reason));
     if let Some(i) = d.named {
         let c = &d.candidates[i];
         push(
-            &mut m,
+            m,
             &format!(
                 "Fitted: {}.\n",
                 c.parameters
@@ -296,10 +309,14 @@ pub fn markdown(
             ),
         );
     }
+}
+
+/// `## Data`: what was read, and what was not used.
+fn data_section(m: &mut String, baseline: &Baseline, measured: &Measured, d: &Diagnosis) {
     let r = &measured.report;
-    push(&mut m, "## Data\n");
+    push(m, "## Data\n");
     push(
-        &mut m,
+        m,
         &format!(
             "{} rows from `{}`: {} specimens, {} used, {} left out for a missing node{}. Nodes compared: {}. Job `{}` (id {}), seed {}, N = {} simulated samples per evaluation.\n",
             r.rows,
@@ -329,7 +346,7 @@ pub fn markdown(
     );
     if !r.unknown_nodes.is_empty() || !r.rare_nodes.is_empty() {
         push(
-            &mut m,
+            m,
             &format!(
                 "Ignored: unknown nodes [{}], nodes measured by fewer than half of the specimens [{}].\n",
                 r.unknown_nodes.join(", "),
@@ -339,7 +356,7 @@ pub fn markdown(
     }
     if let Some(rows) = r.member_rows {
         push(
-            &mut m,
+            m,
             &format!(
                 "Member measurements: {rows} used{}.\n",
                 if r.unknown_members.is_empty() {
@@ -353,14 +370,18 @@ pub fn markdown(
             ),
         );
     }
-    push(&mut m, "## 1. Where simulation and measurement disagree\n");
+}
+
+/// `## 1.`: the statistics that disagree, before any effect is added.
+fn disagreement_section(m: &mut String, d: &Diagnosis) {
+    push(m, "## 1. Where simulation and measurement disagree\n");
     let mut flagged: Vec<&Statistic> = d.before.statistics.iter().filter(|s| s.disagrees).collect();
     flagged.sort_by(|a, b| a.p_value.total_cmp(&b.p_value));
     if flagged.is_empty() {
-        push(&mut m, "No statistic disagrees (Holm-adjusted p < 0.05).\n");
+        push(m, "No statistic disagrees (Holm-adjusted p < 0.05).\n");
     } else {
         push(
-            &mut m,
+            m,
             &format!(
                 "{} of {} statistics disagree (Holm-adjusted p < 0.05); the strongest:\n",
                 flagged.len(),
@@ -368,12 +389,12 @@ pub fn markdown(
             ),
         );
         for s in flagged.iter().take(12) {
-            push(&mut m, &format!("- {} (p = {:.1e})", s.words, s.p_value));
+            push(m, &format!("- {} (p = {:.1e})", s.words, s.p_value));
         }
-        push(&mut m, "");
+        push(m, "");
     }
     push(
-        &mut m,
+        m,
         &format!(
             "Tolerance ({}): {}.\n",
             d.before.tolerance.bands,
@@ -384,13 +405,17 @@ pub fn markdown(
             }
         ),
     );
-    push(&mut m, "## 2. Which effect\n");
+}
+
+/// `## 2.` and `## 3.`: the candidates, their fits and tests, and what was added.
+fn effect_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
+    push(m, "## 2. Which effect\n");
     push(
-        &mut m,
+        m,
         "| candidate | k | ℓ | Λ | p | ΔBIC | Vuong z | fitted |\n|---|---|---|---|---|---|---|---|",
     );
     push(
-        &mut m,
+        m,
         &format!(
             "| baseline | 0 | {:.1} | | | 0 | | |",
             d.baseline_log_likelihood
@@ -400,7 +425,7 @@ pub fn markdown(
     order.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
     for c in order {
         push(
-            &mut m,
+            m,
             &format!(
                 "| {}{} | {} | {:.1} | {:.1} | {:.2e} | {:.1} | {} | {} |",
                 c.name,
@@ -421,15 +446,15 @@ pub fn markdown(
         );
     }
     push(
-        &mut m,
+        m,
         "\n\\* significant at 0.05/K (Bonferroni). Vuong z: how much closer the named effect fits than this one (below 1.96: not significantly).\n",
     );
     for (n, why) in &d.skipped {
-        push(&mut m, &format!("- `{n}` not tried: {why}."));
+        push(m, &format!("- `{n}` not tried: {why}."));
     }
-    push(&mut m, "\n## 3. The updated job\n");
+    push(m, "\n## 3. The updated job\n");
     push(
-        &mut m,
+        m,
         &match d.named {
             Some(i) => format!(
                 "`updated-job.json` is the baseline job with `{}` added to case `{}` at its fitted values; run it with mc-shard and mc-merge like any other job.\n",
@@ -438,10 +463,14 @@ pub fn markdown(
             None => "No effect was added: `updated-job.json` is the baseline job.\n".into(),
         },
     );
-    push(&mut m, "## 4. Before and after\n");
+}
+
+/// `## 4.`: the discrepancy before and after, statistic by statistic.
+fn before_after_section(m: &mut String, d: &Diagnosis) {
+    push(m, "## 4. Before and after\n");
     let after_e = d.after.as_ref().map_or(d.before.energy, |a| a.energy);
     push(
-        &mut m,
+        m,
         &format!(
             "Overall discrepancy (energy distance, standardised): before {:.4} (p = {:.3}), after {:.4}{}.\n",
             d.before.energy,
@@ -457,7 +486,7 @@ pub fn markdown(
         ),
     );
     push(
-        &mut m,
+        m,
         "| statistic | measured | before: simulated | before: comparison [95 % CI] | | after: simulated | after: comparison [95 % CI] | |\n|---|---|---|---|---|---|---|---|",
     );
     let key = |s: &Statistic| {
@@ -490,22 +519,26 @@ pub fn markdown(
             )
         });
         push(
-            &mut m,
+            m,
             &format!("{}{}", before.trim_end_matches('|').trim_end(), after),
         );
     }
     push(
-        &mut m,
+        m,
         "\nEvery statistic, before and after, with its interval and p-value, is in `diagnosis.json`.\n",
     );
+}
+
+/// The plots and `## Method`: how every number was found.
+fn method_section(m: &mut String, d: &Diagnosis, plots: &[String]) {
     if !plots.is_empty() {
-        push(&mut m, "Plots:\n");
+        push(m, "Plots:\n");
         for p in plots {
-            push(&mut m, &format!("- ![{p}]({p})"));
+            push(m, &format!("- ![{p}]({p})"));
         }
-        push(&mut m, "");
+        push(m, "");
     }
-    push(&mut m, "## Method\n");
+    push(m, "## Method\n");
     for (k, v) in [
         ("Likelihood", METHOD.likelihood),
         ("Fit", METHOD.fit),
@@ -515,14 +548,13 @@ pub fn markdown(
         ("Statistics", METHOD.statistics),
         ("Discrepancy", METHOD.discrepancy),
     ] {
-        push(&mut m, &format!("- **{k}.** {v}"));
+        push(m, &format!("- **{k}.** {v}"));
     }
     push(
-        &mut m,
+        m,
         &format!(
             "\n{} simulations ({} solves) in {:.1} s.",
             d.work.0, d.work.1, d.work.2
         ),
     );
-    m
 }
