@@ -36,10 +36,10 @@ step() { echo "e2e: $*" >&2; }
 
 cat > "$WORK/job.json" <<'EOF'
 {
-  "model": {"prism": {"stages": 5}},
+  "model": {"prism": {"stages": 30}},
   "seed": 4242,
   "cases": [
-    {"name": "sigma-0.0063", "samples": 240000,
+    {"name": "sigma-0.0063", "samples": 120000,
      "length_errors": {"batten": {"normal": {"sigma": 0.0063}}, "longeron": {"normal": {"sigma": 0.0063}}}}
   ]
 }
@@ -68,9 +68,11 @@ step "merged report is byte-identical to the single-process report"
 step "cancelling one array task mid-shard, then resubmitting what is missing"
 eval "$("$SLURM/submit.sh" "$WORK/job.json" --shards 8 --out "$WORK/killed")"
 victim=5
-# Shards of 30,000 samples (about a second of one core): the cancel lands mid-shard. With
-# 3,000 a shard could finish between its first lines and the scancel, leaving nothing missing.
-shard_file="$WORK/killed/$(printf 'shard-%010d-%010d.jsonl' 150000 180000)"
+# Shards of 15,000 samples of the 30-stage truss (about 150 µs each: two seconds of one
+# core): the cancel lands mid-shard. Shards of 30,000 samples of the 5-stage truss (0.2 s
+# on two threads) sometimes finished between their first lines and the scancel on a loaded
+# machine, leaving nothing missing.
+shard_file="$WORK/killed/$(printf 'shard-%010d-%010d.jsonl' 75000 90000)"
 deadline=$((SECONDS + 300))
 until [[ -f "$shard_file" ]] && (( $(wc -l < "$shard_file") > 1 )); do
     (( SECONDS < deadline )) || fail "task $victim never started writing"
