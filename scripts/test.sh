@@ -21,6 +21,9 @@ command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null || scripts
 echo "test: cargo test --workspace" >&2
 cargo test --workspace --quiet
 
+echo "test: the cross-check against faer (a large build the default tests do without)" >&2
+cargo test --release --quiet -p truss-core --features cross-checks --lib -- block::tests::agrees_with_faer_dense
+
 echo "test: the slow statistical checks (#[ignore]d in the default run), in release" >&2
 # Only the crates that have such tests: building every test target in release costs minutes.
 for crate in $(grep -rl '#\[ignore' crates/*/src crates/*/tests | cut -d/ -f2 | sort -u); do
