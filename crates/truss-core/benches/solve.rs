@@ -164,7 +164,8 @@ fn bench(stages: usize, samples: usize) {
 }
 
 /// A dense Cholesky (faer) of a 45 × 45 matrix the shape of the 5-stage tangent, for
-/// comparison with the block band.
+/// comparison with the block band (with `--features cross-checks`, which brings faer).
+#[cfg(feature = "cross-checks")]
 fn dense_comparison() {
     use faer::Mat;
     let n = 45;
@@ -181,6 +182,11 @@ fn dense_comparison() {
         black_box(a.llt(faer::Side::Lower).unwrap());
     });
     println!("dense faer LLT of a 45 × 45 matrix: {t:.2} µs per factorisation (for comparison)");
+}
+
+#[cfg(not(feature = "cross-checks"))]
+fn dense_comparison() {
+    println!("dense faer LLT: run with --features cross-checks for the comparison");
 }
 
 fn main() {
