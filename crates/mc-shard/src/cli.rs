@@ -152,6 +152,14 @@ pub enum CliError {
     /// Writing output failed.
     #[error("cannot write output: {0}")]
     Output(#[from] std::io::Error),
+    /// Stopped by SIGINT or SIGTERM; `kept` sample lines are in the shard files.
+    #[error("{}", crate::interrupt::message(*.kept))]
+    Interrupted {
+        /// The signal.
+        signal: crate::interrupt::Signal,
+        /// Sample lines in the shard files, kept for a rerun.
+        kept: u64,
+    },
 }
 
 impl From<JobError> for CliError {
@@ -166,6 +174,7 @@ impl CliError {
         match self {
             CliError::Run(e) => run_exit_code(e),
             CliError::Output(_) => exit::IO,
+            CliError::Interrupted { signal, .. } => signal.exit_code(),
         }
     }
 }
@@ -205,6 +214,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
             if threads == 0 {
                 return Err(RunError::Usage("--threads must be at least 1".into()).into());
             }
+            crate::interrupt::install()?;
             let summary = run_shard(
                 &job,
                 &a.out,
@@ -214,6 +224,12 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
                     quiet: a.quiet,
                 },
             )?;
+            if let Some(signal) = summary.interrupted {
+                return Err(CliError::Interrupted {
+                    signal,
+                    kept: summary.resumed + summary.computed,
+                });
+            }
             if summary.already_complete {
                 writeln!(
                     out,
@@ -283,6 +299,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
                 stale_after: seconds("stale-after", a.stale_after)?,
                 quiet: a.quiet,
             };
+            crate::interrupt::install()?;
             let mut failed = None;
             crate::work::work(&job, &a.out, &options, |action| {
                 let line = serde_json::to_string(action).expect("actions serialise");
@@ -290,6 +307,12 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
                     failed.get_or_insert(e);
                 }
             })?;
+            if let Some(signal) = crate::interrupt::requested() {
+                return Err(CliError::Interrupted {
+                    signal,
+                    kept: kept_samples(&job, &a.out, a.shards),
+                });
+            }
             match failed {
                 Some(e) => Err(e.into()),
                 None => Ok(()),
@@ -322,7 +345,21 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     }
 }
 
-/// The number of cores.
+/// The sample lines in the shard files of the `shards` shards of `job` in `dir` (complete
+/// or partial): what a rerun keeps.
+pub fn kept_samples(job: &Job, dir: &std::path::Path, shards: u64) -> u64 {
+    shard_states(job, dir, shards).map_or(0, |states| {
+        states
+            .iter()
+            .map(|(r, s)| match s {
+                ShardState::Complete => r.len(),
+                ShardState::Partial(n) => *n,
+                ShardState::Missing | ShardState::Bad(_) => 0,
+            })
+            .sum()
+    })
+}
+
 /// The default thread or worker count: the machine's cores.
 pub fn default_threads() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())

@@ -41,6 +41,7 @@
 
 pub mod cli;
 pub mod errors;
+pub mod interrupt;
 pub mod progress;
 pub mod reproduce;
 pub mod runner;
