@@ -182,6 +182,13 @@ async fn run_children(
     signals: &mut Signals,
 ) -> Result<(Vec<String>, Option<Signal>), RunError> {
     let k = ranges.len();
+    // Progress: the sample lines the shard files hold before any child starts (kept from
+    // an interrupted run: not counted in the rate), then the lines they gain.
+    let mut counted = vec![(0u64, 0u64); k];
+    let mut kept = 0;
+    for (r, (offset, lines)) in ranges.iter().zip(counted.iter_mut()) {
+        kept += count_new_lines(&options.out.join(r.file_name()), offset, lines, r.len());
+    }
     let limit = Arc::new(tokio::sync::Semaphore::new(options.workers.max(1)));
     let (cancel_tx, cancel_rx) = tokio::sync::watch::channel(false);
     let mut tasks = tokio::task::JoinSet::new();
@@ -233,9 +240,7 @@ async fn run_children(
             }
         });
     }
-    // Progress: newlines the shard files have gained.
-    let mut progress = Progress::new("run-all", job.samples(), 0, options.quiet);
-    let mut counted = vec![(0u64, 0u64); k];
+    let mut progress = Progress::new("run-all", job.samples(), kept, options.quiet);
     let mut failures = Vec::new();
     let mut interrupted = None;
     let mut tick = tokio::time::interval(Duration::from_millis(200));
