@@ -18,7 +18,8 @@
 //!
 //! ## Commands (see `mc-shard --help`)
 //!
-//! - `mc-shard plan JOB.json` — job id, cases, sample count, a suggested split.
+//! - `mc-shard plan JOB.json` — job id, cases, sample count, an estimate of the CPU time and
+//!   a suggestion: this machine, and a cluster split only for a job of more than ten minutes.
 //! - `mc-shard run --job JOB.json --out DIR [--shard I/K | --range A..B] [--threads T]` —
 //!   one shard (selection in [`select`]); crash-safe and resumable ([`shard`]).
 //! - `mc-shard reproduce --job JOB.json --case NAME --sample K [--detail]` — the exact line
