@@ -38,7 +38,8 @@
 //! The scheme every truss-mc binary shares (`truss-exit`): 0 success, 1 internal error, 2
 //! usage error or a range outside the job, 3 invalid job (the message gives the JSON path of
 //! the fault), 4 a file could not be read or written, 5 the shard file is in the way
-//! (another job's, locked by another process, or damaged).
+//! (another job's, locked by another process, or damaged), 130 / 143 `run` or `work`
+//! stopped by SIGINT / SIGTERM, every finished sample kept ([`interrupt`]).
 
 pub mod cli;
 pub mod errors;
