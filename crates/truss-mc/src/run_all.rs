@@ -142,6 +142,7 @@ async fn run_and_merge(
     let mut signals = Signals::new()?;
     let (failures, interrupted) = run_children(exe, job, ranges, options, &mut signals).await?;
     if let Some(signal) = interrupted {
+        // `kept` is counted by `run_all` once the runtime has stopped.
         return Err(RunAllError::Interrupted { signal, kept: 0 });
     }
     if !failures.is_empty() {
