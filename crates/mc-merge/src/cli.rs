@@ -90,6 +90,11 @@ pub struct Args {
     /// Do not draw the SVG plots.
     #[arg(long)]
     pub no_plots: bool,
+
+    /// Verify, then write every sample as a row of FILE (.csv with a header row, or .jsonl),
+    /// numbers as the shards hold them. Without --out no statistics are computed.
+    #[arg(long, value_name = "FILE")]
+    pub export: Option<PathBuf>,
 }
 
 /// The statistical settings of a merge, recorded in the report.

@@ -137,6 +137,7 @@ pub mod analysis;
 pub mod cli;
 pub mod definitions;
 pub mod errors;
+pub mod export;
 pub mod gof;
 pub mod load;
 pub mod plot;

@@ -9,11 +9,14 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     // Usage errors exit with clap's code 2, which is ExitCodes::USAGE.
     let args = Args::parse();
-    let result = args
-        .validate()
-        .and_then(|options| mc_merge::run(&options, &mut std::io::stdout().lock()));
+    let export = args.export.clone();
+    let out = &mut std::io::stdout().lock();
+    let result = args.validate().and_then(|options| match &export {
+        Some(to) => mc_merge::export::run(&options, to, out),
+        None => mc_merge::run(&options, out).map(|_| ()),
+    });
     match result {
-        Ok(_) => ExitCode::from(ExitCodes::OK),
+        Ok(()) => ExitCode::from(ExitCodes::OK),
         Err(e) => {
             eprintln!("mc-merge: error: {e}");
             ExitCode::from(e.exit_code())

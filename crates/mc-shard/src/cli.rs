@@ -152,6 +152,14 @@ pub enum CliError {
     /// Writing output failed.
     #[error("cannot write output: {0}")]
     Output(#[from] std::io::Error),
+    /// Stopped by SIGINT or SIGTERM; `kept` sample lines are in the shard files.
+    #[error("{}", crate::interrupt::message(*.kept))]
+    Interrupted {
+        /// The signal.
+        signal: crate::interrupt::Signal,
+        /// Sample lines in the shard files, kept for a rerun.
+        kept: u64,
+    },
 }
 
 impl From<JobError> for CliError {
@@ -166,6 +174,7 @@ impl CliError {
         match self {
             CliError::Run(e) => run_exit_code(e),
             CliError::Output(_) => exit::IO,
+            CliError::Interrupted { signal, .. } => signal.exit_code(),
         }
     }
 }
@@ -205,6 +214,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
             if threads == 0 {
                 return Err(RunError::Usage("--threads must be at least 1".into()).into());
             }
+            crate::interrupt::install()?;
             let summary = run_shard(
                 &job,
                 &a.out,
@@ -214,6 +224,12 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
                     quiet: a.quiet,
                 },
             )?;
+            if let Some(signal) = summary.interrupted {
+                return Err(CliError::Interrupted {
+                    signal,
+                    kept: summary.resumed + summary.computed,
+                });
+            }
             if summary.already_complete {
                 writeln!(
                     out,
@@ -283,6 +299,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
                 stale_after: seconds("stale-after", a.stale_after)?,
                 quiet: a.quiet,
             };
+            crate::interrupt::install()?;
             let mut failed = None;
             crate::work::work(&job, &a.out, &options, |action| {
                 let line = serde_json::to_string(action).expect("actions serialise");
@@ -290,6 +307,12 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
                     failed.get_or_insert(e);
                 }
             })?;
+            if let Some(signal) = crate::interrupt::requested() {
+                return Err(CliError::Interrupted {
+                    signal,
+                    kept: kept_samples(&job, &a.out, a.shards),
+                });
+            }
             match failed {
                 Some(e) => Err(e.into()),
                 None => Ok(()),
@@ -322,7 +345,21 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     }
 }
 
-/// The number of cores.
+/// The sample lines in the shard files of the `shards` shards of `job` in `dir` (complete
+/// or partial): what a rerun keeps.
+pub fn kept_samples(job: &Job, dir: &std::path::Path, shards: u64) -> u64 {
+    shard_states(job, dir, shards).map_or(0, |states| {
+        states
+            .iter()
+            .map(|(r, s)| match s {
+                ShardState::Complete => r.len(),
+                ShardState::Partial(n) => *n,
+                ShardState::Missing | ShardState::Bad(_) => 0,
+            })
+            .sum()
+    })
+}
+
 /// The default thread or worker count: the machine's cores.
 pub fn default_threads() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
@@ -351,8 +388,8 @@ fn plan(a: &PlanArgs, out: &mut dyn Write) -> Result<(), CliError> {
         per_case.push(each);
     }
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
-    // About five minutes of one core per cluster task.
-    let cluster_shards = ((cpu_seconds / 300.0).ceil() as u64).clamp(1, job.samples());
+    let advice = Advice::new(cpu_seconds, cores, job.samples());
+    let cluster_shards = advice.cluster_shards.unwrap_or(1);
     if a.json {
         let value = serde_json::json!({
             "job_id": job.id,
@@ -362,7 +399,8 @@ fn plan(a: &PlanArgs, out: &mut dyn Write) -> Result<(), CliError> {
                 "parameters": c.parameters, "seconds_per_sample": t,
             })).collect::<Vec<_>>(),
             "estimated_cpu_seconds": cpu_seconds,
-            "suggested": {"local_threads": cores, "cluster_shards": cluster_shards},
+            "suggested": {"local_threads": cores, "cluster_shards": cluster_shards,
+                          "cluster_advised": advice.cluster_shards.is_some()},
         });
         writeln!(
             out,
@@ -396,10 +434,103 @@ fn plan(a: &PlanArgs, out: &mut dyn Write) -> Result<(), CliError> {
         )?;
     }
     writeln!(out, "estimated {cpu_seconds:.1} CPU-seconds")?;
-    writeln!(
-        out,
-        "suggested: this machine, one shard on {cores} threads (mc-shard run --job {} --out DIR); a cluster, {cluster_shards} shards of about 5 CPU-minutes each (--shard I/{cluster_shards})",
-        a.job.display()
-    )?;
+    writeln!(out, "{}", advice.text(&a.job.display().to_string()))?;
     Ok(())
+}
+
+/// A cluster task's work: about five minutes of one core \[s\].
+const CLUSTER_TASK_SECONDS: f64 = 300.0;
+
+/// Below this wall time on this machine a job is not worth a cluster \[s\].
+const CLUSTER_WORTHWHILE_SECONDS: f64 = 600.0;
+
+/// `mc-shard plan`'s suggestion: this machine, and a cluster split only for a job that
+/// would take this machine more than [`CLUSTER_WORTHWHILE_SECONDS`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Advice {
+    /// The job's estimated CPU time \[s\].
+    pub cpu_seconds: f64,
+    /// This machine's cores.
+    pub cores: u64,
+    /// Shards of about [`CLUSTER_TASK_SECONDS`] each, when a cluster is worth it.
+    pub cluster_shards: Option<u64>,
+}
+
+impl Advice {
+    /// The advice for a job of `cpu_seconds` CPU time and `samples` samples on `cores` cores.
+    pub fn new(cpu_seconds: f64, cores: u64, samples: u64) -> Self {
+        let cores = cores.max(1);
+        let local = cpu_seconds / cores as f64;
+        let cluster_shards = (local > CLUSTER_WORTHWHILE_SECONDS)
+            .then(|| ((cpu_seconds / CLUSTER_TASK_SECONDS).ceil() as u64).clamp(2, samples.max(2)));
+        Advice {
+            cpu_seconds,
+            cores,
+            cluster_shards,
+        }
+    }
+
+    /// The line `plan` prints for the job file `job`.
+    pub fn text(&self, job: &str) -> String {
+        let local = self.cpu_seconds / self.cores as f64;
+        let here = format!(
+            "suggested: this machine, about {} on {} (truss-mc run-all --job {job} --out DIR)",
+            duration(local),
+            plural(self.cores, "core", "cores"),
+        );
+        match self.cluster_shards {
+            None => format!("{here}; no cluster needed"),
+            Some(k) => format!(
+                "{here}; or a cluster, {} of about {} each (--shard I/{k})",
+                plural(k, "shard", "shards"),
+                duration(self.cpu_seconds / k as f64),
+            ),
+        }
+    }
+}
+
+/// `1 shard`, `2 shards`.
+fn plural(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
+/// A duration for people: `9.5 s`, `4 min`, `2.5 h`.
+fn duration(seconds: f64) -> String {
+    if seconds < 60.0 {
+        format!("{seconds:.1} s")
+    } else if seconds < 5400.0 {
+        format!("{:.0} min", seconds / 60.0)
+    } else {
+        format!("{:.1} h", seconds / 3600.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Advice;
+
+    /// A job of seconds gets no cluster advice; a long one gets a split with the right
+    /// grammar, never "1 shards".
+    #[test]
+    fn plan_advises_a_cluster_only_for_long_jobs() {
+        let short = Advice::new(9.5, 2, 1000).text("job.json");
+        assert_eq!(
+            short,
+            "suggested: this machine, about 4.8 s on 2 cores \
+             (truss-mc run-all --job job.json --out DIR); no cluster needed"
+        );
+        assert!(Advice::new(0.2, 1, 10).text("j").contains("on 1 core "));
+        // 20 CPU-hours on 8 cores: 2.5 h here, or 240 shards of 5 min.
+        let long = Advice::new(72_000.0, 8, 300_000).text("j");
+        assert!(long.contains("about 2.5 h on 8 cores"), "{long}");
+        assert!(long.contains("a cluster, 240 shards of about 5 min each (--shard I/240)"));
+        // Just over the threshold: at least two shards.
+        let edge = Advice::new(700.0, 1, 50).cluster_shards;
+        assert_eq!(edge, Some(3));
+        assert_eq!(Advice::new(601.0, 1, 50).cluster_shards, Some(3));
+        assert_eq!(Advice::new(599.0, 1, 50).cluster_shards, None);
+        for cpu in [0.0, 1.0, 650.0, 1e4, 1e6] {
+            assert!(!Advice::new(cpu, 1, 100).text("j").contains("1 shards"));
+        }
+    }
 }

@@ -18,7 +18,8 @@
 //!
 //! ## Commands (see `mc-shard --help`)
 //!
-//! - `mc-shard plan JOB.json` — job id, cases, sample count, a suggested split.
+//! - `mc-shard plan JOB.json` — job id, cases, sample count, an estimate of the CPU time and
+//!   a suggestion: this machine, and a cluster split only for a job of more than ten minutes.
 //! - `mc-shard run --job JOB.json --out DIR [--shard I/K | --range A..B] [--threads T]` —
 //!   one shard (selection in [`select`]); crash-safe and resumable ([`shard`]).
 //! - `mc-shard reproduce --job JOB.json --case NAME --sample K [--detail]` — the exact line
@@ -37,10 +38,12 @@
 //! The scheme every truss-mc binary shares (`truss-exit`): 0 success, 1 internal error, 2
 //! usage error or a range outside the job, 3 invalid job (the message gives the JSON path of
 //! the fault), 4 a file could not be read or written, 5 the shard file is in the way
-//! (another job's, locked by another process, or damaged).
+//! (another job's, locked by another process, or damaged), 130 / 143 `run` or `work`
+//! stopped by SIGINT / SIGTERM, every finished sample kept ([`interrupt`]).
 
 pub mod cli;
 pub mod errors;
+pub mod interrupt;
 pub mod progress;
 pub mod reproduce;
 pub mod runner;

@@ -5,8 +5,14 @@
 //! buffer and appends every chunk that is next in order, in one write. Memory stays flat in the sample count:
 //! the buffer holds at most the lines in flight. Each sample's line depends only on the job
 //! and its index, so the file is the same bytes for any thread count.
+//!
+//! After SIGINT or SIGTERM (once [`crate::interrupt::install`]ed) workers stop before their
+//! next sample and send what they finished; the writer appends every line that is next in
+//! order, syncs the file and returns with [`RunSummary::interrupted`] set, leaving the shard
+//! without its end line for a rerun to resume.
 
 use crate::errors::RunError;
+use crate::interrupt::{self, Signal};
 use crate::job::Job;
 use crate::progress::Progress;
 use crate::shard::{Opened, ShardWriter, begin};
@@ -38,6 +44,8 @@ pub struct RunSummary {
     pub failed: u64,
     /// Wall time of this run \[s\].
     pub seconds: f64,
+    /// The signal that stopped the run before the shard was complete, if one did.
+    pub interrupted: Option<Signal>,
 }
 
 /// Options of a shard run.
@@ -74,6 +82,7 @@ pub fn run_shard(
                 computed: 0,
                 failed: scan.digest.end().failed,
                 seconds: started.elapsed().as_secs_f64(),
+                interrupted: None,
             });
         }
         Opened::Writer(w) => w,
@@ -100,19 +109,28 @@ pub fn run_shard(
                 let mut worker = Worker::new(job);
                 loop {
                     let start = next.fetch_add(CHUNK, Ordering::Relaxed);
-                    if start >= range.end || stop.load(Ordering::Relaxed) {
+                    let halt = || stop.load(Ordering::Relaxed) || interrupt::requested().is_some();
+                    if start >= range.end || halt() {
                         break;
                     }
                     let end = (start + CHUNK).min(range.end);
                     let mut bytes = Vec::with_capacity(300 * (end - start) as usize);
                     let mut lines = Vec::with_capacity((end - start) as usize);
                     for index in start..end {
+                        if halt() {
+                            // Interrupted: send the samples finished so far.
+                            break;
+                        }
                         let sample = worker.sample(index);
                         let before = bytes.len();
                         sample.write_line(&mut bytes);
                         lines.push((bytes.len() - before, sample.status == Status::Failed));
                     }
-                    if tx.send((start, (bytes, lines))).is_err() {
+                    let partial = lines.len() as u64 != end - start;
+                    if !lines.is_empty() && tx.send((start, (bytes, lines))).is_err() {
+                        return;
+                    }
+                    if partial {
                         return;
                     }
                 }
@@ -133,11 +151,25 @@ pub fn run_shard(
                 progress.advance(lines.len() as u64);
             }
         }
-        Ok(())
+        Ok(expect)
     });
     progress.finish();
-    result?;
+    let written = result?;
     let path = writer.path().to_path_buf();
+    if written < range.end {
+        // Interrupted (the only way the workers stop early without an error).
+        writer.sync()?;
+        return Ok(RunSummary {
+            path,
+            range,
+            already_complete: false,
+            resumed,
+            computed: written - first,
+            failed: writer.failed(),
+            seconds: started.elapsed().as_secs_f64(),
+            interrupted: Some(interrupt::requested().unwrap_or(Signal::Terminate)),
+        });
+    }
     let end = writer.finish()?;
     Ok(RunSummary {
         path,
@@ -147,5 +179,6 @@ pub fn run_shard(
         computed: range.end - first,
         failed: end.failed,
         seconds: started.elapsed().as_secs_f64(),
+        interrupted: None,
     })
 }

@@ -143,6 +143,19 @@ impl ShardWriter {
         self.write_raw(bytes)
     }
 
+    /// Failed samples among the lines so far.
+    pub fn failed(&self) -> u64 {
+        self.digest.end().failed
+    }
+
+    /// Syncs the lines written so far to disk (before stopping without the end line).
+    pub fn sync(&self) -> Result<(), ShardError> {
+        self.file.sync_all().map_err(|source| ShardError::Io {
+            path: self.path.clone(),
+            source,
+        })
+    }
+
     /// Writes the end line, syncs the file to disk, and returns the end record.
     pub fn finish(mut self) -> Result<shard_record::End, ShardError> {
         assert_eq!(

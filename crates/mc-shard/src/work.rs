@@ -57,7 +57,8 @@ pub struct WorkOptions {
 pub struct Action {
     /// Shard index.
     pub shard: u64,
-    /// `completed`, `already-complete`, `claimed-elsewhere`, `locked-elsewhere`, `took-over`.
+    /// `completed`, `already-complete`, `claimed-elsewhere`, `locked-elsewhere`, `took-over`,
+    /// `interrupted` (SIGINT/SIGTERM: the claim is released, the shard left to resume).
     pub action: &'static str,
     /// Samples computed by this worker.
     pub computed: u64,
@@ -111,6 +112,9 @@ pub fn work(
     };
     for (i, range) in ranges.iter().enumerate() {
         let i = i as u64;
+        if crate::interrupt::requested().is_some() {
+            break;
+        }
         if looks_complete(&dir.join(range.file_name())) {
             continue;
         }
@@ -139,6 +143,11 @@ pub fn work(
         match result {
             Ok(summary) => {
                 let _ = std::fs::remove_file(&claim);
+                if summary.interrupted.is_some() {
+                    // Released at once for another worker (or a rerun) to resume.
+                    act(i, "interrupted", summary.computed, summary.resumed);
+                    break;
+                }
                 if summary.already_complete {
                     act(i, "already-complete", 0, summary.resumed);
                 } else {

@@ -13,6 +13,8 @@
 //! | 5 | [`IN_THE_WAY`] | a file in the way: a shard of another job, locked by another process, or damaged |
 //! | 6 | [`VERIFICATION`] | verification failed: shards incomplete or not verifying at the merge; a shard process of `run-all` failed |
 //! | 7 | [`FAILED_SAMPLES`] | failed samples: a solve did not converge (`truss solve`, a diagnosis's simulation), or the merge found failed samples without `--allow-failed` |
+//! | 130 | [`INTERRUPTED_SIGINT`] | interrupted by SIGINT (Ctrl-C): the finished samples are kept; rerun the same command to resume |
+//! | 143 | [`INTERRUPTED_SIGTERM`] | interrupted by SIGTERM (`kill`, a supervisor, a time limit): likewise |
 
 /// Success.
 pub const OK: u8 = 0;
@@ -30,9 +32,13 @@ pub const IN_THE_WAY: u8 = 5;
 pub const VERIFICATION: u8 = 6;
 /// Samples failed: a solve did not converge.
 pub const FAILED_SAMPLES: u8 = 7;
+/// Interrupted by SIGINT (128 + 2, as a shell reports it); finished samples are kept.
+pub const INTERRUPTED_SIGINT: u8 = 130;
+/// Interrupted by SIGTERM (128 + 15); finished samples are kept.
+pub const INTERRUPTED_SIGTERM: u8 = 143;
 
 /// The scheme in one line, for every binary's `--help`.
-pub const SUMMARY: &str = "Exit codes: 0 success, 1 internal error, 2 usage error, 3 invalid input (job, model, measured data), 4 I/O error, 5 a file in the way (another job's shard, locked, damaged), 6 verification failed (shards incomplete or not verifying; a shard process failed), 7 failed samples (a solve did not converge).";
+pub const SUMMARY: &str = "Exit codes: 0 success, 1 internal error, 2 usage error, 3 invalid input (job, model, measured data), 4 I/O error, 5 a file in the way (another job's shard, locked, damaged), 6 verification failed (shards incomplete or not verifying; a shard process failed), 7 failed samples (a solve did not converge), 130 interrupted by SIGINT, 143 interrupted by SIGTERM (finished samples kept; rerun to resume).";
 
 #[cfg(test)]
 mod tests {
@@ -51,6 +57,9 @@ mod tests {
         ];
         for (i, c) in codes.iter().enumerate() {
             assert_eq!(*c as usize, i);
+            assert!(super::SUMMARY.contains(&format!("{c} ")), "{c}");
+        }
+        for c in [super::INTERRUPTED_SIGINT, super::INTERRUPTED_SIGTERM] {
             assert!(super::SUMMARY.contains(&format!("{c} ")), "{c}");
         }
     }

@@ -74,6 +74,18 @@ impl Error {
             Error::RunAll(RunAllError::Run(e)) => run_exit_code(e),
             Error::RunAll(RunAllError::Workers(_)) => truss_exit::VERIFICATION,
             Error::RunAll(RunAllError::Merge(e)) => e.exit_code(),
+            Error::RunAll(RunAllError::Interrupted { signal, .. }) => signal.exit_code(),
+        }
+    }
+}
+
+impl Error {
+    /// The signal that interrupted the command, if one did.
+    pub fn interrupted(&self) -> Option<mc_shard::interrupt::Signal> {
+        match self {
+            Error::Shard(CliError::Interrupted { signal, .. })
+            | Error::RunAll(RunAllError::Interrupted { signal, .. }) => Some(*signal),
+            _ => None,
         }
     }
 }

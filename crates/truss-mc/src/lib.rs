@@ -18,8 +18,9 @@
 //! ## Exit codes
 //!
 //! The scheme every truss-mc binary shares (`truss-exit`); `run-all` exits with the
-//! verification code (6) when a shard process failed, and with the merge's code when the
-//! merge failed.
+//! verification code (6) when a shard process failed, with the merge's code when the
+//! merge failed, and with 130 / 143 when SIGINT / SIGTERM stopped it (its workers stopped
+//! too, every finished sample kept; see [`run_all`]).
 
 pub mod cli;
 pub mod run_all;

@@ -7,7 +7,17 @@
 //! resumes every shard where it stopped). tokio runs the children and a single progress
 //! display that counts the sample lines the shard files have gained. When all shards are
 //! complete the directory is merged with mc-merge into `DIR/report`.
+//!
+//! **Interrupts.** On SIGINT or SIGTERM sent to `run-all` alone (`kill PID`, a supervisor, a
+//! batch system's time limit) or to its whole process group (Ctrl-C), no further shard
+//! starts, each running child is sent SIGTERM (its runner appends what it finished and
+//! stops; SIGKILL after a grace period), a merge in progress is abandoned, and `run-all`
+//! returns [`RunAllError::Interrupted`]: the binary prints "interrupted: N samples kept;
+//! rerun the same command to resume" and exits 130 (SIGINT) or 143 (SIGTERM). No child
+//! outlives it.
 
+use mc_shard::cli::kept_samples;
+use mc_shard::interrupt::Signal;
 use mc_shard::progress::Progress;
 use mc_shard::{Job, RunError};
 use shard_record::ShardRange;
@@ -28,6 +38,14 @@ pub enum RunAllError {
     /// The merge failed.
     #[error("merge failed: {0}")]
     Merge(mc_merge::MergeError),
+    /// Stopped by SIGINT or SIGTERM; `kept` sample lines are in the shard files.
+    #[error("{}", mc_shard::interrupt::message(*.kept))]
+    Interrupted {
+        /// The signal.
+        signal: Signal,
+        /// Sample lines in the shard files, kept for a rerun.
+        kept: u64,
+    },
 }
 
 /// Options of `run-all`.
@@ -49,6 +67,10 @@ pub struct RunAllOptions {
 
 /// Runs every shard with child processes of the executable `exe`, then merges; writes the
 /// merge table to `out`.
+///
+/// On SIGINT or SIGTERM (see the module doc) it stops: no new shard starts, every running
+/// child gets SIGTERM (and SIGKILL after [`GRACE`]), and it returns
+/// [`RunAllError::Interrupted`] with the sample lines the shard files keep.
 pub fn run_all(
     exe: &Path,
     job: &Job,
@@ -68,12 +90,66 @@ pub fn run_all(
         .enable_all()
         .build()
         .map_err(|e| RunError::Usage(format!("cannot start the async runtime: {e}")))?;
-    let failures = runtime.block_on(run_children(exe, job, &ranges, options))?;
+    let result = runtime.block_on(run_and_merge(exe, job, &ranges, options));
+    // A merge still running on a blocking thread after a signal is not waited for.
+    runtime.shutdown_background();
+    match result {
+        Ok(table) => out.write_all(&table).map_err(|source| {
+            RunAllError::Merge(mc_merge::MergeError::Io {
+                path: PathBuf::from("<stdout>"),
+                source,
+            })
+        }),
+        Err(RunAllError::Interrupted { signal, .. }) => Err(RunAllError::Interrupted {
+            signal,
+            kept: kept_samples(job, &options.out, options.shards),
+        }),
+        Err(e) => Err(e),
+    }
+}
+
+/// The signals `run-all` stops on, as a stream of [`Signal`]s.
+struct Signals {
+    interrupt: tokio::signal::unix::Signal,
+    terminate: tokio::signal::unix::Signal,
+}
+
+impl Signals {
+    fn new() -> Result<Self, RunError> {
+        use tokio::signal::unix::{SignalKind, signal};
+        let fail = |e: std::io::Error| RunError::Usage(format!("cannot handle signals: {e}"));
+        Ok(Signals {
+            interrupt: signal(SignalKind::interrupt()).map_err(fail)?,
+            terminate: signal(SignalKind::terminate()).map_err(fail)?,
+        })
+    }
+
+    async fn recv(&mut self) -> Signal {
+        tokio::select! {
+            _ = self.interrupt.recv() => Signal::Interrupt,
+            _ = self.terminate.recv() => Signal::Terminate,
+        }
+    }
+}
+
+/// Runs the children, then (unless `no_merge`) the merge; returns the merge's table.
+async fn run_and_merge(
+    exe: &Path,
+    job: &Job,
+    ranges: &[ShardRange],
+    options: &RunAllOptions,
+) -> Result<Vec<u8>, RunAllError> {
+    let mut signals = Signals::new()?;
+    let (failures, interrupted) = run_children(exe, job, ranges, options, &mut signals).await?;
+    if let Some(signal) = interrupted {
+        // `kept` is counted by `run_all` once the runtime has stopped.
+        return Err(RunAllError::Interrupted { signal, kept: 0 });
+    }
     if !failures.is_empty() {
         return Err(RunAllError::Workers(failures));
     }
     if options.no_merge {
-        return Ok(());
+        return Ok(Vec::new());
     }
     let merge = mc_merge::Options {
         paths: vec![options.out.clone()],
@@ -81,23 +157,45 @@ pub fn run_all(
         plots: true,
         settings: mc_merge::Settings::default(),
     };
-    mc_merge::run(&merge, out).map_err(RunAllError::Merge)?;
-    Ok(())
+    let merging = tokio::task::spawn_blocking(move || {
+        let mut table = Vec::new();
+        mc_merge::run(&merge, &mut table).map(|_| table)
+    });
+    tokio::select! {
+        done = merging => match done {
+            Ok(result) => result.map_err(RunAllError::Merge),
+            Err(e) => Err(RunError::Usage(format!("the merge panicked: {e}")).into()),
+        },
+        signal = signals.recv() => Err(RunAllError::Interrupted { signal, kept: 0 }),
+    }
 }
 
+/// How long a child may take to stop after SIGTERM before it is killed.
+const GRACE: Duration = Duration::from_secs(10);
+
 /// Runs the shard processes, at most `workers` at once, with one progress display; returns
-/// a description of each that failed.
+/// a description of each that failed, and the signal that interrupted the run if one did.
 async fn run_children(
     exe: &Path,
     job: &Job,
     ranges: &[ShardRange],
     options: &RunAllOptions,
-) -> Result<Vec<String>, RunError> {
+    signals: &mut Signals,
+) -> Result<(Vec<String>, Option<Signal>), RunError> {
     let k = ranges.len();
+    // Progress: the sample lines the shard files hold before any child starts (kept from
+    // an interrupted run: not counted in the rate), then the lines they gain.
+    let mut counted = vec![(0u64, 0u64); k];
+    let mut kept = 0;
+    for (r, (offset, lines)) in ranges.iter().zip(counted.iter_mut()) {
+        kept += count_new_lines(&options.out.join(r.file_name()), offset, lines, r.len());
+    }
     let limit = Arc::new(tokio::sync::Semaphore::new(options.workers.max(1)));
+    let (cancel_tx, cancel_rx) = tokio::sync::watch::channel(false);
     let mut tasks = tokio::task::JoinSet::new();
     for (i, _) in ranges.iter().enumerate() {
         let limit = Arc::clone(&limit);
+        let mut cancel = cancel_rx.clone();
         let mut cmd = tokio::process::Command::new(exe);
         cmd.args(["run", "--job"])
             .arg(&options.job_path)
@@ -108,24 +206,44 @@ async fn run_children(
             .stderr(std::process::Stdio::piped())
             .kill_on_drop(true);
         tasks.spawn(async move {
-            let _permit = limit
-                .acquire_owned()
-                .await
-                .expect("the semaphore is never closed");
-            match cmd.output().await {
+            let _permit = tokio::select! {
+                permit = limit.acquire_owned() => permit.expect("the semaphore is never closed"),
+                _ = cancel.changed() => return None,
+            };
+            if *cancel.borrow() {
+                return None;
+            }
+            let child = match cmd.spawn() {
+                Ok(child) => child,
+                Err(e) => return Some(format!("shard {i}/{k}: cannot start: {e}")),
+            };
+            let pid = child.id();
+            let output = child.wait_with_output();
+            tokio::pin!(output);
+            let output = tokio::select! {
+                o = &mut output => o,
+                _ = cancel.changed() => {
+                    if let Some(pid) = pid.and_then(|p| rustix::process::Pid::from_raw(p as i32)) {
+                        let _ = rustix::process::kill_process(pid, rustix::process::Signal::TERM);
+                    }
+                    // After the grace period the future is dropped: kill_on_drop kills it.
+                    let _ = tokio::time::timeout(GRACE, &mut output).await;
+                    return None;
+                }
+            };
+            match output {
                 Ok(o) if o.status.success() => None,
                 Ok(o) => Some(format!(
                     "shard {i}/{k}: {}",
                     String::from_utf8_lossy(&o.stderr).trim()
                 )),
-                Err(e) => Some(format!("shard {i}/{k}: cannot start: {e}")),
+                Err(e) => Some(format!("shard {i}/{k}: cannot run: {e}")),
             }
         });
     }
-    // Progress: newlines the shard files have gained.
-    let mut progress = Progress::new("run-all", job.samples(), 0, options.quiet);
-    let mut counted = vec![(0u64, 0u64); k];
+    let mut progress = Progress::new("run-all", job.samples(), kept, options.quiet);
     let mut failures = Vec::new();
+    let mut interrupted = None;
     let mut tick = tokio::time::interval(Duration::from_millis(200));
     loop {
         tokio::select! {
@@ -135,6 +253,10 @@ async fn run_children(
                 Some(Err(e)) => failures.push(format!("a task panicked: {e}")),
                 None => break,
             },
+            signal = signals.recv(), if interrupted.is_none() => {
+                interrupted = Some(signal);
+                let _ = cancel_tx.send(true);
+            }
             _ = tick.tick() => {}
         }
         let mut gained = 0;
@@ -144,7 +266,7 @@ async fn run_children(
         progress.advance(gained);
     }
     progress.finish();
-    Ok(failures)
+    Ok((failures, interrupted))
 }
 
 /// Counts the sample lines appended to `path` since `offset` (header and end lines not

@@ -109,3 +109,132 @@ fn run_all_exit_codes() {
     assert!(stderr.contains("shard 0/2"), "{stderr}");
     assert_eq!(sample_lines(&out).len(), 10, "the other shard completed");
 }
+
+/// The pids whose parent is `pid` (from /proc).
+fn children_of(pid: u32) -> Vec<u32> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir("/proc").unwrap().flatten() {
+        let Ok(stat) = std::fs::read_to_string(entry.path().join("stat")) else {
+            continue;
+        };
+        // "pid (comm) state ppid …": comm may hold spaces, so split after its ')'.
+        let Some(rest) = stat.rfind(')').map(|i| &stat[i + 1..]) else {
+            continue;
+        };
+        let mut fields = rest.split_whitespace();
+        let ppid = fields.nth(1).and_then(|p| p.parse::<u32>().ok());
+        if ppid == Some(pid) {
+            out.extend(
+                entry
+                    .file_name()
+                    .to_str()
+                    .and_then(|s| s.parse::<u32>().ok()),
+            );
+        }
+    }
+    out
+}
+
+/// Whether `pid` is a live process (not gone, not a zombie).
+fn alive(pid: u32) -> bool {
+    std::fs::read_to_string(format!("/proc/{pid}/stat")).is_ok_and(|stat| {
+        let state = stat
+            .rfind(')')
+            .map(|i| stat[i + 1..].trim_start().chars().next());
+        state != Some(Some('Z'))
+    })
+}
+
+/// SIGTERM to `run-all`'s pid alone (`kill PID`, as a supervisor or Slurm's time limit
+/// sends it): it stops its workers (none survives it), prints the "interrupted" line, exits
+/// 143; running the same command again resumes to the sample lines of an uninterrupted run.
+#[test]
+fn run_all_stops_its_workers_on_sigterm_and_resumes() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(
+        dir.path(),
+        "job.json",
+        r#"{"model": {"prism": {"stages": 30}}, "seed": 11, "cases": [
+  {"name": "normal", "samples": 12000,
+   "length_errors": {"batten": {"normal": {"sigma": 0.0063}},
+                     "longeron": {"normal": {"sigma": 0.0063}}}}]}"#,
+    );
+    let out = dir.path().join("all");
+    let args = [
+        "run-all",
+        "--job",
+        job.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--shards",
+        "2",
+        "--workers",
+        "2",
+        "--quiet",
+        "--no-merge",
+    ];
+    let mut child = Command::new(env!("CARGO_BIN_EXE_truss-mc"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    // Wait (polling, not timing) until both workers run and lines are written.
+    let started = Instant::now();
+    let workers = loop {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "run-all ended too soon"
+        );
+        let workers = children_of(pid);
+        let written: u64 = std::fs::read_dir(&out)
+            .map(|d| {
+                d.flatten()
+                    .map(|e| e.metadata().map_or(0, |m| m.len()))
+                    .sum()
+            })
+            .unwrap_or(0);
+        if workers.len() == 2 && written > 4000 {
+            break workers;
+        }
+        assert!(started.elapsed() < Duration::from_secs(120), "no workers");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let s = Command::new("kill").arg(pid.to_string()).status().unwrap();
+    assert!(s.success());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(143), "{stderr}");
+    for w in &workers {
+        assert!(!alive(*w), "worker {w} survived run-all");
+    }
+    let kept = sample_lines(&out).len();
+    assert!(kept > 0 && kept < 12000, "{kept}");
+    assert_eq!(
+        stderr.trim(),
+        format!("interrupted: {kept} samples kept; rerun the same command to resume")
+    );
+    let r = truss_mc(&args, &[]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let single = dir.path().join("single");
+    let r = truss_mc(
+        &[
+            "run",
+            "--job",
+            job.to_str().unwrap(),
+            "--out",
+            single.to_str().unwrap(),
+            "--threads",
+            "2",
+            "--quiet",
+        ],
+        &[],
+    );
+    assert!(r.status.success());
+    assert!(
+        sample_lines(&out) == sample_lines(&single),
+        "resumed lines differ"
+    );
+}

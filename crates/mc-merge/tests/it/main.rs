@@ -2,5 +2,6 @@
 
 mod cli;
 mod common;
+mod export;
 mod statistics;
 mod sweep;

@@ -350,3 +350,27 @@ fn exit_codes() {
 fn mc_shard_job_id(job: &Path) -> String {
     mc_shard::Job::read(job).unwrap().id
 }
+
+/// `plan` on a job of milliseconds advises this machine and no cluster, in good grammar;
+/// its JSON says so too.
+#[test]
+fn plan_advises_no_cluster_for_a_small_job() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "job.json", &small_job(20));
+    let plan = mc_shard(&["plan", job.to_str().unwrap()], &[]);
+    assert!(plan.status.success());
+    let text = String::from_utf8_lossy(&plan.stdout);
+    let advice = text.lines().last().unwrap();
+    assert!(
+        advice.starts_with("suggested: this machine, about "),
+        "{advice}"
+    );
+    assert!(advice.ends_with("; no cluster needed"), "{advice}");
+    assert!(
+        !text.contains("1 shards") && !text.contains("cluster,"),
+        "{text}"
+    );
+    let json = mc_shard(&["plan", job.to_str().unwrap(), "--json"], &[]);
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    assert_eq!(v["suggested"]["cluster_advised"], false);
+}

@@ -5,6 +5,7 @@ mod backlash;
 mod cli;
 mod common;
 mod determinism;
+mod interrupt;
 mod job;
 mod sampling;
 mod work;
