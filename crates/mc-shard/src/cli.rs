@@ -439,10 +439,10 @@ fn plan(a: &PlanArgs, out: &mut dyn Write) -> Result<(), CliError> {
 }
 
 /// A cluster task's work: about five minutes of one core \[s\].
-const CLUSTER_TASK_SECONDS: f64 = 300.0;
+pub const CLUSTER_TASK_SECONDS: f64 = 300.0;
 
 /// Below this wall time on this machine a job is not worth a cluster \[s\].
-const CLUSTER_WORTHWHILE_SECONDS: f64 = 600.0;
+pub const CLUSTER_WORTHWHILE_SECONDS: f64 = 600.0;
 
 /// `mc-shard plan`'s suggestion: this machine, and a cluster split only for a job that
 /// would take this machine more than [`CLUSTER_WORTHWHILE_SECONDS`].

@@ -171,7 +171,7 @@ async fn run_and_merge(
 }
 
 /// How long a child may take to stop after SIGTERM before it is killed.
-const GRACE: Duration = Duration::from_secs(10);
+pub const GRACE: Duration = Duration::from_secs(10);
 
 /// Runs the shard processes, at most `workers` at once, with one progress display; returns
 /// a description of each that failed, and the signal that interrupted the run if one did.
