@@ -10,7 +10,8 @@
 //!   (`<…>`, `JOB`) or inputs the README does not make (`truss diagnose`'s measured data)
 //!   are only checked, not run.
 //! - Scripts (`scripts/…`): the file exists, is executable, and names every flag used.
-//! - `kubectl … -f FILE`: the file exists. `cargo` lines are not checked.
+//! - `kubectl … -f FILE`: the file exists. `cargo run … -p BIN -- ARGS` runs as `BIN ARGS`;
+//!   other `cargo` lines are not checked.
 //!
 //! The binaries are the ones `cargo test --workspace` builds beside this test's executable
 //! (`target/debug`); run alone (`cargo test -p pipeline-tests`) with them missing, the test
@@ -79,6 +80,18 @@ fn our_binary(word: &str) -> Option<&'static str> {
     ["truss", "truss-mc", "mc-shard", "mc-merge"]
         .into_iter()
         .find(|b| *b == name)
+}
+
+/// The binary of a `cargo run [--release] -p PACKAGE -- ARGS` line, if it is one of ours.
+fn cargo_run(words: &[String]) -> Option<&'static str> {
+    if words.first().map(String::as_str) != Some("cargo")
+        || words.get(1).map(String::as_str) != Some("run")
+    {
+        return None;
+    }
+    let p = words.iter().position(|w| w == "-p")?;
+    words.iter().any(|w| w == "--").then_some(())?;
+    our_binary(words.get(p + 1)?)
 }
 
 /// A tiny stand-in for the paper's job.
@@ -219,6 +232,16 @@ fn readme_commands_run() {
             if let Some(at) = words.iter().position(|w| w == "-f") {
                 assert!(root().join(&words[at + 1]).exists(), "{command}");
             }
+        } else if let Some(bin) = cargo_run(&words) {
+            // `cargo run --release -p BIN -- ARGS` runs BIN ARGS (the binary is built here).
+            let at = words
+                .iter()
+                .position(|w| w == "--")
+                .expect("cargo run … --");
+            let mut run = vec![bin.to_string()];
+            run.extend(words[at + 1..].iter().cloned());
+            check_ours(bin, &run, scratch.path(), &job);
+            ran_ours += 1;
         } else {
             assert_eq!(
                 first, "cargo",
