@@ -199,150 +199,162 @@ pub fn run_exit_code(e: &RunError) -> u8 {
 pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     match cli.command {
         Command::Plan(a) => plan(&a, out),
-        Command::Run(a) => {
-            let job = Job::read(&a.job)?;
-            let (range, source) = select(
-                a.range.as_deref(),
-                a.shard.as_deref(),
-                a.shards,
-                job.samples(),
-                |k| std::env::var(k).ok(),
-            )?;
-            let threads = a
-                .threads
-                .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-            if threads == 0 {
-                return Err(RunError::Usage("--threads must be at least 1".into()).into());
-            }
-            crate::interrupt::install()?;
-            let summary = run_shard(
-                &job,
-                &a.out,
-                range,
-                &RunOptions {
-                    threads,
-                    quiet: a.quiet,
-                },
-            )?;
-            if let Some(signal) = summary.interrupted {
-                return Err(CliError::Interrupted {
-                    signal,
-                    kept: summary.resumed + summary.computed,
-                });
-            }
-            if summary.already_complete {
-                writeln!(
-                    out,
-                    "{}: already complete and verified ({} samples, {} failed)",
-                    summary.path.display(),
-                    summary.resumed,
-                    summary.failed
-                )?;
+        Command::Run(a) => run_command(a, out),
+        Command::Reproduce(a) => reproduce_command(a, out),
+        Command::Work(a) => work_command(a, out),
+        Command::Status(a) => status_command(a, out),
+    }
+}
+
+/// `mc-shard run`: one shard, crash-safe and resumable.
+fn run_command(a: RunArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let job = Job::read(&a.job)?;
+    let (range, source) = select(
+        a.range.as_deref(),
+        a.shard.as_deref(),
+        a.shards,
+        job.samples(),
+        |k| std::env::var(k).ok(),
+    )?;
+    let threads = a
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    if threads == 0 {
+        return Err(RunError::Usage("--threads must be at least 1".into()).into());
+    }
+    crate::interrupt::install()?;
+    let summary = run_shard(
+        &job,
+        &a.out,
+        range,
+        &RunOptions {
+            threads,
+            quiet: a.quiet,
+        },
+    )?;
+    if let Some(signal) = summary.interrupted {
+        return Err(CliError::Interrupted {
+            signal,
+            kept: summary.resumed + summary.computed,
+        });
+    }
+    if summary.already_complete {
+        writeln!(
+            out,
+            "{}: already complete and verified ({} samples, {} failed)",
+            summary.path.display(),
+            summary.resumed,
+            summary.failed
+        )?;
+    } else {
+        writeln!(
+            out,
+            "{}: {} samples ({} computed now{}, {} failed) in {:.2} s, {:.0} samples/s [range from {:?}]",
+            summary.path.display(),
+            range.len(),
+            summary.computed,
+            if summary.resumed > 0 {
+                format!(", {} kept from before", summary.resumed)
             } else {
-                writeln!(
-                    out,
-                    "{}: {} samples ({} computed now{}, {} failed) in {:.2} s, {:.0} samples/s [range from {:?}]",
-                    summary.path.display(),
-                    range.len(),
-                    summary.computed,
-                    if summary.resumed > 0 {
-                        format!(", {} kept from before", summary.resumed)
-                    } else {
-                        String::new()
-                    },
-                    summary.failed,
-                    summary.seconds,
-                    summary.computed as f64 / summary.seconds.max(1e-9),
-                    source
-                )?;
-            }
-            Ok(())
+                String::new()
+            },
+            summary.failed,
+            summary.seconds,
+            summary.computed as f64 / summary.seconds.max(1e-9),
+            source
+        )?;
+    }
+    Ok(())
+}
+
+/// `mc-shard reproduce`: one sample's line, or its detail.
+fn reproduce_command(a: ReproduceArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let job = Job::read(&a.job)?;
+    let c = job.case_named(&a.case).ok_or_else(|| {
+        RunError::Usage(format!(
+            "no case {:?} (cases: {})",
+            a.case,
+            job.cases
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ))
+    })?;
+    if a.sample >= job.cases[c].samples {
+        return Err(RunError::Usage(format!(
+            "case {:?} has samples 0..{}, not {}",
+            a.case, job.cases[c].samples, a.sample
+        ))
+        .into());
+    }
+    out.write_all(crate::reproduce::reproduce(&job, c, a.sample, a.detail).as_bytes())?;
+    Ok(())
+}
+
+/// `mc-shard work`: claim, run and repeat until no shard is left.
+fn work_command(a: WorkArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let job = Job::read(&a.job)?;
+    let seconds = |name: &str, v: f64| {
+        if v.is_finite() && v > 0.0 {
+            Ok(std::time::Duration::from_secs_f64(v))
+        } else {
+            Err(RunError::Usage(format!(
+                "--{name} must be a positive number of seconds"
+            )))
         }
-        Command::Reproduce(a) => {
-            let job = Job::read(&a.job)?;
-            let c = job.case_named(&a.case).ok_or_else(|| {
-                RunError::Usage(format!(
-                    "no case {:?} (cases: {})",
-                    a.case,
-                    job.cases
-                        .iter()
-                        .map(|c| c.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ))
-            })?;
-            if a.sample >= job.cases[c].samples {
-                return Err(RunError::Usage(format!(
-                    "case {:?} has samples 0..{}, not {}",
-                    a.case, job.cases[c].samples, a.sample
-                ))
-                .into());
-            }
-            out.write_all(crate::reproduce::reproduce(&job, c, a.sample, a.detail).as_bytes())?;
-            Ok(())
+    };
+    let options = crate::work::WorkOptions {
+        shards: a.shards,
+        threads: a.threads.unwrap_or_else(default_threads),
+        heartbeat: seconds("heartbeat", a.heartbeat)?,
+        stale_after: seconds("stale-after", a.stale_after)?,
+        quiet: a.quiet,
+    };
+    crate::interrupt::install()?;
+    let mut failed = None;
+    crate::work::work(&job, &a.out, &options, |action| {
+        let line = serde_json::to_string(action).expect("actions serialise");
+        if let Err(e) = writeln!(out, "{line}").and_then(|_| out.flush()) {
+            failed.get_or_insert(e);
         }
-        Command::Work(a) => {
-            let job = Job::read(&a.job)?;
-            let seconds = |name: &str, v: f64| {
-                if v.is_finite() && v > 0.0 {
-                    Ok(std::time::Duration::from_secs_f64(v))
-                } else {
-                    Err(RunError::Usage(format!(
-                        "--{name} must be a positive number of seconds"
-                    )))
-                }
+    })?;
+    if let Some(signal) = crate::interrupt::requested() {
+        return Err(CliError::Interrupted {
+            signal,
+            kept: kept_samples(&job, &a.out, a.shards),
+        });
+    }
+    match failed {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
+    }
+}
+
+/// `mc-shard status`: which shards are complete, partial, missing or bad.
+fn status_command(a: StatusArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let job = Job::read(&a.job)?;
+    let states = shard_states(&job, &a.out, a.shards).map_err(RunError::Usage)?;
+    if a.missing {
+        let missing: Vec<String> = states
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, s))| *s != ShardState::Complete)
+            .map(|(i, _)| i.to_string())
+            .collect();
+        writeln!(out, "{}", missing.join(","))?;
+    } else {
+        for (i, (r, s)) in states.iter().enumerate() {
+            let what = match s {
+                ShardState::Complete => "complete".to_string(),
+                ShardState::Partial(n) => format!("partial ({n} of {} samples)", r.len()),
+                ShardState::Missing => "missing".to_string(),
+                ShardState::Bad(why) => format!("bad: {why}"),
             };
-            let options = crate::work::WorkOptions {
-                shards: a.shards,
-                threads: a.threads.unwrap_or_else(default_threads),
-                heartbeat: seconds("heartbeat", a.heartbeat)?,
-                stale_after: seconds("stale-after", a.stale_after)?,
-                quiet: a.quiet,
-            };
-            crate::interrupt::install()?;
-            let mut failed = None;
-            crate::work::work(&job, &a.out, &options, |action| {
-                let line = serde_json::to_string(action).expect("actions serialise");
-                if let Err(e) = writeln!(out, "{line}").and_then(|_| out.flush()) {
-                    failed.get_or_insert(e);
-                }
-            })?;
-            if let Some(signal) = crate::interrupt::requested() {
-                return Err(CliError::Interrupted {
-                    signal,
-                    kept: kept_samples(&job, &a.out, a.shards),
-                });
-            }
-            match failed {
-                Some(e) => Err(e.into()),
-                None => Ok(()),
-            }
-        }
-        Command::Status(a) => {
-            let job = Job::read(&a.job)?;
-            let states = shard_states(&job, &a.out, a.shards).map_err(RunError::Usage)?;
-            if a.missing {
-                let missing: Vec<String> = states
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, (_, s))| *s != ShardState::Complete)
-                    .map(|(i, _)| i.to_string())
-                    .collect();
-                writeln!(out, "{}", missing.join(","))?;
-            } else {
-                for (i, (r, s)) in states.iter().enumerate() {
-                    let what = match s {
-                        ShardState::Complete => "complete".to_string(),
-                        ShardState::Partial(n) => format!("partial ({n} of {} samples)", r.len()),
-                        ShardState::Missing => "missing".to_string(),
-                        ShardState::Bad(why) => format!("bad: {why}"),
-                    };
-                    writeln!(out, "shard {i}/{} {r}: {what}", a.shards)?;
-                }
-            }
-            Ok(())
+            writeln!(out, "shard {i}/{} {r}: {what}", a.shards)?;
         }
     }
+    Ok(())
 }
 
 /// The sample lines in the shard files of the `shards` shards of `job` in `dir` (complete
