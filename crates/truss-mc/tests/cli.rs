@@ -19,13 +19,9 @@ fn truss_mc(args: &[&str], env: &[(&str, &str)]) -> Output {
     cmd.output().unwrap()
 }
 
-/// `run-all` runs every shard as concurrent processes, then merges: the sample lines are the
-/// single run's, and the report is written.
-#[test]
-fn run_all_runs_every_shard_then_merges() {
-    let dir = tempfile::tempdir().unwrap();
-    let job = write(dir.path(), "job.json", &small_job(60));
-    let single = dir.path().join("single");
+/// The reference: the whole job as one shard by `truss-mc run`, into `dir/single`.
+fn single_run(dir: &Path, job: &Path) -> std::path::PathBuf {
+    let single = dir.join("single");
     let r = truss_mc(
         &[
             "run",
@@ -33,11 +29,23 @@ fn run_all_runs_every_shard_then_merges() {
             job.to_str().unwrap(),
             "--out",
             single.to_str().unwrap(),
+            "--threads",
+            "2",
             "--quiet",
         ],
         &[],
     );
-    assert!(r.status.success());
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    single
+}
+
+/// `run-all` runs every shard as concurrent processes, then merges: the sample lines are the
+/// single run's, and the report is written.
+#[test]
+fn run_all_runs_every_shard_then_merges() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "job.json", &small_job(60));
+    let single = single_run(dir.path(), &job);
     let all = dir.path().join("all");
     let r = truss_mc(
         &[
@@ -218,21 +226,7 @@ fn run_all_stops_its_workers_on_sigterm_and_resumes() {
     );
     let r = truss_mc(&args, &[]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
-    let single = dir.path().join("single");
-    let r = truss_mc(
-        &[
-            "run",
-            "--job",
-            job.to_str().unwrap(),
-            "--out",
-            single.to_str().unwrap(),
-            "--threads",
-            "2",
-            "--quiet",
-        ],
-        &[],
-    );
-    assert!(r.status.success());
+    let single = single_run(dir.path(), &job);
     assert!(
         sample_lines(&out) == sample_lines(&single),
         "resumed lines differ"
