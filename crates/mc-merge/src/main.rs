@@ -10,16 +10,13 @@ fn main() -> ExitCode {
     // Usage errors exit with clap's code 2, which is ExitCodes::USAGE.
     let args = Args::parse();
     let export = args.export.clone();
-    let out = &mut std::io::stdout().lock();
+    let mut out = truss_exit::Stdout::lock();
     let result = args.validate().and_then(|options| match &export {
-        Some(to) => mc_merge::export::run(&options, to, out),
-        None => mc_merge::run(&options, out).map(|_| ()),
+        Some(to) => mc_merge::export::run(&options, to, &mut out),
+        None => mc_merge::run(&options, &mut out).map(|_| ()),
     });
     match result {
         Ok(()) => ExitCode::from(ExitCodes::OK),
-        Err(e) => {
-            eprintln!("mc-merge: error: {e}");
-            ExitCode::from(e.exit_code())
-        }
+        Err(e) => truss_exit::finish("mc-merge", &e, e.exit_code(), &out),
     }
 }

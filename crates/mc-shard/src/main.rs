@@ -4,15 +4,14 @@ use clap::Parser;
 
 fn main() -> std::process::ExitCode {
     let cli = mc_shard::cli::Cli::parse();
-    match mc_shard::cli::run(cli, &mut std::io::stdout().lock()) {
+    let mut out = truss_exit::Stdout::lock();
+    match mc_shard::cli::run(cli, &mut out) {
         Ok(()) => std::process::ExitCode::SUCCESS,
+        // "interrupted: N samples kept; rerun …" is a notice, not an error.
         Err(e @ mc_shard::cli::CliError::Interrupted { .. }) => {
             eprintln!("{e}");
             std::process::ExitCode::from(e.exit_code())
         }
-        Err(e) => {
-            eprintln!("mc-shard: {e}");
-            std::process::ExitCode::from(e.exit_code())
-        }
+        Err(e) => truss_exit::finish("mc-shard", &e, e.exit_code(), &out),
     }
 }

@@ -4,11 +4,9 @@ use clap::Parser;
 
 fn main() -> std::process::ExitCode {
     let cli = truss_cli::Cli::parse();
-    match truss_cli::run(cli, &mut std::io::stdout().lock()) {
+    let mut out = truss_exit::Stdout::lock();
+    match truss_cli::run(cli, &mut out) {
         Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("truss: {e:#}");
-            std::process::ExitCode::from(truss_cli::exit_code(&e))
-        }
+        Err(e) => truss_exit::finish("truss", &*e, truss_cli::exit_code(&e), &out),
     }
 }

@@ -4,15 +4,14 @@ use clap::Parser;
 
 fn main() -> std::process::ExitCode {
     let cli = truss_mc::cli::Cli::parse();
-    match truss_mc::cli::run(cli, &mut std::io::stdout().lock()) {
+    let mut out = truss_exit::Stdout::lock();
+    match truss_mc::cli::run(cli, &mut out) {
         Ok(()) => std::process::ExitCode::SUCCESS,
+        // "interrupted: N samples kept; rerun …" is a notice, not an error.
         Err(e) if e.interrupted().is_some() => {
             eprintln!("{e}");
             std::process::ExitCode::from(e.exit_code())
         }
-        Err(e) => {
-            eprintln!("truss-mc: {e}");
-            std::process::ExitCode::from(e.exit_code())
-        }
+        Err(e) => truss_exit::finish("truss-mc", &e, e.exit_code(), &out),
     }
 }

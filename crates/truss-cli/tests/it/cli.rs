@@ -1,0 +1,240 @@
+//! The `truss` binary, run as a user would: generated models, solve output, exit codes.
+
+use crate::{json, truss};
+
+#[test]
+fn prism_model_has_the_papers_counts_and_overrides_apply() {
+    let out = truss(&["model", "prism", "--stages", "5"]);
+    assert!(out.status.success());
+    let m = json(&out);
+    assert_eq!(m["nodes"].as_array().unwrap().len(), 18);
+    assert_eq!(m["members"].as_array().unwrap().len(), 63);
+    let out = truss(&[
+        "model",
+        "prism",
+        "--stages",
+        "2",
+        "--exact-diagonals",
+        "--diagonal-area",
+        "4.5",
+    ]);
+    let m = json(&out);
+    let d = m["members"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|x| x["group"] == "diagonal")
+        .unwrap();
+    assert_eq!(d["area"], 4.5);
+    assert!((d["natural_length"].as_f64().unwrap() - 380.0 * 2f64.sqrt()).abs() < 1e-12);
+}
+
+#[test]
+fn solve_prints_the_result_with_ids_and_units() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("p.json");
+    std::fs::write(&path, truss(&["model", "prism", "--stages", "3"]).stdout).unwrap();
+    let out = truss(&[
+        "solve",
+        path.to_str().unwrap(),
+        "--length-error",
+        "longeron.1.0=0.01",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let r = json(&out);
+    assert_eq!(r["converged"], true);
+    let theta = r["theta_p"].as_f64().unwrap();
+    // The hand estimate of the one-longeron test, within 5 % below.
+    let estimate = 0.01 / (3f64.sqrt() / 2.0 * 380.0);
+    assert!(theta < estimate && theta > 0.95 * estimate, "{theta}");
+    assert_eq!(r["units"]["length"], "mm");
+    assert!(r["displacements"]["n3.0"][2].as_f64().unwrap() > 0.008);
+    assert!(r["forces"]["longeron.1.0"].as_f64().unwrap() < 0.0);
+    assert!(r["slack_cables"].is_array());
+}
+
+#[test]
+fn exit_codes_distinguish_usage_model_and_io_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nope.json");
+    let out = truss(&["solve", missing.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(4));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("nope.json"));
+
+    let bad = dir.path().join("bad.json");
+    let text = String::from_utf8(truss(&["model", "prism", "--stages", "1"]).stdout)
+        .unwrap()
+        .replacen("\"n1.0\"", "\"n9.9\"", 1);
+    std::fs::write(&bad, text).unwrap();
+    let out = truss(&["solve", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("unknown node") && err.contains("\"n1.0\""),
+        "{err}"
+    );
+
+    let good = dir.path().join("good.json");
+    std::fs::write(&good, truss(&["model", "prism", "--stages", "1"]).stdout).unwrap();
+    let out = truss(&[
+        "solve",
+        good.to_str().unwrap(),
+        "--length-error",
+        "nosuch=1",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no member \"nosuch\""));
+    assert_eq!(
+        truss(&["model", "prism", "--stages", "0"]).status.code(),
+        Some(2)
+    );
+    assert_eq!(truss(&["frobnicate"]).status.code(), Some(2));
+}
+
+#[test]
+fn a_failed_solve_prints_why_and_exits_7() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("p.json");
+    // A load of 10⁹ N on a top node: far beyond what the members carry, no equilibrium
+    // near the nominal shape (a length error that large is refused before solving).
+    let mut model = json(&truss(&["model", "prism", "--stages", "1"]));
+    model["loads"] = serde_json::json!([{"node": "n1.0", "force": [0.0, 0.0, -1e9]}]);
+    std::fs::write(&path, model.to_string()).unwrap();
+    let out = truss(&["solve", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(7), "failed samples (truss-exit)");
+    let r = json(&out);
+    assert_eq!(r["converged"], false);
+    assert!(r["error"].as_str().unwrap().contains("did not converge"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.starts_with("truss: error: the solve failed: Newton did not converge"), "{err}");
+}
+
+fn job_path() -> String {
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../jobs/diagnose-baseline.json"
+    )
+    .to_string()
+}
+
+/// `synth-measured` then `diagnose`, as a user runs them: a strong hidden pretension on 40
+/// specimens is named, every output file is written, and the updated job is a valid job
+/// whose case carries the fitted diagonal length error.
+#[test]
+fn synth_measured_then_diagnose_names_the_hidden_effect() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = job_path();
+    let out = truss(&[
+        "synth-measured",
+        "--job",
+        &job,
+        "--case",
+        "as-built",
+        "--specimens",
+        "40",
+        "--seed",
+        "5",
+        "--effect",
+        "diagonal_pretension:length_error=-0.08",
+        "--measurement-sigma",
+        "0.001",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("specimen,node,x,y,z\n"));
+    assert_eq!(text.lines().count(), 1 + 40 * 3);
+    let measured = dir.path().join("m.csv");
+    std::fs::write(&measured, text).unwrap();
+    let report = dir.path().join("report");
+    let out = truss(&[
+        "diagnose",
+        "--job",
+        &job,
+        "--case",
+        "as-built",
+        "--measured",
+        measured.to_str().unwrap(),
+        "--measurement-sigma",
+        "0.001",
+        "--samples",
+        "600",
+        "--out",
+        report.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.starts_with("named_effect: diagonal_pretension\n"),
+        "{stdout}"
+    );
+    // Progress went to stderr.
+    assert!(String::from_utf8_lossy(&out.stderr).contains("fitting length_sigma"));
+    for f in [
+        "diagnosis.json",
+        "diagnosis.md",
+        "updated-job.json",
+        "theta_p-ecdf-before.svg",
+        "theta_p-ecdf-after.svg",
+        "top-scatter-before.svg",
+        "top-scatter-after.svg",
+    ] {
+        assert!(report.join(f).is_file(), "{f} missing");
+    }
+    let d: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report.join("diagnosis.json")).unwrap())
+            .unwrap();
+    assert_eq!(d["named_effect"], "diagonal_pretension");
+    assert!(d["indistinguishable"].is_array());
+    assert!(d["statistics"]["after"]["statistics"].is_array());
+    assert!(d["discrepancy_after"].as_f64().unwrap() < d["discrepancy_before"].as_f64().unwrap());
+    let updated =
+        truss_diagnose::baseline::Baseline::read(&report.join("updated-job.json"), "as-built")
+            .unwrap();
+    let fitted = d["parameters"][0]["value"].as_f64().unwrap();
+    match updated.distributions().get("diagonal") {
+        Some(mc_dist) => assert!((mc_dist.mean() - fitted).abs() < 1e-12),
+        None => panic!("the updated case has no diagonal length error"),
+    }
+    assert_eq!(updated.case().samples, 4000);
+}
+
+/// A bad row is an invalid-data error (exit 3) naming the file and line.
+#[test]
+fn diagnose_reports_a_bad_row_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let measured = dir.path().join("m.csv");
+    std::fs::write(
+        &measured,
+        "specimen,node,x,y,z\r\nA,n5.0,0,0,1900\r\nA,n5.1,380,zero,1900\r\n",
+    )
+    .unwrap();
+    let out = truss(&[
+        "diagnose",
+        "--job",
+        &job_path(),
+        "--case",
+        "as-built",
+        "--measured",
+        measured.to_str().unwrap(),
+        "--out",
+        dir.path().join("r").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(3));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("m.csv:3: y = \"zero\" is not a finite number"),
+        "{err}"
+    );
+}
