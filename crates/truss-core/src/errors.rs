@@ -13,6 +13,15 @@ pub enum ModelError {
         /// The operating system's error.
         source: std::io::Error,
     },
+    /// The model file was refused before it was parsed: not a regular file, too large, or
+    /// not UTF-8 (see [`crate::model_file::read_input`]).
+    #[error("{}: {reason}", path.display())]
+    Refused {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: InputRefusal,
+    },
     /// The text is not a model file (bad JSON, a missing or misspelled field).
     #[error("{origin}: line {line}, column {column}: {message}")]
     Syntax {
@@ -96,6 +105,38 @@ pub enum ModelError {
         node: String,
         /// The direction, `x`, `y` or `z`.
         dof: char,
+    },
+}
+
+/// Why an input file (a model file, a job file) was refused before it was parsed (see
+/// [`crate::model_file::read_input`]). Each is an invalid input, not an I/O failure: the file
+/// was read, or could have been, and is not what the command takes.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum InputRefusal {
+    /// A device, pipe, directory or socket: only regular files are read, so that
+    /// `/dev/zero` or a FIFO cannot feed an endless input.
+    #[error("not a regular file ({kind}); give the path of a file")]
+    NotRegularFile {
+        /// What it is: `a directory`, `a character device`, …
+        kind: &'static str,
+    },
+    /// Larger than [`crate::model_file::MAX_INPUT_BYTES`].
+    #[error("{bytes} bytes is more than the {limit} bytes an input file may have")]
+    TooLarge {
+        /// The file's size \[bytes\].
+        bytes: u64,
+        /// The limit \[bytes\].
+        limit: u64,
+    },
+    /// Not UTF-8 text.
+    #[error("not UTF-8 text: invalid bytes at line {line}, column {column} (byte {offset})")]
+    NotUtf8 {
+        /// Line of the first invalid byte, from 1.
+        line: usize,
+        /// Column (in bytes) of the first invalid byte, from 1.
+        column: usize,
+        /// Offset of the first invalid byte, from 0.
+        offset: usize,
     },
 }
 

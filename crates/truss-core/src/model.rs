@@ -12,7 +12,15 @@ use crate::model_file::{
     BehaviourSpec, JointSpec, LoadSpec, MemberSpec, ModelFile, NodeSpec, SupportSpec,
     TopSurfaceSpec,
 };
-use crate::{DEFAULT_COMPRESSION_RATIO, ModelError};
+use crate::{DEFAULT_COMPRESSION_RATIO, MAX_LENGTH_ERROR_FRACTION, ModelError};
+
+/// The largest joint clearance, as a fraction of the length of the member in the hole:
+/// `g ≤ 0.1·L₀`. A joint is a pin in a hole whose contact acts across a fixed shaft axis
+/// (see [`crate::joint`]); free play of a tenth of the member is no longer a pin joint but a
+/// loose linkage. The bound is wide on purpose: the paper's own Fig. 15 exaggerates the
+/// clearance to 30 mm on 380 mm members (7.9 %) to show the mechanism, where the real
+/// joints have about 0.01 mm.
+pub const MAX_CLEARANCE_FRACTION: f64 = 0.1;
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -117,9 +125,16 @@ pub struct Model {
 impl Model {
     /// Reads and validates a model file.
     pub fn read(path: &Path) -> Result<Self, ModelError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ModelError::Io {
-            path: path.to_path_buf(),
-            source,
+        use crate::model_file::{ReadFailure, read_input};
+        let text = read_input(path).map_err(|e| match e {
+            ReadFailure::Io(source) => ModelError::Io {
+                path: path.to_path_buf(),
+                source,
+            },
+            ReadFailure::Refused(reason) => ModelError::Refused {
+                path: path.to_path_buf(),
+                reason,
+            },
         })?;
         Self::from_json(&text, &path.display().to_string())
     }
@@ -179,7 +194,7 @@ impl Model {
         for (i, l) in file.loads.iter().enumerate() {
             let item = || format!("loads[{i}]");
             let node = lookup(&item, &l.node)?;
-            finite(&item(), "force", &l.force)?;
+            at_most(&item(), "force", &l.force, MAX_FORCE, "N")?;
             for (acc, f) in loads[node].iter_mut().zip(l.force) {
                 *acc += f;
             }
@@ -213,6 +228,13 @@ impl Model {
             joints,
             node_index,
         })
+    }
+
+    /// The largest length error member `m` may be given \[mm\]:
+    /// [`MAX_LENGTH_ERROR_FRACTION`] of its natural length.
+    pub fn max_length_error(&self, m: usize) -> f64 {
+        // L₀/100 rather than 0.01·L₀, which is 3.8000000000000003 for 380 mm.
+        self.members[m].natural_length / MAX_LENGTH_ERROR_FRACTION.recip()
     }
 
     /// The nodes.
@@ -406,7 +428,13 @@ fn positive(item: &str, field: &'static str, value: f64) -> Result<f64, ModelErr
 }
 
 fn check_node(i: usize, n: &NodeSpec) -> Result<Node, ModelError> {
-    finite(&format!("nodes[{i}] (id {:?})", n.id), "xyz", &n.xyz)?;
+    at_most(
+        &format!("nodes[{i}] (id {:?})", n.id),
+        "xyz",
+        &n.xyz,
+        MAX_COORDINATE,
+        "mm",
+    )?;
     Ok(Node {
         id: n.id.clone(),
         xyz: n.xyz,
@@ -431,11 +459,26 @@ fn check_member(
         });
     }
     let area = positive(&item(), "area", m.area)?;
+    at_most(&item(), "area", &[area], MAX_AREA, "mm²")?;
     let youngs_modulus = positive(&item(), "youngs_modulus", m.youngs_modulus)?;
+    at_most(
+        &item(),
+        "youngs_modulus",
+        &[youngs_modulus],
+        MAX_MODULUS,
+        "MPa",
+    )?;
     let natural_length = positive(
         &item(),
         "natural_length",
         m.natural_length.unwrap_or(length),
+    )?;
+    at_most(
+        &item(),
+        "natural_length",
+        &[natural_length],
+        MAX_COORDINATE,
+        "mm",
     )?;
     let behaviour = match (m.behaviour, m.compression_ratio) {
         (BehaviourSpec::Bar, None) => Behaviour::Bar,
@@ -581,6 +624,23 @@ fn check_joint(
             message: format!("clearance must be at least 0 mm, got {}", j.clearance),
         });
     }
+    let shortest = members
+        .iter()
+        .filter(|m| m.nodes.contains(&hole))
+        .map(|m| m.natural_length)
+        .fold(f64::INFINITY, f64::min);
+    if j.clearance > MAX_CLEARANCE_FRACTION * shortest {
+        return Err(ModelError::Invalid {
+            item: item(),
+            message: format!(
+                "clearance {} mm is more than {}% of its member's length {shortest} mm: \
+                 free play that large is not a pin joint (see \
+                 truss_core::model::MAX_CLEARANCE_FRACTION)",
+                j.clearance,
+                100.0 * MAX_CLEARANCE_FRACTION
+            ),
+        });
+    }
     let tension_stiffness = match j.tension_stiffness {
         Some(k) => positive(&item(), "tension_stiffness", k)?,
         None => {
@@ -627,6 +687,35 @@ fn check_joint(
         compression_ratio,
         axial_stiffness,
     })
+}
+
+/// Largest coordinate, `|x|`, `|y|`, `|z|` ≤ 10⁷ mm (10 km) \[mm\]: a plausible bound that
+/// keeps every product of the solver far from overflow (a coordinate of 1e308 would pass
+/// `is_finite` and make every length infinite).
+pub const MAX_COORDINATE: f64 = 1e7;
+/// Largest member cross-section, 10⁸ mm² (100 m²) \[mm²\].
+pub const MAX_AREA: f64 = 1e8;
+/// Largest Young's modulus, 10⁷ MPa (10 TPa, ten times diamond's) \[MPa\].
+pub const MAX_MODULUS: f64 = 1e7;
+/// Largest component of a nodal load, 10¹² N \[N\].
+pub const MAX_FORCE: f64 = 1e12;
+
+/// Refuses a value beyond ±`max` (after [`finite`]), naming its item and field.
+fn at_most(
+    item: &str,
+    field: &'static str,
+    values: &[f64],
+    max: f64,
+    unit: &str,
+) -> Result<(), ModelError> {
+    finite(item, field, values)?;
+    match values.iter().find(|v| v.abs() > max) {
+        None => Ok(()),
+        Some(v) => Err(ModelError::Invalid {
+            item: item.to_string(),
+            message: format!("{field} {v:e} is beyond the plausible ±{max:e} {unit}"),
+        }),
+    }
 }
 
 /// Largest accepted `compression_ratio` of a joint: with the default contact stiffness
@@ -719,4 +808,45 @@ fn check_joint_layout(
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::prism::{BacklashOptions, PrismOptions};
+
+    /// Finite but implausible magnitudes (1e308 passes `is_finite`) are refused by item and
+    /// field: a coordinate, an area, a modulus, a load, a joint clearance.
+    #[test]
+    fn implausible_magnitudes_are_refused_by_field() {
+        let prism = || PrismOptions::with_stages(1).file().unwrap();
+        let message = |f| crate::Model::new(f).unwrap_err().to_string();
+        let mut f = prism();
+        f.nodes[4].xyz[2] = 1e308;
+        let m = message(f);
+        assert!(m.starts_with("nodes[4] (id \"n1.1\"): xyz 1e308"), "{m}");
+        let mut f = prism();
+        f.members[0].area = 1e308;
+        assert!(message(f).contains("members[0] (id \"batten.0.0\"): area 1e308"));
+        let mut f = prism();
+        f.members[3].youngs_modulus = 1e308;
+        assert!(message(f).contains("youngs_modulus 1e308"));
+        let mut f = prism();
+        f.loads.push(crate::model_file::LoadSpec {
+            node: "n1.0".into(),
+            force: [0.0, 0.0, -1e308],
+        });
+        assert!(message(f).contains("loads[0]: force -1e308"));
+        let mut f = PrismOptions {
+            backlash: Some(BacklashOptions::default()),
+            ..PrismOptions::with_stages(1)
+        }
+        .file()
+        .unwrap();
+        f.joints[0].clearance = 40.0;
+        let m = message(f);
+        assert!(
+            m.contains("joints[0]") && m.contains("clearance 40 mm"),
+            "{m}"
+        );
+    }
 }

@@ -47,7 +47,94 @@
 //! Unknown fields are refused, so a misspelt field name is an error rather than a silently
 //! ignored value.
 
+use crate::errors::InputRefusal;
 use serde::{Deserialize, Serialize};
+use std::io::Read;
+use std::path::Path;
+
+/// The largest input file (model file, job file) read, 64 MiB \[bytes\]: ten times the model
+/// of the largest prism ([`crate::prism::MAX_STAGES`] stages with backlash joints, 6.1 MB as
+/// `truss model prism` writes it), so the limit refuses only what no truss needs, or what
+/// never ends, before it is read into memory.
+pub const MAX_INPUT_BYTES: u64 = 64 << 20;
+
+/// Why [`read_input`] failed: the file could not be read, or it was refused.
+#[derive(Debug)]
+pub enum ReadFailure {
+    /// The operating system's error (a missing file, no permission): an I/O failure.
+    Io(std::io::Error),
+    /// Read, or readable, but not an input this program takes: an invalid input.
+    Refused(InputRefusal),
+}
+
+/// Reads an input file's text, refusing before it reads far what cannot be an input: a
+/// file that is not a regular file (a directory, `/dev/zero`, a FIFO), one larger than
+/// [`MAX_INPUT_BYTES`] (checked on the open file, and again while reading, in case it
+/// grows), or text that is not UTF-8. A leading UTF-8 byte-order mark, which some Windows
+/// editors write, is accepted and dropped.
+pub fn read_input(path: &Path) -> Result<String, ReadFailure> {
+    let file = std::fs::File::open(path).map_err(ReadFailure::Io)?;
+    let meta = file.metadata().map_err(ReadFailure::Io)?;
+    if !meta.is_file() {
+        return Err(ReadFailure::Refused(InputRefusal::NotRegularFile {
+            kind: file_kind(&meta.file_type()),
+        }));
+    }
+    let too_large = |bytes| {
+        ReadFailure::Refused(InputRefusal::TooLarge {
+            bytes,
+            limit: MAX_INPUT_BYTES,
+        })
+    };
+    if meta.len() > MAX_INPUT_BYTES {
+        return Err(too_large(meta.len()));
+    }
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(MAX_INPUT_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(ReadFailure::Io)?;
+    if bytes.len() as u64 > MAX_INPUT_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let offset = e.utf8_error().valid_up_to();
+        let before = &e.as_bytes()[..offset];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        let column = offset
+            - before
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(0, |p| p + 1)
+            + 1;
+        ReadFailure::Refused(InputRefusal::NotUtf8 {
+            line,
+            column,
+            offset,
+        })
+    })?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
+}
+
+/// What a file that is not a regular file is, in words.
+fn file_kind(t: &std::fs::FileType) -> &'static str {
+    use std::os::unix::fs::FileTypeExt;
+    if t.is_dir() {
+        "a directory"
+    } else if t.is_char_device() {
+        "a character device"
+    } else if t.is_block_device() {
+        "a block device"
+    } else if t.is_fifo() {
+        "a pipe"
+    } else if t.is_socket() {
+        "a socket"
+    } else {
+        "not a file"
+    }
+}
 
 /// A model file as written: ids are strings, nothing is checked yet.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -179,6 +266,7 @@ fn default_normal() -> [f64; 3] {
 impl ModelFile {
     /// Parses a model file's text; `origin` names it in errors (a path, or `<string>`).
     pub fn from_json(text: &str, origin: &str) -> Result<Self, crate::ModelError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         serde_json::from_str(text).map_err(|e| crate::ModelError::Syntax {
             origin: origin.to_string(),
             line: e.line(),
@@ -192,5 +280,74 @@ impl ModelFile {
         let mut s = serde_json::to_string_pretty(self).expect("model files always serialise");
         s.push('\n');
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{MAX_INPUT_BYTES, ReadFailure, read_input};
+    use crate::InputRefusal;
+
+    fn refusal(path: &std::path::Path) -> InputRefusal {
+        match read_input(path) {
+            Err(ReadFailure::Refused(r)) => r,
+            other => panic!("{}: expected a refusal, got {other:?}", path.display()),
+        }
+    }
+
+    /// Devices and directories are refused at once, before a byte is read: `/dev/zero`
+    /// would otherwise fill the memory.
+    #[test]
+    fn only_regular_files_are_read() {
+        assert_eq!(
+            refusal(std::path::Path::new("/dev/zero")),
+            InputRefusal::NotRegularFile {
+                kind: "a character device"
+            }
+        );
+        let dir = tempfile::tempdir().unwrap();
+        assert_eq!(
+            refusal(dir.path()),
+            InputRefusal::NotRegularFile {
+                kind: "a directory"
+            }
+        );
+        let missing = read_input(&dir.path().join("missing.json"));
+        assert!(matches!(missing, Err(ReadFailure::Io(_))), "{missing:?}");
+    }
+
+    /// A file over the limit is refused from its size (a sparse file: nothing is written).
+    #[test]
+    fn files_over_the_limit_are_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("big.json");
+        let file = std::fs::File::create(&path).unwrap();
+        file.set_len(MAX_INPUT_BYTES + 1).unwrap();
+        assert_eq!(
+            refusal(&path),
+            InputRefusal::TooLarge {
+                bytes: MAX_INPUT_BYTES + 1,
+                limit: MAX_INPUT_BYTES
+            }
+        );
+    }
+
+    /// Invalid UTF-8 is refused with its line and column; a UTF-8 byte-order mark is
+    /// dropped, and the text after it is read unchanged.
+    #[test]
+    fn text_must_be_utf8_and_a_bom_is_dropped() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("latin1.json");
+        std::fs::write(&path, b"{\n  \"id\": \"n\xe90\"\n}").unwrap();
+        assert_eq!(
+            refusal(&path),
+            InputRefusal::NotUtf8 {
+                line: 2,
+                column: 11,
+                offset: 12
+            }
+        );
+        std::fs::write(&path, "\u{feff}{\"a\": 1}").unwrap();
+        assert_eq!(read_input(&path).unwrap(), "{\"a\": 1}");
     }
 }

@@ -45,6 +45,9 @@
 //! slightly in compression; [`PrismOptions::diagonal_length`] `None` gives the exact length.
 
 use crate::joint::{DEFAULT_JOINT_COMPRESSION_RATIO, DEFAULT_JOINT_TENSION_FACTOR};
+use crate::model::{
+    MAX_AREA, MAX_CLEARANCE_FRACTION, MAX_COORDINATE, MAX_JOINT_COMPRESSION_RATIO, MAX_MODULUS,
+};
 use crate::model_file::JointSpec;
 use crate::model_file::{
     BehaviourSpec, MemberSpec, ModelFile, NodeSpec, SupportSpec, TopSurfaceSpec,
@@ -97,6 +100,19 @@ pub struct BacklashOptions {
     pub compression_ratio: f64,
 }
 
+/// The largest stage count accepted, 1000.
+///
+/// Memory and time grow linearly with the stages (a block-banded stiffness; 12 members and 9
+/// degrees of freedom per stage, 27 with backlash joints): the largest prism is a model of
+/// 12,003 members, 3.4 MB as `truss model prism` writes it (6.1 MB with backlash joints),
+/// which takes some tens of MB to build and solve. Real deployable masts have tens of stages
+/// (the paper's truss 5; the 60 m mast of the Shuttle Radar Topography Mission 87), so 1000
+/// leaves room for any mast, and for convergence studies, while refusing at once, by name,
+/// a count such as 2⁶⁴ − 1 that would exhaust the memory (and whose model file could not
+/// be read back: it would pass [`crate::model_file::MAX_INPUT_BYTES`] beyond some 19,000
+/// stages).
+pub const MAX_STAGES: usize = 1000;
+
 /// The paper's size of the backlash at a node, "about 0.01 mm" (section 4.1) \[mm\].
 pub const PAPER_CLEARANCE: f64 = 0.01;
 
@@ -138,14 +154,94 @@ impl PrismOptions {
         }
     }
 
-    /// The model file of the prism.
-    pub fn file(&self) -> Result<ModelFile, ModelError> {
-        if self.stages == 0 {
-            return Err(ModelError::Invalid {
-                item: "prism".into(),
-                message: "stages must be at least 1".into(),
-            });
+    /// Checks every option before any is used; the error is the field's name as a job
+    /// writes it (`stages`, `backlash.clearance`, …) and what is wrong. Limits: `1 ≤ stages ≤`
+    /// [`MAX_STAGES`]; lengths in (0, [`MAX_COORDINATE`]] mm; areas in (0, [`MAX_AREA`]] mm²;
+    /// moduli in (0, [`MAX_MODULUS`]] MPa; cable compression ratio in [0, 1); the diagonal's
+    /// natural length in (0, [`MAX_COORDINATE`]] mm; a clearance in
+    /// [0, [`MAX_CLEARANCE_FRACTION`] × the shorter of side and height]; joint tension
+    /// factor in (0, 10⁹]; joint compression ratio in [0, [`MAX_JOINT_COMPRESSION_RATIO`]].
+    pub fn check(&self) -> Result<(), (&'static str, String)> {
+        if !(1..=MAX_STAGES).contains(&self.stages) {
+            return Err((
+                "stages",
+                format!(
+                    "must be from 1 to {MAX_STAGES} (the limit keeps a model within memory), got {}",
+                    self.stages
+                ),
+            ));
         }
+        let within = |field: &'static str, v: f64, max: f64, unit: &str| {
+            if v.is_finite() && v > 0.0 && v <= max {
+                Ok(())
+            } else {
+                Err((
+                    field,
+                    format!("must be positive and at most {max:e} {unit}, got {v:e}"),
+                ))
+            }
+        };
+        within("side", self.side, MAX_COORDINATE, "mm")?;
+        within("height", self.height, MAX_COORDINATE, "mm")?;
+        within("batten_area", self.batten_area, MAX_AREA, "mm²")?;
+        within("longeron_area", self.longeron_area, MAX_AREA, "mm²")?;
+        within("diagonal_area", self.diagonal_area, MAX_AREA, "mm²")?;
+        within("batten_modulus", self.batten_modulus, MAX_MODULUS, "MPa")?;
+        within(
+            "longeron_modulus",
+            self.longeron_modulus,
+            MAX_MODULUS,
+            "MPa",
+        )?;
+        within(
+            "diagonal_modulus",
+            self.diagonal_modulus,
+            MAX_MODULUS,
+            "MPa",
+        )?;
+        if !(0.0..1.0).contains(&self.compression_ratio) {
+            return Err((
+                "compression_ratio",
+                format!("must be in [0, 1), got {}", self.compression_ratio),
+            ));
+        }
+        if let Some(d) = self.diagonal_length {
+            within("diagonal_length", d, MAX_COORDINATE, "mm")?;
+        }
+        if let Some(b) = &self.backlash {
+            let max = MAX_CLEARANCE_FRACTION * self.side.min(self.height);
+            if !(b.clearance.is_finite() && (0.0..=max).contains(&b.clearance)) {
+                return Err((
+                    "backlash.clearance",
+                    format!(
+                        "must be from 0 to {max} mm ({}% of the shorter of side and height), got {:e}",
+                        100.0 * MAX_CLEARANCE_FRACTION,
+                        b.clearance
+                    ),
+                ));
+            }
+            within("backlash.tension_factor", b.tension_factor, 1e9, "")?;
+            if !(0.0..=MAX_JOINT_COMPRESSION_RATIO).contains(&b.compression_ratio) {
+                return Err((
+                    "backlash.compression_ratio",
+                    format!(
+                        "must be in [0, {MAX_JOINT_COMPRESSION_RATIO:e}], got {}",
+                        b.compression_ratio
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The model file of the prism (after [`PrismOptions::check`], whose field it names as
+    /// `prism.FIELD`).
+    pub fn file(&self) -> Result<ModelFile, ModelError> {
+        self.check()
+            .map_err(|(field, message)| ModelError::Invalid {
+                item: format!("prism.{field}"),
+                message,
+            })?;
         let (l, h) = (self.side, self.height);
         let vertex = |j: usize, k: usize| match j {
             0 => [0.0, 0.0, k as f64 * h],
@@ -308,5 +404,54 @@ impl PrismOptions {
     /// The validated model of the prism.
     pub fn model(&self) -> Result<Model, ModelError> {
         Model::new(self.file()?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Stage counts outside 1..=MAX_STAGES and implausible values are refused by field,
+    /// before any node is made (2⁶⁴ − 1 stages used to fill the memory).
+    #[test]
+    fn options_are_checked_by_field_before_building() {
+        for stages in [0, MAX_STAGES + 1, usize::MAX] {
+            let e = PrismOptions::with_stages(stages).check().unwrap_err();
+            assert_eq!(e.0, "stages", "{stages}");
+            let m = PrismOptions::with_stages(stages).file().unwrap_err();
+            assert!(m.to_string().starts_with("prism.stages: "), "{m}");
+        }
+        assert!(PrismOptions::with_stages(MAX_STAGES).check().is_ok());
+        let field = |o: PrismOptions| o.check().unwrap_err().0;
+        let t = PrismOptions::default;
+        assert_eq!(field(PrismOptions { side: 1e308, ..t() }), "side");
+        assert_eq!(
+            field(PrismOptions {
+                height: -1.0,
+                ..t()
+            }),
+            "height"
+        );
+        let nan = PrismOptions {
+            batten_modulus: f64::NAN,
+            ..t()
+        };
+        assert_eq!(field(nan), "batten_modulus");
+        let loose = PrismOptions {
+            backlash: Some(BacklashOptions {
+                clearance: 1e308,
+                ..BacklashOptions::default()
+            }),
+            ..t()
+        };
+        assert_eq!(field(loose), "backlash.clearance");
+        let exaggerated = PrismOptions {
+            backlash: Some(BacklashOptions {
+                clearance: 30.0,
+                ..BacklashOptions::default()
+            }),
+            ..t()
+        };
+        assert!(exaggerated.check().is_ok(), "the paper's Fig. 15 clearance");
     }
 }
