@@ -22,6 +22,15 @@
 //! `reference` a point in mm, default the origin) lengthens each member by
 //! `α·ΔT(x_mid)·L` \[mm\], its midpoint's temperature times its nominal length, added to its
 //! length error. Default α = 23e-6 /K (aluminium).
+//!
+//! ## Plausible values
+//!
+//! Beyond being finite, each value must be plausible, so that a typo such as `1e308` is
+//! refused by name rather than failing every sample: `0 ≤ g ≤` [`MAX_GRAVITY`],
+//! `0 ≤ density ≤` [`MAX_DENSITY`], `|α| ≤` [`MAX_ALPHA`], `|offset| ≤` [`MAX_TEMPERATURE_CHANGE`],
+//! each gradient component at most [`MAX_GRADIENT`], each `direction` and `reference`
+//! component at most [`truss_core::model::MAX_COORDINATE`]. The job also refuses a thermal
+//! strain `α·ΔT` beyond [`truss_core::MAX_LENGTH_ERROR_FRACTION`] in any member.
 
 use serde::{Deserialize, Serialize};
 use truss_core::Model;
@@ -76,6 +85,17 @@ pub struct ThermalSpec {
     pub reference: [f64; 3],
 }
 
+/// Largest gravity, 1000 m/s² (about 100 g₀, beyond any ground test) \[m/s²\].
+pub const MAX_GRAVITY: f64 = 1000.0;
+/// Largest density, 10⁻⁴ kg/mm³ (100,000 kg/m³, four times osmium's) \[kg/mm³\].
+pub const MAX_DENSITY: f64 = 1e-4;
+/// Largest |α|, 10⁻³ /K (five times that of the most expansive plastics) \[1/K\].
+pub const MAX_ALPHA: f64 = 1e-3;
+/// Largest |temperature change| at the reference point, 1000 K \[K\].
+pub const MAX_TEMPERATURE_CHANGE: f64 = 1000.0;
+/// Largest |temperature gradient| component, 10 K/mm \[K/mm\].
+pub const MAX_GRADIENT: f64 = 10.0;
+
 fn standard_gravity() -> f64 {
     STANDARD_GRAVITY
 }
@@ -97,19 +117,25 @@ pub struct Applied {
 }
 
 impl EffectsSpec {
-    /// Checks the parameters; the error names the field (relative to `effects`).
+    /// Checks the parameters (finite, and within the plausible bounds of the module doc);
+    /// the error names the field (relative to `effects`).
     pub fn check(&self) -> Result<(), (String, String)> {
-        let finite = |field: &str, v: &[f64]| {
-            if v.iter().all(|x| x.is_finite()) {
-                Ok(())
-            } else {
-                Err((field.to_string(), "must be finite numbers".to_string()))
-            }
+        use truss_core::model::MAX_COORDINATE;
+        let bounded = |field: &str, v: &[f64], max: f64, unit: &str| match v
+            .iter()
+            .find(|x| !x.is_finite() || x.abs() > max)
+        {
+            None => Ok(()),
+            Some(x) if !x.is_finite() => Err((field.to_string(), "must be finite numbers".into())),
+            Some(x) => Err((
+                field.to_string(),
+                format!("{x:e} is beyond the plausible ±{max:e} {unit}"),
+            )),
         };
         if let Some(g) = &self.gravity {
-            finite("gravity.direction", &g.direction)?;
-            finite("gravity.g", &[g.g])?;
-            finite("gravity.density", &[g.density])?;
+            bounded("gravity.direction", &g.direction, MAX_COORDINATE, "")?;
+            bounded("gravity.g", &[g.g], MAX_GRAVITY, "m/s²")?;
+            bounded("gravity.density", &[g.density], MAX_DENSITY, "kg/mm³")?;
             if g.direction == [0.0; 3] {
                 return Err(("gravity.direction".into(), "must not be zero".into()));
             }
@@ -121,10 +147,25 @@ impl EffectsSpec {
             }
         }
         if let Some(t) = &self.thermal_gradient {
-            finite("thermal_gradient.gradient", &t.gradient)?;
-            finite("thermal_gradient.offset", &[t.offset])?;
-            finite("thermal_gradient.alpha", &[t.alpha])?;
-            finite("thermal_gradient.reference", &t.reference)?;
+            bounded(
+                "thermal_gradient.gradient",
+                &t.gradient,
+                MAX_GRADIENT,
+                "K/mm",
+            )?;
+            bounded(
+                "thermal_gradient.offset",
+                &[t.offset],
+                MAX_TEMPERATURE_CHANGE,
+                "K",
+            )?;
+            bounded("thermal_gradient.alpha", &[t.alpha], MAX_ALPHA, "/K")?;
+            bounded(
+                "thermal_gradient.reference",
+                &t.reference,
+                MAX_COORDINATE,
+                "mm",
+            )?;
         }
         Ok(())
     }
@@ -172,6 +213,46 @@ impl EffectsSpec {
 mod tests {
     use super::*;
     use truss_core::prism::PrismOptions;
+
+    /// Each value beyond its plausible bound, or not finite, is refused by its field.
+    #[test]
+    fn implausible_values_are_refused_by_field() {
+        let gravity = |g: f64, density: f64| EffectsSpec {
+            gravity: Some(GravitySpec {
+                direction: [0.0, 0.0, -1.0],
+                g,
+                density,
+            }),
+            thermal_gradient: None,
+        };
+        assert!(gravity(STANDARD_GRAVITY, ALUMINIUM_DENSITY).check().is_ok());
+        assert_eq!(
+            gravity(1e308, ALUMINIUM_DENSITY).check().unwrap_err().0,
+            "gravity.g"
+        );
+        assert_eq!(gravity(f64::NAN, 0.0).check().unwrap_err().0, "gravity.g");
+        assert_eq!(
+            gravity(9.8, 1e308).check().unwrap_err().0,
+            "gravity.density"
+        );
+        let thermal = |offset: f64, alpha: f64| EffectsSpec {
+            gravity: None,
+            thermal_gradient: Some(ThermalSpec {
+                gradient: [0.0, 0.0, 0.002],
+                offset,
+                alpha,
+                reference: [0.0; 3],
+            }),
+        };
+        assert!(thermal(0.5, ALUMINIUM_ALPHA).check().is_ok());
+        let e = thermal(1e308, ALUMINIUM_ALPHA).check().unwrap_err();
+        assert_eq!(e.0, "thermal_gradient.offset");
+        assert!(e.1.contains("1e308"), "{}", e.1);
+        assert_eq!(
+            thermal(0.5, 1.0).check().unwrap_err().0,
+            "thermal_gradient.alpha"
+        );
+    }
 
     /// Total weight = ρ·g·Σ A·L, all of it along the direction; each batten of 380 mm and
     /// 14.9 mm² weighs 2.7e-6 · 14.9 · 380 · 9.80665 = 0.149918 N.

@@ -13,6 +13,15 @@ pub enum JobError {
         /// The operating system's error.
         source: std::io::Error,
     },
+    /// The job file was refused before it was parsed: not a regular file, too large, or not
+    /// UTF-8 (see [`truss_core::model_file::read_input`]).
+    #[error("{}: {reason}", path.display())]
+    Refused {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        reason: truss_core::InputRefusal,
+    },
     /// A value is invalid; `path` is its JSON path (`cases[2].length_errors.longeron`).
     #[error("{}{message}", if path.is_empty() { String::new() } else { format!("{path}: ") })]
     Invalid {
@@ -43,7 +52,7 @@ impl JobError {
     /// This error, said of the job file `file`.
     pub fn in_file(self, file: &std::path::Path) -> Self {
         match self {
-            e @ JobError::Io { .. } => e,
+            e @ (JobError::Io { .. } | JobError::Refused { .. }) => e,
             e => JobError::InFile {
                 file: file.to_path_buf(),
                 source: Box::new(e),

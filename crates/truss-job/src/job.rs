@@ -31,6 +31,23 @@
 //! Unknown fields are refused. Every fault is reported with its JSON path
 //! (`cases[2].length_errors.longron: the model has no group "longron" …`).
 //!
+//! ## Limits
+//!
+//! A job is refused, naming the field, before any model is built or any sample drawn, when:
+//! the file is not a regular file, is larger than
+//! [`MAX_INPUT_BYTES`](truss_core::model_file::MAX_INPUT_BYTES) or is not UTF-8 (a leading
+//! UTF-8 byte-order mark is accepted); a prism has more than
+//! [`MAX_STAGES`](truss_core::prism::MAX_STAGES) stages or an implausible option (see
+//! [`PrismOptions::check`]); a case has more than [`MAX_CASE_SAMPLES`] samples, or the job
+//! more than [`MAX_JOB_SAMPLES`]; a length error can reach beyond
+//! [`MAX_LENGTH_ERROR_FRACTION`](truss_core::MAX_LENGTH_ERROR_FRACTION) of a member's
+//! natural length (a normal's `|mean| + 6σ`, see
+//! [`NORMAL_REACH`](crate::distribution::NORMAL_REACH); a uniform's bounds; a constant),
+//! alone or with a thermal effect's `α·ΔT·L`; a clearance can exceed
+//! [`MAX_CLEARANCE_FRACTION`](truss_core::model::MAX_CLEARANCE_FRACTION) of a jointed
+//! member's length; an effect's value is implausible (see [`crate::effects`]); a group is
+//! named twice, or given two distributions.
+//!
 //! ## Job id
 //!
 //! The SHA-256 (hex) of the job's canonical form: the seed, and per case its name, sample
@@ -55,6 +72,15 @@ use truss_core::{Model, Structure};
 /// Version of the numerics: bumped whenever the solver or the sampling would give different
 /// numbers for the same job, so that the job id changes and old and new shards never mix.
 pub const NUMERICS_VERSION: u32 = 2;
+
+/// The most samples a case may have, 10⁸. At 10⁸ samples the 95th percentile's relative
+/// standard error is about 10⁻⁴, far finer than any input of the model is known; and the
+/// merge keeps each case's θ_P values in memory (8 bytes each: 800 MB at the limit).
+pub const MAX_CASE_SAMPLES: u64 = 100_000_000;
+
+/// The most samples a job may have over all its cases, 10⁹ (about 14 CPU-hours of the
+/// paper's 5-stage truss at some 50 µs a sample).
+pub const MAX_JOB_SAMPLES: u64 = 1_000_000_000;
 
 /// A job file as written: read with [`JobSpec::from_json`], written with
 /// [`JobSpec::to_json`], validated into a [`Job`] by [`Job::new`].
@@ -81,7 +107,11 @@ pub struct CaseSpec<M = ModelSpec> {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<M>,
     /// Length-error distribution per member group \[mm\].
-    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    #[serde(
+        default,
+        skip_serializing_if = "BTreeMap::is_empty",
+        deserialize_with = "distinct_groups"
+    )]
     pub length_errors: BTreeMap<String, DistributionSpec>,
     /// Deterministic effects: self-weight, a temperature field (see [`crate::effects`]).
     #[serde(default, skip_serializing_if = "EffectsSpec::is_empty")]
@@ -89,6 +119,36 @@ pub struct CaseSpec<M = ModelSpec> {
     /// Joint clearances drawn per joint and sample; needs a model with joints.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backlash: Option<CaseBacklash>,
+}
+
+/// Reads `length_errors`, refusing a group named twice (which a plain map would take as its
+/// last value, silently).
+fn distinct_groups<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<BTreeMap<String, DistributionSpec>, D::Error> {
+    struct Groups;
+    impl<'de> serde::de::Visitor<'de> for Groups {
+        type Value = BTreeMap<String, DistributionSpec>;
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("a map from member group to distribution")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut a: A,
+        ) -> Result<Self::Value, A::Error> {
+            let mut groups = BTreeMap::new();
+            while let Some(group) = a.next_key::<String>()? {
+                let dist: DistributionSpec = a.next_value()?;
+                if groups.insert(group.clone(), dist).is_some() {
+                    return Err(serde::de::Error::custom(format!(
+                        "group {group:?} is given twice: give it one distribution"
+                    )));
+                }
+            }
+            Ok(groups)
+        }
+    }
+    d.deserialize_map(Groups)
 }
 
 /// A model as a job writes it: `{"prism": {...}}` (the paper's prism, any Table 1 value
@@ -146,6 +206,9 @@ impl ModelSpec {
                                     &e.into_inner().to_string(),
                                 )
                             })?;
+                        options
+                            .check()
+                            .map_err(|(field, m)| JobError::at(&format!("{at}.{field}"), &m))?;
                         Ok(ModelSpec::Prism(options))
                     }
                     _ => Err(bad()),
@@ -166,7 +229,9 @@ impl ModelSpec {
 
 impl JobSpec {
     /// Parses a job's text, naming faults by their JSON path.
+    /// A leading UTF-8 byte-order mark is accepted and dropped.
     pub fn from_json(text: &str) -> Result<Self, JobError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let de = &mut serde_json::Deserializer::from_str(text);
         let raw: JobSpec<serde_json::Value> =
             serde_path_to_error::deserialize(de).map_err(|e| {
@@ -263,9 +328,16 @@ pub struct Job {
 impl Job {
     /// Reads and validates a job file.
     pub fn read(path: &Path) -> Result<Self, JobError> {
-        let text = std::fs::read_to_string(path).map_err(|source| JobError::Io {
-            path: path.to_path_buf(),
-            source,
+        use truss_core::model_file::{ReadFailure, read_input};
+        let text = read_input(path).map_err(|e| match e {
+            ReadFailure::Io(source) => JobError::Io {
+                path: path.to_path_buf(),
+                source,
+            },
+            ReadFailure::Refused(reason) => JobError::Refused {
+                path: path.to_path_buf(),
+                reason,
+            },
         })?;
         let base = path.parent().unwrap_or(Path::new("."));
         let mut job = Self::from_json(&text, base).map_err(|e| e.in_file(path))?;
@@ -297,8 +369,14 @@ impl Job {
                     &format!("{:?} is also the name of cases[{j}]", c.name),
                 ));
             }
-            if c.samples == 0 {
-                return Err(JobError::at(&at("samples"), "must be at least 1"));
+            if !(1..=MAX_CASE_SAMPLES).contains(&c.samples) {
+                return Err(JobError::at(
+                    &at("samples"),
+                    &format!(
+                        "must be from 1 to {MAX_CASE_SAMPLES} (10⁸) per case, got {}",
+                        c.samples
+                    ),
+                ));
             }
             let (model, structure, stages) = match &c.model {
                 Some(m) => resolve_model(m, &at("model"), base)?,
@@ -340,6 +418,10 @@ impl Job {
                 }
             }
             let applied = c.effects.apply(&model);
+            check_reach(&model, &c.length_errors, &applied, &at)?;
+            if let Some(b) = &c.backlash {
+                check_clearance(&model, &b.clearance, &at("backlash.clearance"))?;
+            }
             let member_errors = model
                 .members()
                 .iter()
@@ -379,9 +461,16 @@ impl Job {
                 applied,
                 backlash: c.backlash,
             });
-            start = start.checked_add(c.samples).ok_or_else(|| {
-                JobError::at(&at("samples"), "the job has more than 2^64 samples")
-            })?;
+            start += c.samples;
+            if start > MAX_JOB_SAMPLES {
+                return Err(JobError::at(
+                    &at("samples"),
+                    &format!(
+                        "the job's cases have {start} samples up to here, more than the \
+                         {MAX_JOB_SAMPLES} (10⁹) a job may have"
+                    ),
+                ));
+            }
         }
         let id = job_id(spec.seed, &cases);
         Ok(Self {
@@ -412,6 +501,103 @@ impl Job {
     }
 }
 
+/// Refuses length errors that can reach beyond
+/// [`MAX_LENGTH_ERROR_FRACTION`](truss_core::MAX_LENGTH_ERROR_FRACTION) of a member's
+/// natural length ([`Model::max_length_error`]): a group's distribution alone (its
+/// [`DistributionSpec::reach`]), a thermal effect alone, or both together. `at` makes a
+/// field's JSON path.
+fn check_reach(
+    model: &Model,
+    length_errors: &BTreeMap<String, DistributionSpec>,
+    applied: &Applied,
+    at: &dyn Fn(&str) -> String,
+) -> Result<(), JobError> {
+    let percent = 100.0 * truss_core::MAX_LENGTH_ERROR_FRACTION;
+    for (m, member) in model.members().iter().enumerate() {
+        let max = model.max_length_error(m);
+        let thermal = applied.length_changes.get(m).map_or(0.0, |x| x.abs());
+        let dist = length_errors.get(&member.group);
+        let reach = dist.map_or(0.0, DistributionSpec::reach);
+        let what = match dist {
+            Some(DistributionSpec::Normal { .. }) => {
+                format!(
+                    "|mean| + {}σ = {reach:e} mm",
+                    crate::distribution::NORMAL_REACH
+                )
+            }
+            Some(DistributionSpec::Uniform { .. }) => format!("a bound of {reach:e} mm"),
+            Some(DistributionSpec::Constant { .. }) => format!("a value of {reach:e} mm"),
+            None => String::new(),
+        };
+        let limit = format!(
+            "more than {percent}% of member {:?}'s natural length {} mm ({max} mm): a \
+             length error beyond the elastic range, where the model means nothing (see \
+             truss_core::MAX_LENGTH_ERROR_FRACTION)",
+            member.id, member.natural_length
+        );
+        if reach > max {
+            return Err(JobError::at(
+                &at(&format!("length_errors.{}", member.group)),
+                &format!("{what} is {limit}"),
+            ));
+        }
+        if thermal > max {
+            return Err(JobError::at(
+                &at("effects.thermal_gradient"),
+                &format!("a thermal length change of {thermal:e} mm is {limit}"),
+            ));
+        }
+        if reach + thermal > max {
+            return Err(JobError::at(
+                &at("effects.thermal_gradient"),
+                &format!(
+                    "a thermal length change of {thermal:e} mm with length_errors.{}'s {what} \
+                     is {limit}",
+                    member.group
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a clearance distribution that can exceed
+/// [`MAX_CLEARANCE_FRACTION`](truss_core::model::MAX_CLEARANCE_FRACTION) of the length of
+/// a member held by a joint.
+fn check_clearance(
+    model: &Model,
+    clearance: &DistributionSpec,
+    path: &str,
+) -> Result<(), JobError> {
+    let fraction = truss_core::model::MAX_CLEARANCE_FRACTION;
+    let shortest = model
+        .joints()
+        .iter()
+        .flat_map(|j| {
+            model
+                .members()
+                .iter()
+                .filter(move |m| m.nodes.contains(&j.hole))
+        })
+        .map(|m| m.natural_length)
+        .fold(f64::INFINITY, f64::min);
+    let max = fraction * shortest;
+    let highest = clearance.highest();
+    if highest <= max {
+        Ok(())
+    } else {
+        Err(JobError::at(
+            path,
+            &format!(
+                "a clearance can reach {highest:e} mm, more than {}% of the shortest jointed \
+                 member's length {shortest} mm ({max} mm): free play that large is not a pin \
+                 joint (see truss_core::model::MAX_CLEARANCE_FRACTION)",
+                100.0 * fraction
+            ),
+        ))
+    }
+}
+
 /// A model and its compiled structure, with the prism's stage count if it is one.
 type Resolved = (Arc<Model>, Arc<Structure>, Option<usize>);
 
@@ -433,10 +619,14 @@ fn resolve_model(spec: &ModelSpec, path: &str, base: &Path) -> Result<Resolved, 
 
 fn read_model(file: &Path, path: &str, base: &Path) -> Result<Model, JobError> {
     let full = base.join(file);
-    let text = std::fs::read_to_string(&full).map_err(|e| {
+    let text = truss_core::model_file::read_input(&full).map_err(|e| {
+        let why = match e {
+            truss_core::model_file::ReadFailure::Io(e) => e.to_string(),
+            truss_core::model_file::ReadFailure::Refused(r) => r.to_string(),
+        };
         JobError::at(
             path,
-            &format!("cannot read model file {}: {e}", full.display()),
+            &format!("cannot read model file {}: {why}", full.display()),
         )
     })?;
     Model::from_json(&text, &full.display().to_string())
@@ -488,4 +678,172 @@ fn job_id(seed: u64, cases: &[Case]) -> String {
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The message of the job `text` refused.
+    fn refusal(text: &str) -> String {
+        Job::from_json(text, Path::new("."))
+            .map(|_| ())
+            .unwrap_err()
+            .to_string()
+    }
+
+    /// A job of one case of the 1-stage prism, `case` spliced into the case.
+    fn job(case: &str) -> String {
+        format!(
+            r#"{{"model": {{"prism": {{"stages": 1}}}}, "seed": 1,
+                "cases": [{{"name": "a", "samples": 10{case}}}]}}"#
+        )
+    }
+
+    /// A stage count of 2⁶⁴ − 1 or 100,000 is refused from the spec, by its JSON path,
+    /// before any model is built (it used to fill the memory).
+    #[test]
+    fn stage_counts_are_refused_by_path() {
+        let m = refusal(
+            r#"{"model": {"prism": {"stages": 18446744073709551615}}, "seed": 1,
+                "cases": [{"name": "a", "samples": 1}]}"#,
+        );
+        assert!(
+            m.starts_with("model.prism.stages: must be from 1 to 1000"),
+            "{m}"
+        );
+        let m = refusal(&job(r#", "model": {"prism": {"stages": 100000}}"#));
+        assert!(m.starts_with("cases[0].model.prism.stages: "), "{m}");
+        let m = refusal(&job(r#", "model": {"prism": {"side": 1e308}}"#));
+        assert!(m.starts_with("cases[0].model.prism.side: "), "{m}");
+    }
+
+    /// σ, means, bounds and constants that reach beyond 1 % of a member's length (3.8 mm of
+    /// 380 mm; a normal's |mean| + 6σ) are refused by their group; those within are not.
+    #[test]
+    fn length_errors_beyond_the_elastic_range_are_refused() {
+        let group = |dist: &str| job(&format!(r#", "length_errors": {{"longeron": {dist}}}"#));
+        for dist in [
+            r#"{"normal": {"sigma": 50}}"#,
+            r#"{"normal": {"sigma": 1e308}}"#,
+            r#"{"normal": {"mean": 1e308, "sigma": 0.01}}"#,
+            r#"{"normal": {"sigma": 0.64}}"#,
+            r#"{"uniform": {"low": -0.2, "high": 1e308}}"#,
+            r#"{"constant": {"value": -3.81}}"#,
+        ] {
+            let m = refusal(&group(dist));
+            assert!(
+                m.starts_with("cases[0].length_errors.longeron: ")
+                    && m.contains(
+                        "more than 1% of member \"longeron.1.0\"'s natural length 380 mm (3.8 mm)"
+                    ),
+                "{dist}: {m}"
+            );
+        }
+        for dist in [
+            r#"{"normal": {"sigma": 0.63}}"#,
+            r#"{"uniform": {"low": -3.8, "high": 3.8}}"#,
+        ] {
+            Job::from_json(&group(dist), Path::new(".")).unwrap();
+        }
+    }
+
+    /// A thermal strain α·ΔT beyond 1 % is refused by the effect's path; implausible effect
+    /// values by their field.
+    #[test]
+    fn effects_beyond_plausible_values_are_refused() {
+        let m = refusal(&job(
+            r#", "effects": {"thermal_gradient": {"gradient": [0, 0, 0], "offset": 500, "alpha": 1e-4}}"#,
+        ));
+        assert!(
+            m.starts_with("cases[0].effects.thermal_gradient: a thermal length change of 1.9e1 mm"),
+            "{m}"
+        );
+        let m = refusal(&job(
+            r#", "effects": {"gravity": {"direction": [0, 0, -1], "g": 1e308}}"#,
+        ));
+        assert!(
+            m.starts_with("cases[0].effects.gravity.g: 1e308 is beyond"),
+            "{m}"
+        );
+    }
+
+    /// A clearance that can exceed a tenth of the jointed member is refused.
+    #[test]
+    fn implausible_clearances_are_refused() {
+        let m = refusal(
+            r#"{"model": {"prism": {"stages": 1, "backlash": true}}, "seed": 1,
+                "cases": [{"name": "a", "samples": 1,
+                           "backlash": {"clearance": {"uniform": {"low": 0, "high": 1e308}}}}]}"#,
+        );
+        assert!(
+            m.starts_with("cases[0].backlash.clearance: a clearance can reach 1e308 mm"),
+            "{m}"
+        );
+    }
+
+    /// Samples are capped per case and per job.
+    #[test]
+    fn sample_counts_are_capped() {
+        let m =
+            refusal(&job("0000000").replace("\"samples\": 100000000", "\"samples\": 100000001"));
+        assert!(
+            m.starts_with("cases[0].samples: must be from 1 to 100000000"),
+            "{m}"
+        );
+        let case = |n: usize| format!(r#"{{"name": "c{n}", "samples": 100000000}}"#);
+        let cases: Vec<String> = (0..11).map(case).collect();
+        let m = refusal(&format!(
+            r#"{{"model": {{"prism": {{"stages": 1}}}}, "seed": 1, "cases": [{}]}}"#,
+            cases.join(",")
+        ));
+        assert!(
+            m.starts_with("cases[10].samples: the job's cases have 1100000000"),
+            "{m}"
+        );
+    }
+
+    /// Two distributions for one group, or one group named twice, are refused naming the
+    /// group (not serde's bare "expected …").
+    #[test]
+    fn a_group_gets_one_distribution() {
+        let m = refusal(&job(
+            r#", "length_errors": {"batten": {"normal": {"sigma": 0.01}, "uniform": {"low": 0, "high": 0.1}}}"#,
+        ));
+        assert!(
+            m.starts_with(
+                "cases[0].length_errors.batten: one distribution at a time, got 2 (normal, uniform)"
+            ),
+            "{m}"
+        );
+        let m = refusal(&job(
+            r#", "length_errors": {"batten": {"normal": {"sigma": 0.01}}, "batten": {"normal": {"sigma": 0.02}}}"#,
+        ));
+        assert!(m.contains("group \"batten\" is given twice"), "{m}");
+    }
+
+    /// A job file with a UTF-8 byte-order mark is the same job; /dev/zero and invalid UTF-8
+    /// are refused (invalid input, not I/O), naming the file.
+    #[test]
+    fn job_files_are_read_as_text_files_only() {
+        let text = job("");
+        let plain = Job::from_json(&text, Path::new(".")).unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("bom.json");
+        std::fs::write(&path, format!("\u{feff}{text}")).unwrap();
+        assert_eq!(Job::read(&path).unwrap().id, plain.id);
+        std::fs::write(&path, b"{\"seed\": \xff}").unwrap();
+        let e = Job::read(&path).unwrap_err();
+        assert!(matches!(e, JobError::Refused { .. }), "{e:?}");
+        assert!(
+            e.to_string()
+                .contains("bom.json: not UTF-8 text: invalid bytes at line 1, column 10"),
+            "{e}"
+        );
+        let e = Job::read(Path::new("/dev/zero")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "/dev/zero: not a regular file (a character device); give the path of a file"
+        );
+    }
 }
