@@ -12,6 +12,18 @@
 //!   the gap shrink (the `truss_diagnose` crate; [`diagnose`]).
 //! - `truss synth-measured --job J --case NAME --specimens N --seed S --effect NAME:P=V,…`
 //!   writes measured data with a hidden effect to stdout ([`truss_diagnose::synth`]).
+//! - `truss completions bash|zsh|fish|elvish|powershell` writes a shell completion script
+//!   to stdout (`truss completions bash > ~/.local/share/bash-completion/completions/truss`),
+//!   and `truss man` the roff manual page (`truss man > truss.1; man ./truss.1`).
+//!
+//! ## Limits
+//!
+//! `truss model prism` takes at most [`MAX_STAGES`](truss_core::prism::MAX_STAGES) stages
+//! and plausible values only ([`PrismOptions::check`]), refusing others as usage errors
+//! that name the flag. `truss solve` reads only a regular file of at most
+//! [`MAX_INPUT_BYTES`](truss_core::model_file::MAX_INPUT_BYTES), in UTF-8, and refuses a
+//! `--length-error` beyond [`MAX_LENGTH_ERROR_FRACTION`](truss_core::MAX_LENGTH_ERROR_FRACTION)
+//! of its member's natural length, or given twice for one member.
 //!
 //! ## Exit codes
 //!
@@ -73,6 +85,14 @@ pub enum Command {
     Diagnose(diagnose::DiagnoseArgs),
     /// Write measured data (CSV, stdout) made from a case with a hidden effect.
     SynthMeasured(diagnose::SynthArgs),
+    /// Write a shell completion script to stdout.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Write the manual page (roff) to stdout.
+    Man,
 }
 
 /// Model generators.
@@ -90,34 +110,34 @@ fn table1() -> PrismOptions {
 /// Options of `truss model prism`; defaults are the paper's Table 1.
 #[derive(Debug, Args)]
 pub struct PrismArgs {
-    /// Number of stages N.
+    /// Number of stages N, from 1 to 1000.
     #[arg(long, default_value_t = table1().stages)]
     pub stages: usize,
-    /// Batten length l, the triangle's side \[mm\].
+    /// Batten length l, the triangle's side (mm).
     #[arg(long, default_value_t = table1().side)]
     pub side: f64,
-    /// Stage height h, the longeron length \[mm\].
+    /// Stage height h, the longeron length (mm).
     #[arg(long, default_value_t = table1().height)]
     pub height: f64,
-    /// Batten cross-section \[mm²\].
+    /// Batten cross-section (mm²).
     #[arg(long, default_value_t = table1().batten_area)]
     pub batten_area: f64,
-    /// Batten Young's modulus \[MPa\].
+    /// Batten Young's modulus (MPa).
     #[arg(long, default_value_t = table1().batten_modulus)]
     pub batten_modulus: f64,
-    /// Longeron cross-section \[mm²\].
+    /// Longeron cross-section (mm²).
     #[arg(long, default_value_t = table1().longeron_area)]
     pub longeron_area: f64,
-    /// Longeron Young's modulus \[MPa\].
+    /// Longeron Young's modulus (MPa).
     #[arg(long, default_value_t = table1().longeron_modulus)]
     pub longeron_modulus: f64,
-    /// Diagonal cable cross-section \[mm²\].
+    /// Diagonal cable cross-section (mm²).
     #[arg(long, default_value_t = table1().diagonal_area)]
     pub diagonal_area: f64,
-    /// Diagonal cable Young's modulus \[MPa\].
+    /// Diagonal cable Young's modulus (MPa).
     #[arg(long, default_value_t = table1().diagonal_modulus)]
     pub diagonal_modulus: f64,
-    /// Diagonal natural length \[mm\] (Table 1: 537.4).
+    /// Diagonal natural length (mm; Table 1: 537.4).
     #[arg(long, default_value_t = TABLE1_DIAGONAL_LENGTH, conflicts_with = "exact_diagonals")]
     pub diagonal_length: f64,
     /// Give the diagonals the exact face-diagonal length √(l² + h²) instead.
@@ -130,7 +150,7 @@ pub struct PrismArgs {
     /// end gets its own hole on the batten's shaft, with free play.
     #[arg(long)]
     pub backlash: bool,
-    /// Clearance of every joint \[mm\] (with `--backlash`).
+    /// Clearance of every joint (mm; with `--backlash`).
     #[arg(long, default_value_t = truss_core::prism::PAPER_CLEARANCE, requires = "backlash")]
     pub clearance: f64,
     /// Joint contact stiffness over a longeron's axial stiffness E·A/h (with `--backlash`).
@@ -143,6 +163,16 @@ pub struct PrismArgs {
 }
 
 impl PrismArgs {
+    /// The flag that sets a field of [`PrismOptions`] (as [`PrismOptions::check`] names it).
+    pub fn flag(field: &str) -> String {
+        match field {
+            "backlash.clearance" => "--clearance".into(),
+            "backlash.tension_factor" => "--joint-tension-factor".into(),
+            "backlash.compression_ratio" => "--joint-compression-ratio".into(),
+            f => format!("--{}", f.replace('_', "-")),
+        }
+    }
+
     /// The generator options.
     pub fn options(&self) -> PrismOptions {
         PrismOptions {
@@ -224,13 +254,31 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> anyhow::Result<()> {
         Command::Model {
             kind: ModelKind::Prism(args),
         } => {
-            let model = args.options().model().map_err(CliError::from)?;
+            let options = args.options();
+            options.check().map_err(|(field, message)| {
+                CliError::Usage(format!("{}: {message}", PrismArgs::flag(field)))
+            })?;
+            let model = options.model().map_err(CliError::from)?;
             out.write_all(model.to_file().to_json().as_bytes())
                 .map_err(CliError::from)?;
         }
         Command::Solve(args) => solve::run(&args, out)?,
         Command::Diagnose(args) => diagnose::run_diagnose(&args, out)?,
         Command::SynthMeasured(args) => diagnose::run_synth(&args, out)?,
+        Command::Completions { shell } => {
+            // Into memory first: clap_complete panics on a failed write (a closed pipe).
+            let mut script = Vec::new();
+            let mut command = <Cli as clap::CommandFactory>::command();
+            clap_complete::generate(shell, &mut command, "truss", &mut script);
+            out.write_all(&script).map_err(CliError::from)?;
+        }
+        Command::Man => {
+            let mut page = Vec::new();
+            clap_mangen::Man::new(<Cli as clap::CommandFactory>::command())
+                .render(&mut page)
+                .map_err(CliError::from)?;
+            out.write_all(&page).map_err(CliError::from)?;
+        }
     }
     Ok(())
 }

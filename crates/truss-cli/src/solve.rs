@@ -65,9 +65,13 @@ pub struct SolveOutput {
     pub iteration_log: Option<Vec<IterationLine>>,
 }
 
-/// Parses `ID=MM` length errors into a per-member vector.
+/// Parses `ID=MM` length errors into a per-member vector, refusing a member given twice
+/// and an error beyond [`Model::max_length_error`] (a fraction
+/// [`MAX_LENGTH_ERROR_FRACTION`](truss_core::MAX_LENGTH_ERROR_FRACTION) of the member's
+/// natural length, beyond which the elastic model means nothing: see there).
 pub fn parse_length_errors(model: &Model, specs: &[String]) -> Result<Vec<f64>, CliError> {
     let mut errors = vec![0.0; model.members().len()];
+    let mut given: Vec<Option<&str>> = vec![None; errors.len()];
     for spec in specs {
         let (id, value) = spec
             .split_once('=')
@@ -84,7 +88,24 @@ pub fn parse_length_errors(model: &Model, specs: &[String]) -> Result<Vec<f64>, 
                     "--length-error {spec:?}: {value:?} is not a number"
                 ))
             })?;
-        errors[m] += v;
+        if let Some(first) = given[m] {
+            return Err(CliError::Usage(format!(
+                "--length-error {spec:?}: member {id:?} already has a length error \
+                 (--length-error {first:?}); give each member once"
+            )));
+        }
+        let max = model.max_length_error(m);
+        if v.abs() > max {
+            return Err(CliError::Usage(format!(
+                "--length-error {spec:?}: {v} mm is more than {}% of the member's natural \
+                 length {} mm ({max} mm), beyond the elastic range where the model means \
+                 anything",
+                100.0 * truss_core::MAX_LENGTH_ERROR_FRACTION,
+                model.members()[m].natural_length
+            )));
+        }
+        given[m] = Some(spec.as_str());
+        errors[m] = v;
     }
     Ok(errors)
 }

@@ -110,7 +110,10 @@ fn a_failed_solve_prints_why_and_exits_7() {
     assert_eq!(r["converged"], false);
     assert!(r["error"].as_str().unwrap().contains("did not converge"));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.starts_with("truss: error: the solve failed: Newton did not converge"), "{err}");
+    assert!(
+        err.starts_with("truss: error: the solve failed: Newton did not converge"),
+        "{err}"
+    );
 }
 
 fn job_path() -> String {

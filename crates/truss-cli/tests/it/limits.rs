@@ -1,0 +1,225 @@
+//! Hostile and meaningless inputs, refused at once by name with the right exit code (usage
+//! 2, invalid input 3, I/O 4), and the command-line conventions every binary shares: one
+//! error prefix, each cause printed once, a quiet end on a broken pipe, completions and a
+//! man page.
+
+use crate::{json, truss};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+
+/// stderr as text.
+fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// A 1-stage prism model file in a fresh directory.
+fn prism_file(dir: &std::path::Path) -> std::path::PathBuf {
+    let path = dir.join("p.json");
+    std::fs::write(&path, truss(&["model", "prism", "--stages", "1"]).stdout).unwrap();
+    path
+}
+
+/// Stage counts past the limit, 2⁶⁴ − 1 included, are usage errors naming `--stages`
+/// (they used to fill the memory); the limit itself is accepted.
+#[test]
+fn stage_counts_beyond_the_limit_are_refused() {
+    for stages in ["18446744073709551615", "100000", "1001", "0"] {
+        let out = truss(&["model", "prism", "--stages", stages]);
+        assert_eq!(out.status.code(), Some(2), "{stages}: {}", stderr(&out));
+        let err = stderr(&out);
+        assert!(
+            err.starts_with("truss: error: --stages: must be from 1 to 1000"),
+            "{err}"
+        );
+        assert!(out.stdout.is_empty());
+    }
+    let out = truss(&["model", "prism", "--stages", "1000"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        json(&out)["members"].as_array().unwrap().len(),
+        12 * 1000 + 3
+    );
+}
+
+/// Implausible prism values are usage errors naming their flag.
+#[test]
+fn implausible_prism_values_name_their_flag() {
+    for (flag, value) in [
+        ("--side", "1e308"),
+        ("--height", "-380"),
+        ("--batten-modulus", "NaN"),
+        ("--diagonal-area", "inf"),
+    ] {
+        let out = truss(&["model", "prism", &format!("{flag}={value}")]);
+        assert_eq!(out.status.code(), Some(2), "{flag} {value}");
+        assert!(
+            stderr(&out).starts_with(&format!("truss: error: {flag}: ")),
+            "{}",
+            stderr(&out)
+        );
+    }
+    let out = truss(&["model", "prism", "--backlash", "--clearance", "1e308"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--clearance: must be from 0 to 38 mm"));
+}
+
+/// Not a regular file, too large, not UTF-8: invalid input (3), naming the file, at once;
+/// a missing file is an I/O error (4) whose cause is printed once.
+#[test]
+fn model_files_that_cannot_be_models_are_refused_by_name() {
+    let out = truss(&["solve", "/dev/zero"]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert_eq!(
+        stderr(&out),
+        "truss: error: /dev/zero: not a regular file (a character device); give the path of a file\n"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let out = truss(&["solve", dir.path().to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(stderr(&out).contains("(a directory)"));
+
+    let big = dir.path().join("big.json");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(truss_core::model_file::MAX_INPUT_BYTES + 1)
+        .unwrap();
+    let out = truss(&["solve", big.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(
+        stderr(&out).contains("big.json: 67108865 bytes is more than the 67108864 bytes"),
+        "{}",
+        stderr(&out)
+    );
+
+    let latin1 = dir.path().join("latin1.json");
+    let mut text = truss(&["model", "prism", "--stages", "1"]).stdout;
+    let at = text.windows(4).position(|w| w == b"n0.0").unwrap();
+    text[at] = 0xe9;
+    std::fs::write(&latin1, &text).unwrap();
+    let out = truss(&["solve", latin1.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3), "invalid UTF-8 is invalid input");
+    assert!(stderr(&out).contains("latin1.json: not UTF-8 text: invalid bytes at line 4"));
+
+    let missing = dir.path().join("nope.json");
+    let out = truss(&["solve", missing.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(4));
+    let err = stderr(&out);
+    let cause = std::io::Error::from(std::io::ErrorKind::NotFound).to_string();
+    assert!(err.starts_with("truss: error: "), "{err}");
+    assert_eq!(
+        err.matches("No such file or directory").count(),
+        1,
+        "{err} ({cause})"
+    );
+}
+
+/// A model file starting with a UTF-8 byte-order mark (as some Windows editors write) is
+/// read as if it had none.
+#[test]
+fn a_byte_order_mark_is_accepted() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = prism_file(dir.path());
+    let mut text = "\u{feff}".as_bytes().to_vec();
+    text.extend(std::fs::read(&path).unwrap());
+    std::fs::write(&path, text).unwrap();
+    let out = truss(&["solve", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(json(&out)["converged"], true);
+}
+
+/// A length error beyond 1 % of the member's natural length (3.8 mm of 380 mm) is a usage
+/// error, as is a member given twice; 1 % itself is solved.
+#[test]
+fn meaningless_length_errors_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = prism_file(dir.path());
+    let p = path.to_str().unwrap();
+    for value in ["100", "-3.81", "1e308"] {
+        let arg = format!("longeron.1.0={value}");
+        let out = truss(&["solve", p, "--length-error", &arg]);
+        assert_eq!(out.status.code(), Some(2), "{value}");
+        let err = stderr(&out);
+        assert!(
+            err.contains("more than 1% of the member's natural length 380 mm (3.8 mm)"),
+            "{err}"
+        );
+        assert!(out.stdout.is_empty(), "nothing solved");
+    }
+    let out = truss(&["solve", p, "--length-error", "longeron.1.0=3.8"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let out = truss(&[
+        "solve",
+        p,
+        "--length-error",
+        "longeron.1.0=0.01",
+        "--length-error",
+        "batten.0.0=0.01",
+        "--length-error",
+        "longeron.1.0=0.02",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).contains("member \"longeron.1.0\" already has a length error"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// `truss model prism --stages 30 | head -1`: the reader leaves after one line, and
+/// `truss` ends quietly with 0 (no "I/O error").
+#[test]
+fn a_broken_pipe_ends_quietly() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_truss"))
+        .args(["model", "prism", "--stages", "30"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    let mut reader = BufReader::new(child.stdout.take().unwrap());
+    reader.read_line(&mut first).unwrap();
+    assert_eq!(first, "{\n");
+    // The model (about 100 kB) is more than a pipe holds: truss is still writing.
+    drop(reader);
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert_eq!(stderr(&out), "");
+}
+
+/// Completion scripts for bash, zsh and fish, and a man page, all from the same flags.
+#[test]
+fn completions_and_man_page_are_generated() {
+    for (shell, sign) in [
+        ("bash", "complete -F"),
+        ("zsh", "#compdef truss"),
+        ("fish", "complete -c truss"),
+    ] {
+        let out = truss(&["completions", shell]);
+        assert!(out.status.success(), "{shell}");
+        let script = String::from_utf8(out.stdout).unwrap();
+        assert!(script.contains(sign), "{shell}: {script}");
+        assert!(script.contains("length-error"), "{shell}");
+    }
+    assert_eq!(truss(&["completions", "tcsh"]).status.code(), Some(2));
+    let out = truss(&["man"]);
+    assert!(out.status.success());
+    let page = String::from_utf8(out.stdout).unwrap();
+    assert!(page.contains(".TH truss 1"), "{page}");
+    assert!(page.contains("completions"));
+}
+
+/// No help text shows rustdoc's escapes (`\[mm\]`).
+#[test]
+fn help_has_no_escaped_brackets() {
+    for args in [
+        &["--help"][..],
+        &["model", "prism", "--help"],
+        &["solve", "--help"],
+        &["completions", "--help"],
+        &["man", "--help"],
+    ] {
+        let out = truss(args);
+        let help = String::from_utf8(out.stdout).unwrap();
+        assert!(!help.contains("\\["), "{args:?}: {help}");
+    }
+}
