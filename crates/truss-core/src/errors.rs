@@ -177,3 +177,15 @@ pub enum SolveError {
     #[error("bad input: {0}")]
     Input(String),
 }
+
+/// A number as an error message shows it: as Rust writes it (the shortest form that reads
+/// back the same) for magnitudes from 10⁻⁴ to 10⁶, and zero; in e-notation beyond, so that
+/// `1e308` is not written with 309 digits.
+pub fn readable(x: f64) -> String {
+    let a = x.abs();
+    if a == 0.0 || !a.is_finite() || (1e-4..1e6).contains(&a) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}

@@ -86,7 +86,7 @@ pub mod prism_spec;
 pub mod solver;
 mod structure;
 
-pub use errors::{InputRefusal, ModelError, SolveError};
+pub use errors::{InputRefusal, ModelError, SolveError, readable};
 pub use measure::{Distortion, distortion};
 pub use model::{Behaviour, Joint, Member, Model, Node, TopSurface};
 pub use model_file::ModelFile;

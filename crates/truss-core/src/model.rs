@@ -713,7 +713,10 @@ fn at_most(
         None => Ok(()),
         Some(v) => Err(ModelError::Invalid {
             item: item.to_string(),
-            message: format!("{field} {v:e} is beyond the plausible ±{max:e} {unit}"),
+            message: format!(
+                "{field} {} is beyond the plausible ±{max:e} {unit}",
+                crate::readable(*v)
+            ),
         }),
     }
 }

@@ -177,7 +177,10 @@ impl PrismOptions {
             } else {
                 Err((
                     field,
-                    format!("must be positive and at most {max:e} {unit}, got {v:e}"),
+                    format!(
+                        "must be positive and at most {max:e} {unit}, got {}",
+                        crate::readable(v)
+                    ),
                 ))
             }
         };
@@ -214,9 +217,9 @@ impl PrismOptions {
                 return Err((
                     "backlash.clearance",
                     format!(
-                        "must be from 0 to {max} mm ({}% of the shorter of side and height), got {:e}",
+                        "must be from 0 to {max} mm ({}% of the shorter of side and height), got {}",
                         100.0 * MAX_CLEARANCE_FRACTION,
-                        b.clearance
+                        crate::readable(b.clearance)
                     ),
                 ));
             }

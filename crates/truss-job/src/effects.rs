@@ -129,7 +129,10 @@ impl EffectsSpec {
             Some(x) if !x.is_finite() => Err((field.to_string(), "must be finite numbers".into())),
             Some(x) => Err((
                 field.to_string(),
-                format!("{x:e} is beyond the plausible ±{max:e} {unit}"),
+                format!(
+                    "{} is beyond the plausible ±{max:e} {unit}",
+                    truss_core::readable(*x)
+                ),
             )),
         };
         if let Some(g) = &self.gravity {

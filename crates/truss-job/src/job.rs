@@ -369,11 +369,14 @@ impl Job {
                     &format!("{:?} is also the name of cases[{j}]", c.name),
                 ));
             }
-            if !(1..=MAX_CASE_SAMPLES).contains(&c.samples) {
+            if c.samples == 0 {
+                return Err(JobError::at(&at("samples"), "must be at least 1"));
+            }
+            if c.samples > MAX_CASE_SAMPLES {
                 return Err(JobError::at(
                     &at("samples"),
                     &format!(
-                        "must be from 1 to {MAX_CASE_SAMPLES} (10⁸) per case, got {}",
+                        "must be at most {MAX_CASE_SAMPLES} (10⁸) per case, got {}",
                         c.samples
                     ),
                 ));
@@ -518,15 +521,18 @@ fn check_reach(
         let thermal = applied.length_changes.get(m).map_or(0.0, |x| x.abs());
         let dist = length_errors.get(&member.group);
         let reach = dist.map_or(0.0, DistributionSpec::reach);
+        let reach_shown = truss_core::readable(reach);
         let what = match dist {
-            Some(DistributionSpec::Normal { .. }) => {
+            Some(DistributionSpec::Normal { mean, sigma }) => {
                 format!(
-                    "|mean| + {}σ = {reach:e} mm",
+                    "mean {} mm, σ {} mm: |mean| + {}σ = {reach_shown} mm",
+                    truss_core::readable(*mean),
+                    truss_core::readable(*sigma),
                     crate::distribution::NORMAL_REACH
                 )
             }
-            Some(DistributionSpec::Uniform { .. }) => format!("a bound of {reach:e} mm"),
-            Some(DistributionSpec::Constant { .. }) => format!("a value of {reach:e} mm"),
+            Some(DistributionSpec::Uniform { .. }) => format!("a bound of {reach_shown} mm"),
+            Some(DistributionSpec::Constant { .. }) => format!("a value of {reach_shown} mm"),
             None => String::new(),
         };
         let limit = format!(
@@ -544,15 +550,18 @@ fn check_reach(
         if thermal > max {
             return Err(JobError::at(
                 &at("effects.thermal_gradient"),
-                &format!("a thermal length change of {thermal:e} mm is {limit}"),
+                &format!(
+                    "a thermal length change of {} mm is {limit}",
+                    truss_core::readable(thermal)
+                ),
             ));
         }
         if reach + thermal > max {
             return Err(JobError::at(
                 &at("effects.thermal_gradient"),
                 &format!(
-                    "a thermal length change of {thermal:e} mm with length_errors.{}'s {what} \
-                     is {limit}",
+                    "a thermal length change of {} mm with length_errors.{}'s {what} is {limit}",
+                    truss_core::readable(thermal),
                     member.group
                 ),
             ));
@@ -589,9 +598,10 @@ fn check_clearance(
         Err(JobError::at(
             path,
             &format!(
-                "a clearance can reach {highest:e} mm, more than {}% of the shortest jointed \
+                "a clearance can reach {} mm, more than {}% of the shortest jointed \
                  member's length {shortest} mm ({max} mm): free play that large is not a pin \
                  joint (see truss_core::model::MAX_CLEARANCE_FRACTION)",
+                truss_core::readable(highest),
                 100.0 * fraction
             ),
         ))
@@ -756,7 +766,7 @@ mod tests {
             r#", "effects": {"thermal_gradient": {"gradient": [0, 0, 0], "offset": 500, "alpha": 1e-4}}"#,
         ));
         assert!(
-            m.starts_with("cases[0].effects.thermal_gradient: a thermal length change of 1.9e1 mm"),
+            m.starts_with("cases[0].effects.thermal_gradient: a thermal length change of 19 mm"),
             "{m}"
         );
         let m = refusal(&job(
@@ -788,7 +798,7 @@ mod tests {
         let m =
             refusal(&job("0000000").replace("\"samples\": 100000000", "\"samples\": 100000001"));
         assert!(
-            m.starts_with("cases[0].samples: must be from 1 to 100000000"),
+            m.starts_with("cases[0].samples: must be at most 100000000"),
             "{m}"
         );
         let case = |n: usize| format!(r#"{{"name": "c{n}", "samples": 100000000}}"#);
