@@ -1,8 +1,9 @@
 //! The validated truss model: nodes, members, supports, loads, and the measured surface.
 //!
 //! A [`Model`] is built only by validating a [`ModelFile`]; from then on its invariants hold:
-//! ids are unique, every reference resolves to an index, every number is finite, areas,
-//! moduli and natural lengths are positive, no member has zero length, a joint's two nodes
+//! ids are unique, every reference resolves to an index, every number is finite and within
+//! a plausible magnitude ([`MAX_COORDINATE`], [`MAX_AREA`], [`MAX_MODULUS`], [`MAX_FORCE`],
+//! [`MAX_CLEARANCE_FRACTION`]), areas, moduli and natural lengths are positive, no member has zero length, a joint's two nodes
 //! coincide, every hole node carries exactly one member, perpendicular to its shaft's axis,
 //! and nothing else (one hole per member end: see [`crate::joint`]), and the nominal
 //! structure is not a mechanism.

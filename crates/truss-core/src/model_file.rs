@@ -45,7 +45,10 @@
 //! | `joints[].axial_stiffness` | `k_a` > 0 along the axis; default `k_t` (kept for the file format: the shoulders are taken as rigid along the axis) | N/mm |
 //!
 //! Unknown fields are refused, so a misspelt field name is an error rather than a silently
-//! ignored value.
+//! ignored value. Magnitudes must be plausible (coordinates and lengths within ±10⁷ mm,
+//! areas up to 10⁸ mm², moduli up to 10⁷ MPa, load components up to 10¹² N, a clearance up
+//! to a tenth of its member: see [`crate::model`]), and a file is read only if it is a
+//! regular file of at most [`MAX_INPUT_BYTES`] in UTF-8 ([`read_input`]).
 
 use crate::errors::InputRefusal;
 use serde::{Deserialize, Serialize};
