@@ -76,13 +76,20 @@ pub enum ReadFailure {
 /// grows), or text that is not UTF-8. A leading UTF-8 byte-order mark, which some Windows
 /// editors write, is accepted and dropped.
 pub fn read_input(path: &Path) -> Result<String, ReadFailure> {
+    let regular = |meta: std::fs::Metadata| {
+        if meta.is_file() {
+            Ok(meta)
+        } else {
+            Err(ReadFailure::Refused(InputRefusal::NotRegularFile {
+                kind: file_kind(&meta.file_type()),
+            }))
+        }
+    };
+    // Before opening: opening a FIFO waits for a writer, which may never come.
+    regular(std::fs::metadata(path).map_err(ReadFailure::Io)?)?;
     let file = std::fs::File::open(path).map_err(ReadFailure::Io)?;
-    let meta = file.metadata().map_err(ReadFailure::Io)?;
-    if !meta.is_file() {
-        return Err(ReadFailure::Refused(InputRefusal::NotRegularFile {
-            kind: file_kind(&meta.file_type()),
-        }));
-    }
+    // Again on the open file, in case the path was replaced in between.
+    let meta = regular(file.metadata().map_err(ReadFailure::Io)?)?;
     let too_large = |bytes| {
         ReadFailure::Refused(InputRefusal::TooLarge {
             bytes,
@@ -298,8 +305,9 @@ mod tests {
         }
     }
 
-    /// Devices and directories are refused at once, before a byte is read: `/dev/zero`
-    /// would otherwise fill the memory.
+    /// Devices, directories and pipes are refused at once, before a byte is read:
+    /// `/dev/zero` would otherwise fill the memory, and opening a FIFO would wait for a
+    /// writer.
     #[test]
     fn only_regular_files_are_read() {
         assert_eq!(
@@ -314,6 +322,16 @@ mod tests {
             InputRefusal::NotRegularFile {
                 kind: "a directory"
             }
+        );
+        let fifo = dir.path().join("fifo");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        assert_eq!(
+            refusal(&fifo),
+            InputRefusal::NotRegularFile { kind: "a pipe" }
         );
         let missing = read_input(&dir.path().join("missing.json"));
         assert!(matches!(missing, Err(ReadFailure::Io(_))), "{missing:?}");
