@@ -129,6 +129,17 @@ pub fn read_input(path: &Path) -> Result<String, ReadFailure> {
 }
 
 /// What a file that is not a regular file is, in words.
+#[cfg(not(unix))]
+fn file_kind(t: &std::fs::FileType) -> &'static str {
+    if t.is_dir() {
+        "a directory"
+    } else {
+        "not a file"
+    }
+}
+
+/// What a file that is not a regular file is, in words.
+#[cfg(unix)]
 fn file_kind(t: &std::fs::FileType) -> &'static str {
     use std::os::unix::fs::FileTypeExt;
     if t.is_dir() {
