@@ -1,18 +1,19 @@
 //! Benchmark of one equilibrium solve of the paper's prism with random length errors
-//! (σ = 0.0063 mm on battens and longerons), for 5, 30 and 300 stages.
+//! (σ = 0.0063 mm on battens and longerons), for 5, 30 and 300 stages, and for the 5-stage
+//! prism with backlash joints of the paper's 0.01 mm clearance and free play.
 //!
 //! Prints, per model: the median, 10th and 90th percentile time per solve over the samples
 //! (each solve timed on its own, one thread), the median and mean Newton iterations,
 //! factorisations and force evaluations, and the time of each kernel measured on its own
 //! (factorise, triangular solves, evaluate, assemble) with the share of the solve that
 //! counts × kernel time accounts for. For comparison, a dense Cholesky of the same 5-stage
-//! tangent with faer. Run with `cargo bench -p truss-core`; `-- --quick` for fewer samples.
+//! tangent with faer. For 300 stages, the histogram of the iteration counts. Run with `cargo bench -p truss-core`; `-- --quick` for fewer samples.
 //! The machine is shared: run it several times and quote medians.
 
 use std::hint::black_box;
 use std::time::Instant;
 use truss_core::block::BlockBandMatrix;
-use truss_core::prism::PrismOptions;
+use truss_core::prism::{BacklashOptions, PrismOptions};
 use truss_core::{SolveOptions, Solver};
 
 /// SplitMix64 + Box–Muller: deterministic sample errors.
@@ -52,8 +53,13 @@ fn kernel_time(reps: usize, mut f: impl FnMut()) -> f64 {
     batches[3]
 }
 
-fn bench(stages: usize, samples: usize) {
-    let model = PrismOptions::with_stages(stages).model().unwrap();
+fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) {
+    let model = PrismOptions {
+        backlash: backlash.then(BacklashOptions::default),
+        ..PrismOptions::with_stages(stages)
+    }
+    .model()
+    .unwrap();
     let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
     let mut rng = Normals(2024);
     let sigma = 0.0063;
@@ -135,8 +141,9 @@ fn bench(stages: usize, samples: usize) {
         solver.solve(black_box(e0)).unwrap();
     });
     let r0 = solver.solve(e0).unwrap();
+    let kind = if backlash { " with backlash" } else { "" };
     println!(
-        "{stages:>3} stages ({} DOF, {} members, block band {q}): median {:.2} µs per solve (p10 {:.2}, p90 {:.2}) over {samples} samples",
+        "{stages:>3} stages{kind} ({} DOF, {} members, block band {q}): median {:.2} µs per solve (p10 {:.2}, p90 {:.2}) over {samples} samples",
         s.free_dofs(),
         s.member_count(),
         median_time.0,
@@ -161,6 +168,17 @@ fn bench(stages: usize, samples: usize) {
         100.0 * mf * (t_factor - t_copy) / median_time.0,
         100.0 * (mi + 1.0) * t_solve / median_time.0
     );
+    if histogram {
+        let mut counts = std::collections::BTreeMap::new();
+        for &i in &its {
+            *counts.entry(i as u32).or_insert(0u32) += 1;
+        }
+        let bars: Vec<String> = counts.iter().map(|(i, c)| format!("{i}: {c}")).collect();
+        println!(
+            "      iterations histogram (count: samples): {}",
+            bars.join(", ")
+        );
+    }
 }
 
 /// A dense Cholesky (faer) of a 45 × 45 matrix the shape of the 5-stage tangent, for
@@ -192,8 +210,9 @@ fn dense_comparison() {
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
     let n = |full: usize| if quick { full / 10 } else { full };
-    bench(5, n(20_000));
-    bench(30, n(2_000));
-    bench(300, n(100).max(10));
+    bench(5, n(20_000), false, false);
+    bench(5, n(20_000), true, false);
+    bench(30, n(2_000), false, false);
+    bench(300, n(100).max(10), false, true);
     dense_comparison();
 }
