@@ -7,7 +7,8 @@
 //! factorisations and force evaluations, and the time of each kernel measured on its own
 //! (factorise, triangular solves, evaluate, assemble) with the share of the solve that
 //! counts × kernel time accounts for. For comparison, a dense Cholesky of the same 5-stage
-//! tangent with faer. For 300 stages, the histogram of the iteration counts. Run with `cargo bench -p truss-core`; `-- --quick` for fewer samples.
+//! tangent with faer. For 300 stages, the histogram of the iteration counts. Run with
+//! `cargo bench -p truss-core`; `-- --quick` for fewer samples.
 //! The machine is shared: run it several times and quote medians.
 
 use std::hint::black_box;
