@@ -208,7 +208,131 @@ fn dense_comparison() {
     println!("dense faer LLT: run with --features cross-checks for the comparison");
 }
 
+/// Whether the converged state depends on the path the iteration took: the §3.4 prisms
+/// (σ = 0.0667 mm on battens and longerons) solved with the default options and again
+/// without reusing factorisations (a different sequence of steps, the same convergence
+/// test). Prints, per stage count, the largest relative change of θ_P and of the
+/// displacements, and how many samples moved by more than 1e-9 relative. Run with
+/// `cargo bench -p truss-core -- --paths`.
+fn path_independence(samples: usize) {
+    let other = SolveOptions {
+        reuse_factorisation: false,
+        ..SolveOptions::default()
+    };
+    for stages in [1, 5, 10, 20, 30] {
+        let model = PrismOptions::with_stages(stages).model().unwrap();
+        let mut a = Solver::new(&model, SolveOptions::default()).unwrap();
+        let mut b = Solver::new(&model, other.clone()).unwrap();
+        let mut rng = Normals(34 + stages as u64);
+        let (mut worst_theta, mut worst_u, mut moved) = (0.0f64, 0.0f64, 0);
+        let mut worst_sample = None;
+        let mut worst_errors = Vec::new();
+        for k in 0..samples {
+            let e: Vec<f64> = model
+                .members()
+                .iter()
+                .map(|m| {
+                    if m.group == "diagonal" {
+                        0.0
+                    } else {
+                        0.0666666666666667 * rng.normal()
+                    }
+                })
+                .collect();
+            let (ra, rb) = (a.solve(&e).unwrap(), b.solve(&e).unwrap());
+            let (ea, eb) = (a.equilibrium().unwrap(), b.equilibrium().unwrap());
+            let (ta, tb) = (
+                ea.distortion.unwrap().theta_p,
+                eb.distortion.unwrap().theta_p,
+            );
+            let dt = (ta - tb).abs() / ta.abs().max(f64::MIN_POSITIVE);
+            let scale = ea
+                .displacements
+                .iter()
+                .flatten()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            let du = ea
+                .displacements
+                .iter()
+                .flatten()
+                .zip(eb.displacements.iter().flatten())
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+                / scale;
+            if dt > 1e-9 || du > 1e-9 {
+                moved += 1;
+            }
+            if dt > worst_theta {
+                worst_sample = Some((k, ra, rb, ea.slack.len(), eb.slack.len()));
+                worst_errors = e.clone();
+            }
+            worst_theta = worst_theta.max(dt);
+            worst_u = worst_u.max(du);
+        }
+        println!(
+            "{stages:>3} stages: {samples} samples, max relative change of θ_P {worst_theta:.2e}, of the displacements {worst_u:.2e}; {moved} moved by more than 1e-9"
+        );
+        if let Some((k, ra, rb, sa, sb)) = worst_sample {
+            println!(
+                "      worst sample {k}: default {} it, residual {:.2e} N, step {:.2e} mm, {sa} slack; without reuse {} it, residual {:.2e} N, step {:.2e} mm, {sb} slack",
+                ra.iterations, ra.residual, ra.step, rb.iterations, rb.residual, rb.step
+            );
+            // The same sample with a force test 100 times tighter, both ways: a flat valley
+            // (one equilibrium, loosely resolved) brings the two together; two equilibria
+            // stay apart.
+            let mut thetas = vec![];
+            for reuse in [true, false] {
+                let tight = SolveOptions {
+                    reuse_factorisation: reuse,
+                    residual_floor: 1e-15,
+                    step_tolerance: 1e-14,
+                    max_iterations: 400,
+                    ..SolveOptions::default()
+                };
+                let mut t = Solver::new(&model, tight).unwrap();
+                match t.solve(&worst_errors) {
+                    Ok(r) => {
+                        let eq = t.equilibrium().unwrap();
+                        let theta = eq.distortion.unwrap().theta_p;
+                        thetas.push(theta);
+                        println!(
+                            "      tight, reuse {reuse}: {} it, residual {:.2e} N, θ_P {theta:.12e}, {} slack, Π {:.15e} N·mm",
+                            r.iterations,
+                            r.residual,
+                            eq.slack.len(),
+                            t.potential_energy()
+                        );
+                    }
+                    Err(err) => println!("      tight, reuse {reuse}: {err}"),
+                }
+            }
+            println!(
+                "      default: θ_P {:.12e} and {:.12e}; Π {:.15e} and {:.15e}",
+                {
+                    a.solve(&worst_errors).unwrap();
+                    a.distortion().unwrap().theta_p
+                },
+                {
+                    b.solve(&worst_errors).unwrap();
+                    b.distortion().unwrap().theta_p
+                },
+                {
+                    a.solve(&worst_errors).unwrap();
+                    a.potential_energy()
+                },
+                {
+                    b.solve(&worst_errors).unwrap();
+                    b.potential_energy()
+                },
+            );
+        }
+    }
+}
+
 fn main() {
+    if std::env::args().any(|a| a == "--paths") {
+        path_independence(400);
+        return;
+    }
     let quick = std::env::args().any(|a| a == "--quick");
     let n = |full: usize| if quick { full / 10 } else { full };
     bench(5, n(20_000), false, false);
