@@ -335,9 +335,24 @@ fn main() {
     }
     let quick = std::env::args().any(|a| a == "--quick");
     let n = |full: usize| if quick { full / 10 } else { full };
-    bench(5, n(20_000), false, false);
-    bench(5, n(20_000), true, false);
-    bench(30, n(2_000), false, false);
-    bench(300, n(100).max(10), false, true);
-    dense_comparison();
+    // `-- --only 5` (or 5b for backlash, 30, 300): that model alone, for a profiler.
+    let args: Vec<String> = std::env::args().collect();
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1).cloned());
+    let runs: [(&str, usize, usize, bool, bool); 4] = [
+        ("5", 5, n(20_000), false, false),
+        ("5b", 5, n(20_000), true, false),
+        ("30", 30, n(2_000), false, false),
+        ("300", 300, n(100).max(10), false, true),
+    ];
+    for (name, stages, samples, backlash, histogram) in runs {
+        if only.as_deref().is_none_or(|o| o == name) {
+            bench(stages, samples, backlash, histogram);
+        }
+    }
+    if only.is_none() {
+        dense_comparison();
+    }
 }
