@@ -7,8 +7,11 @@
 //! factorisations and force evaluations, and the time of each kernel measured on its own
 //! (factorise, triangular solves, evaluate, assemble) with the share of the solve that
 //! counts × kernel time accounts for. For comparison, a dense Cholesky of the same 5-stage
-//! tangent with faer. For 300 stages, the histogram of the iteration counts. Run with
-//! `cargo bench -p truss-core`; `-- --quick` for fewer samples.
+//! tangent with faer. For 300 stages and for backlash, the histograms of the iteration and
+//! factorisation counts. Run with
+//! `cargo bench -p truss-core`; `-- --quick` for fewer samples, `-- --only 5` (or `5b`, `30`,
+//! `300`) for one model alone (for a profiler), `-- --paths` for the probe of whether the
+//! converged state depends on the solver's path (see `path_independence`).
 //! The machine is shared: run it several times and quote medians.
 
 use std::hint::black_box;
@@ -170,15 +173,17 @@ fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) {
         100.0 * (mi + 1.0) * t_solve / median_time.0
     );
     if histogram {
-        let mut counts = std::collections::BTreeMap::new();
-        for &i in &its {
-            *counts.entry(i as u32).or_insert(0u32) += 1;
+        for (what, counts) in [("iterations", &its), ("factorisations", &facts)] {
+            let mut bins = std::collections::BTreeMap::new();
+            for &i in counts.iter() {
+                *bins.entry(i as u32).or_insert(0u32) += 1;
+            }
+            let bars: Vec<String> = bins.iter().map(|(i, c)| format!("{i}: {c}")).collect();
+            println!(
+                "      {what} histogram (count: samples): {}",
+                bars.join(", ")
+            );
         }
-        let bars: Vec<String> = counts.iter().map(|(i, c)| format!("{i}: {c}")).collect();
-        println!(
-            "      iterations histogram (count: samples): {}",
-            bars.join(", ")
-        );
     }
 }
 
@@ -343,7 +348,7 @@ fn main() {
         .and_then(|i| args.get(i + 1).cloned());
     let runs: [(&str, usize, usize, bool, bool); 4] = [
         ("5", 5, n(20_000), false, false),
-        ("5b", 5, n(20_000), true, false),
+        ("5b", 5, n(20_000), true, true),
         ("30", 30, n(2_000), false, false),
         ("300", 300, n(100).max(10), false, true),
     ];
