@@ -1,18 +1,23 @@
 //! Benchmark of one equilibrium solve of the paper's prism with random length errors
-//! (σ = 0.0063 mm on battens and longerons), for 5, 30 and 300 stages.
+//! (σ = 0.0063 mm on battens and longerons), for 5, 30 and 300 stages, and for the 5-stage
+//! prism with backlash joints of the paper's 0.01 mm clearance and free play.
 //!
 //! Prints, per model: the median, 10th and 90th percentile time per solve over the samples
 //! (each solve timed on its own, one thread), the median and mean Newton iterations,
 //! factorisations and force evaluations, and the time of each kernel measured on its own
 //! (factorise, triangular solves, evaluate, assemble) with the share of the solve that
 //! counts × kernel time accounts for. For comparison, a dense Cholesky of the same 5-stage
-//! tangent with faer. Run with `cargo bench -p truss-core`; `-- --quick` for fewer samples.
+//! tangent with faer. For 300 stages and for backlash, the histograms of the iteration and
+//! factorisation counts. Run with
+//! `cargo bench -p truss-core`; `-- --quick` for fewer samples, `-- --only 5` (or `5b`, `30`,
+//! `300`) for one model alone (for a profiler), `-- --paths` for the probe of whether the
+//! converged state depends on the solver's path (see `path_independence`).
 //! The machine is shared: run it several times and quote medians.
 
 use std::hint::black_box;
 use std::time::Instant;
 use truss_core::block::BlockBandMatrix;
-use truss_core::prism::PrismOptions;
+use truss_core::prism::{BacklashOptions, PrismOptions};
 use truss_core::{SolveOptions, Solver};
 
 /// SplitMix64 + Box–Muller: deterministic sample errors.
@@ -52,8 +57,13 @@ fn kernel_time(reps: usize, mut f: impl FnMut()) -> f64 {
     batches[3]
 }
 
-fn bench(stages: usize, samples: usize) {
-    let model = PrismOptions::with_stages(stages).model().unwrap();
+fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) {
+    let model = PrismOptions {
+        backlash: backlash.then(BacklashOptions::default),
+        ..PrismOptions::with_stages(stages)
+    }
+    .model()
+    .unwrap();
     let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
     let mut rng = Normals(2024);
     let sigma = 0.0063;
@@ -135,8 +145,9 @@ fn bench(stages: usize, samples: usize) {
         solver.solve(black_box(e0)).unwrap();
     });
     let r0 = solver.solve(e0).unwrap();
+    let kind = if backlash { " with backlash" } else { "" };
     println!(
-        "{stages:>3} stages ({} DOF, {} members, block band {q}): median {:.2} µs per solve (p10 {:.2}, p90 {:.2}) over {samples} samples",
+        "{stages:>3} stages{kind} ({} DOF, {} members, block band {q}): median {:.2} µs per solve (p10 {:.2}, p90 {:.2}) over {samples} samples",
         s.free_dofs(),
         s.member_count(),
         median_time.0,
@@ -161,6 +172,19 @@ fn bench(stages: usize, samples: usize) {
         100.0 * mf * (t_factor - t_copy) / median_time.0,
         100.0 * (mi + 1.0) * t_solve / median_time.0
     );
+    if histogram {
+        for (what, counts) in [("iterations", &its), ("factorisations", &facts)] {
+            let mut bins = std::collections::BTreeMap::new();
+            for &i in counts.iter() {
+                *bins.entry(i as u32).or_insert(0u32) += 1;
+            }
+            let bars: Vec<String> = bins.iter().map(|(i, c)| format!("{i}: {c}")).collect();
+            println!(
+                "      {what} histogram (count: samples): {}",
+                bars.join(", ")
+            );
+        }
+    }
 }
 
 /// A dense Cholesky (faer) of a 45 × 45 matrix the shape of the 5-stage tangent, for
@@ -189,11 +213,151 @@ fn dense_comparison() {
     println!("dense faer LLT: run with --features cross-checks for the comparison");
 }
 
+/// Whether the converged state depends on the path the iteration took: the §3.4 prisms
+/// (σ = 0.0667 mm on battens and longerons) solved with the default options and again
+/// without reusing factorisations (a different sequence of steps, the same convergence
+/// test). Prints, per stage count, the largest relative change of θ_P and of the
+/// displacements, and how many samples moved by more than 1e-9 relative. Run with
+/// `cargo bench -p truss-core -- --paths`.
+fn path_independence(samples: usize) {
+    let other = SolveOptions {
+        reuse_factorisation: false,
+        ..SolveOptions::default()
+    };
+    for stages in [1, 5, 10, 20, 30] {
+        let model = PrismOptions::with_stages(stages).model().unwrap();
+        let mut a = Solver::new(&model, SolveOptions::default()).unwrap();
+        let mut b = Solver::new(&model, other.clone()).unwrap();
+        let mut rng = Normals(34 + stages as u64);
+        let (mut worst_theta, mut worst_u, mut moved) = (0.0f64, 0.0f64, 0);
+        let mut worst_sample = None;
+        let mut worst_errors = Vec::new();
+        for k in 0..samples {
+            let e: Vec<f64> = model
+                .members()
+                .iter()
+                .map(|m| {
+                    if m.group == "diagonal" {
+                        0.0
+                    } else {
+                        0.0666666666666667 * rng.normal()
+                    }
+                })
+                .collect();
+            let (ra, rb) = (a.solve(&e).unwrap(), b.solve(&e).unwrap());
+            let (ea, eb) = (a.equilibrium().unwrap(), b.equilibrium().unwrap());
+            let (ta, tb) = (
+                ea.distortion.unwrap().theta_p,
+                eb.distortion.unwrap().theta_p,
+            );
+            let dt = (ta - tb).abs() / ta.abs().max(f64::MIN_POSITIVE);
+            let scale = ea
+                .displacements
+                .iter()
+                .flatten()
+                .fold(0.0f64, |m, x| m.max(x.abs()));
+            let du = ea
+                .displacements
+                .iter()
+                .flatten()
+                .zip(eb.displacements.iter().flatten())
+                .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+                / scale;
+            if dt > 1e-9 || du > 1e-9 {
+                moved += 1;
+            }
+            if dt > worst_theta {
+                worst_sample = Some((k, ra, rb, ea.slack.len(), eb.slack.len()));
+                worst_errors = e.clone();
+            }
+            worst_theta = worst_theta.max(dt);
+            worst_u = worst_u.max(du);
+        }
+        println!(
+            "{stages:>3} stages: {samples} samples, max relative change of θ_P {worst_theta:.2e}, of the displacements {worst_u:.2e}; {moved} moved by more than 1e-9"
+        );
+        if let Some((k, ra, rb, sa, sb)) = worst_sample {
+            println!(
+                "      worst sample {k}: default {} it, residual {:.2e} N, step {:.2e} mm, {sa} slack; without reuse {} it, residual {:.2e} N, step {:.2e} mm, {sb} slack",
+                ra.iterations, ra.residual, ra.step, rb.iterations, rb.residual, rb.step
+            );
+            // The same sample with a force test 100 times tighter, both ways: a flat valley
+            // (one equilibrium, loosely resolved) brings the two together; two equilibria
+            // stay apart.
+            let mut thetas = vec![];
+            for reuse in [true, false] {
+                let tight = SolveOptions {
+                    reuse_factorisation: reuse,
+                    residual_floor: 1e-15,
+                    step_tolerance: 1e-14,
+                    max_iterations: 400,
+                    ..SolveOptions::default()
+                };
+                let mut t = Solver::new(&model, tight).unwrap();
+                match t.solve(&worst_errors) {
+                    Ok(r) => {
+                        let eq = t.equilibrium().unwrap();
+                        let theta = eq.distortion.unwrap().theta_p;
+                        thetas.push(theta);
+                        println!(
+                            "      tight, reuse {reuse}: {} it, residual {:.2e} N, θ_P {theta:.12e}, {} slack, Π {:.15e} N·mm",
+                            r.iterations,
+                            r.residual,
+                            eq.slack.len(),
+                            t.potential_energy()
+                        );
+                    }
+                    Err(err) => println!("      tight, reuse {reuse}: {err}"),
+                }
+            }
+            println!(
+                "      default: θ_P {:.12e} and {:.12e}; Π {:.15e} and {:.15e}",
+                {
+                    a.solve(&worst_errors).unwrap();
+                    a.distortion().unwrap().theta_p
+                },
+                {
+                    b.solve(&worst_errors).unwrap();
+                    b.distortion().unwrap().theta_p
+                },
+                {
+                    a.solve(&worst_errors).unwrap();
+                    a.potential_energy()
+                },
+                {
+                    b.solve(&worst_errors).unwrap();
+                    b.potential_energy()
+                },
+            );
+        }
+    }
+}
+
 fn main() {
+    if std::env::args().any(|a| a == "--paths") {
+        path_independence(400);
+        return;
+    }
     let quick = std::env::args().any(|a| a == "--quick");
     let n = |full: usize| if quick { full / 10 } else { full };
-    bench(5, n(20_000));
-    bench(30, n(2_000));
-    bench(300, n(100).max(10));
-    dense_comparison();
+    // `-- --only 5` (or 5b for backlash, 30, 300): that model alone, for a profiler.
+    let args: Vec<String> = std::env::args().collect();
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|i| args.get(i + 1).cloned());
+    let runs: [(&str, usize, usize, bool, bool); 4] = [
+        ("5", 5, n(20_000), false, false),
+        ("5b", 5, n(20_000), true, true),
+        ("30", 30, n(2_000), false, false),
+        ("300", 300, n(100).max(10), false, true),
+    ];
+    for (name, stages, samples, backlash, histogram) in runs {
+        if only.as_deref().is_none_or(|o| o == name) {
+            bench(stages, samples, backlash, histogram);
+        }
+    }
+    if only.is_none() {
+        dense_comparison();
+    }
 }

@@ -6,6 +6,25 @@ use super::evaluate::{dot_n, evaluate_with, max_abs};
 use super::{Evaluation, Solver};
 use crate::SolveError;
 
+/// A trial is accepted when `|φ'(α)| ≤ ETA·|φ'_min|`.
+const ETA: f64 = 0.5;
+
+/// Armijo's sufficient-decrease constant `c₁`.
+const C1: f64 = 1e-4;
+
+/// The rounding noise of `Π` at the floor, relative to `|Σ W| + |fᵀu|`.
+const ENERGY_NOISE: f64 = 1e-11;
+
+/// A step is at most this many times `max(‖u‖∞, s)` (and the fourfold growth of the
+/// bracket's expansion).
+const TRUST_GROWTH: f64 = 4.0;
+
+/// A step moves a node by at most this fraction of the shortest member.
+const TRUST_MEMBER_FRACTION: f64 = 0.2;
+
+/// At most this many trial points per line search.
+const MAX_TRIALS: u32 = 100;
+
 impl Solver {
     /// Line search along `self.work.d` from `self.work.u` (see the module doc); moves `self.work.u`,
     /// `self.work.r` and `self.work.states` to the accepted point and returns α, its evaluation and
@@ -37,17 +56,16 @@ impl Solver {
         current: Evaluation,
         expand: bool,
     ) -> Result<(f64, Evaluation, f64), SolveError> {
-        const ETA: f64 = 0.5;
-        const C1: f64 = 1e-4;
         let n = self.structure.free;
         let phi0 = dot_n(&self.work.r[..n], &self.work.d[..n]);
         let d_max = max_abs(&self.work.d[..n]);
         let u_max = max_abs(&self.work.u[..n]);
-        let trust = (4.0 * u_max.max(self.sample.scale)).min(0.2 * self.shortest_member());
+        let trust = (TRUST_GROWTH * u_max.max(self.sample.scale))
+            .min(TRUST_MEMBER_FRACTION * self.shortest_member());
         let cap = trust / d_max.max(f64::MIN_POSITIVE);
         let work0 = dot_n(&self.sample.loads[..n], &self.work.u[..n]);
         let energy0 = current.strain - work0;
-        let noise = 1e-11 * (current.strain.abs() + work0.abs());
+        let noise = ENERGY_NOISE * (current.strain.abs() + work0.abs());
         if !expand && (phi0 >= 0.0 || phi0.is_nan()) {
             // Not a descent direction (a model step whose switched cables point it
             // uphill): the caller damps its steps, which makes the direction descend.
@@ -61,7 +79,7 @@ impl Solver {
         let (mut b, mut phi_b) = (f64::INFINITY, f64::INFINITY);
         let mut steepest = phi0.min(0.0);
         let mut side = 0i8;
-        for trial in 0..100 {
+        for trial in 0..MAX_TRIALS {
             let alpha = if trial == 0 && !expand {
                 1.0f64.min(cap)
             } else if trial <= 1 {
@@ -71,10 +89,10 @@ impl Solver {
                 } else if b.is_finite() {
                     0.5 * (a + b)
                 } else {
-                    (4.0 * a).max(f64::MIN_POSITIVE).min(cap)
+                    (TRUST_GROWTH * a).max(f64::MIN_POSITIVE).min(cap)
                 }
             } else if !b.is_finite() {
-                (4.0 * a).min(cap)
+                (TRUST_GROWTH * a).min(cap)
             } else if phi_b.is_finite() && phi_b > phi_a && side != 0 {
                 (b - phi_b * (b - a) / (phi_b - phi_a))
                     .clamp(a + 1e-3 * (b - a), b - 1e-3 * (b - a))

@@ -3,7 +3,7 @@
 
 use super::evaluate::{evaluate_with, max_abs};
 use super::step::Step;
-use super::{IterationRecord, Mode, SolveReport, Solver};
+use super::{Evaluation, IterationRecord, Mode, SolveReport, Solver};
 use crate::SolveError;
 use crate::linearised::{ActiveSetFailure, gather_b, scatter_b};
 use crate::structure::Structure;
@@ -46,17 +46,115 @@ const DAMPING_MAX: f64 = 1e8;
 /// a fresh tangent's step, or one whose measured contraction is at most this.
 const CONVERGED_CONTRACTION: f64 = 0.5;
 
-impl Solver {
-    /// Steps 1–5 of the module doc.
-    pub(super) fn newton(&mut self) -> Result<SolveReport, SolveError> {
-        let n = self.structure.free;
-        let opts = self.options.clone();
-        let structure = Arc::clone(&self.structure);
-        let mut iterations = 0u32;
-        let mut factorisations = 0u32;
+/// Most slack sets the banded active-set iteration of step 1 tries (models without a
+/// cable basis) before it gives up and Newton starts from zero.
+const MAX_LINEARISED_PIECES: u32 = 50;
 
-        // Step 1: the linearised problem.
-        let mut mode = match self.linearised(&structure, &mut factorisations) {
+/// The state of one solve's iteration that the parts of [`Solver::newton`] share.
+#[derive(Debug, Clone, Copy)]
+struct Progress {
+    /// Linear solves so far (the linearised problem counts as one).
+    iterations: u32,
+    /// Factorisations so far (the shared nominal one not counted).
+    factorisations: u32,
+    /// The operator of the next step.
+    mode: Mode,
+    /// The current point's evaluation.
+    eval: Evaluation,
+    /// Whether `Solver::factor.k` holds the factorised model stiffness of
+    /// `Solver::factor.factor_slack`.
+    k_valid: bool,
+    /// The last step's size \[mm\] (infinite after a fresh operator: no contraction known).
+    prev_step: f64,
+    /// The last step's size `α·max |d|` \[mm\].
+    step: f64,
+    /// The last reused operator's step contracted by less than
+    /// [`super::SolveOptions::reuse_contraction`]: use a fresh one.
+    poor: bool,
+    /// Iterations since the out-of-balance force last halved.
+    stalled: u32,
+    /// The lowest out-of-balance force so far \[N\].
+    lowest: f64,
+}
+
+/// How the step of one iteration was chosen.
+#[derive(Debug, Clone, Copy)]
+struct StepChoice {
+    /// The tangent was factorised afresh for it.
+    fresh: bool,
+    /// The Levenberg shift μ of that factorisation.
+    shift: f64,
+    /// It is a direction of negative curvature (the line search may expand).
+    curved: bool,
+}
+
+/// Whether the iteration goes on.
+enum Next {
+    /// Take another step.
+    Step,
+    /// Converged.
+    Done,
+}
+
+impl Solver {
+    /// Steps 1–5 of the module doc: the linearised start, then steps (chosen by
+    /// [`Solver::choose_step`], taken by the line search) until the force test
+    /// ([`Solver::force_converged`]) or the step test ([`Solver::step_converged`]) holds.
+    pub(super) fn newton(&mut self) -> Result<SolveReport, SolveError> {
+        let mut p = self.start();
+        loop {
+            if let Next::Done = self.force_converged(&mut p)? {
+                break;
+            }
+            p.iterations += 1;
+            let choice = self.choose_step(&mut p)?;
+            let residual_before = p.eval.residual;
+            let alpha = match self.line_search(p.iterations, p.eval, choice.curved) {
+                Ok((alpha, eval, d_max)) => {
+                    p.eval = eval;
+                    p.step = alpha * d_max;
+                    alpha
+                }
+                Err(e) => {
+                    // No step along this direction lowers the energy: damp the model steps
+                    // (towards steepest descent) and try again from the same point.
+                    if !self.raise_damping() {
+                        return Err(e);
+                    }
+                    p.mode = Mode::Tangent;
+                    p.k_valid = false;
+                    p.prev_step = f64::INFINITY;
+                    continue;
+                }
+            };
+            let u_max = max_abs(&self.work.u[..self.structure.free]);
+            self.adapt_damping(&mut p, alpha, u_max)?;
+            if self.options.record_iterations {
+                self.record(&p, &choice, residual_before, alpha);
+            }
+            self.update_slack();
+            self.pin_failed_switches(choice.fresh, alpha);
+            if let Next::Done = self.step_converged(&mut p, &choice, u_max) {
+                break;
+            }
+        }
+        Ok(SolveReport {
+            iterations: p.iterations,
+            factorisations: p.factorisations,
+            residual: p.eval.residual,
+            step: p.step,
+            slack_cables: self.slack_cable_count(),
+            evaluations: self.evaluations,
+            loose_joints: self.loose_joint_count(),
+        })
+    }
+
+    /// Step 1: the linearised problem (or zero, if it fails), evaluated.
+    fn start(&mut self) -> Progress {
+        let structure = Arc::clone(&self.structure);
+        let mut factorisations = 0;
+        let mut iterations = 0;
+        let mode = match self.linearised(&structure, &mut factorisations) {
             Ok(mode) => {
                 iterations += 1;
                 mode
@@ -66,7 +164,7 @@ impl Solver {
                 Mode::Tangent
             }
         };
-        let mut eval = evaluate_with(
+        let eval = evaluate_with(
             &structure,
             &self.sample.members,
             self.sample.tension.iter().copied(),
@@ -76,194 +174,216 @@ impl Solver {
             &mut self.work.states,
         );
         self.update_slack();
-        // Whether `self.factor.k` holds the factorised model stiffness of `self.factor.factor_slack`.
-        let mut k_valid = false;
-        let mut prev_step = f64::INFINITY;
-        let mut step = 0.0;
-        let mut poor = false;
-        // Iterations since the out-of-balance force last halved, and its lowest value.
-        let (mut stalled, mut lowest) = (0u32, f64::INFINITY);
-        loop {
-            if !eval.residual.is_finite() {
-                return Err(SolveError::NonFinite {
-                    iteration: iterations,
-                    what: "out-of-balance force (a member may have collapsed to zero length)"
-                        .into(),
-                });
-            }
-            // The force test's floor: relative to the largest force.
-            let floor = opts.residual_floor * eval.force_scale.max(self.sample.force_ref);
-            if eval.residual == 0.0 || eval.residual <= floor {
-                break;
-            }
-            // At the rounding floor of an ill-conditioned structure (a tall tower, whose
-            // bending is far softer than its members) the steps stop shrinking before the
-            // step test is met: accept when the force has not halved in three iterations and
-            // is within a thousand times the floor (1e-10 of the largest member force).
-            if eval.residual <= 0.5 * lowest {
-                (stalled, lowest) = (0, eval.residual);
-            } else {
-                stalled += 1;
-            }
-            if stalled >= STALL_ITERATIONS && eval.residual <= STALL_FLOOR_FACTOR * floor {
-                break;
-            }
-            if iterations >= opts.max_iterations {
-                return Err(SolveError::NotConverged {
-                    iterations,
-                    residual: eval.residual,
-                    step,
-                });
-            }
-            iterations += 1;
+        Progress {
+            iterations,
+            factorisations,
+            mode,
+            eval,
+            k_valid: false,
+            prev_step: f64::INFINITY,
+            step: 0.0,
+            poor: false,
+            stalled: 0,
+            lowest: f64::INFINITY,
+        }
+    }
 
-            // Choose the step.
-            self.step.step_slack.copy_from_slice(&self.work.slack);
-            let mut fresh = false;
-            let mut shift = 0.0;
-            let mut curved = false;
-            if mode == Mode::Chord && poor {
-                mode = Mode::Tangent;
-                poor = false;
+    /// The force test of step 5 at the current point: done when the out-of-balance force
+    /// is at its rounding floor `residual_floor·F` (`F` the largest member force, or the
+    /// sample's force scale), or has stopped falling ([`STALL_ITERATIONS`]) within
+    /// [`STALL_FLOOR_FACTOR`] times the floor (an ill-conditioned tall tower, whose
+    /// bending is far softer than its members: the steps stop shrinking before the step
+    /// test is met). Errors on a non-finite force or too many iterations.
+    fn force_converged(&self, p: &mut Progress) -> Result<Next, SolveError> {
+        let eval = &p.eval;
+        if !eval.residual.is_finite() {
+            return Err(SolveError::NonFinite {
+                iteration: p.iterations,
+                what: "out-of-balance force (a member may have collapsed to zero length)".into(),
+            });
+        }
+        let floor = self.force_floor(eval);
+        if eval.residual == 0.0 || eval.residual <= floor {
+            return Ok(Next::Done);
+        }
+        if eval.residual <= 0.5 * p.lowest {
+            (p.stalled, p.lowest) = (0, eval.residual);
+        } else {
+            p.stalled += 1;
+        }
+        if p.stalled >= STALL_ITERATIONS && eval.residual <= STALL_FLOOR_FACTOR * floor {
+            return Ok(Next::Done);
+        }
+        if p.iterations >= self.options.max_iterations {
+            return Err(SolveError::NotConverged {
+                iterations: p.iterations,
+                residual: eval.residual,
+                step: p.step,
+            });
+        }
+        Ok(Next::Step)
+    }
+
+    /// The force test's floor \[N\]: `residual_floor` times the largest member force (or
+    /// the sample's force scale, if larger).
+    fn force_floor(&self, eval: &Evaluation) -> f64 {
+        self.options.residual_floor * eval.force_scale.max(self.sample.force_ref)
+    }
+
+    /// Steps 2–3: puts the next step into `self.work.d`, a chord step with the current
+    /// slack set's Woodbury inverse while those contract, else a model step with the true
+    /// tangent (reusing its factorisation while the slack set is unchanged and steps
+    /// contract).
+    fn choose_step(&mut self, p: &mut Progress) -> Result<StepChoice, SolveError> {
+        let structure = Arc::clone(&self.structure);
+        let n = structure.free;
+        self.step.step_slack.copy_from_slice(&self.work.slack);
+        let mut choice = StepChoice {
+            fresh: false,
+            shift: 0.0,
+            curved: false,
+        };
+        if p.mode == Mode::Chord && p.poor {
+            p.mode = Mode::Tangent;
+            p.poor = false;
+        }
+        if p.mode == Mode::Chord {
+            let basis = structure.basis.as_ref().expect("chord mode needs a basis");
+            let states = &self.work.states;
+            let nc = basis.cables.len();
+            if self
+                .factor
+                .active
+                .set_slack_from(|c| states[basis.cables[c]].slack, nc)
+                && self.factor.active.factor(basis).is_err()
+            {
+                p.mode = Mode::Tangent;
             }
-            if mode == Mode::Chord {
+        }
+        match p.mode {
+            Mode::Chord => {
                 let basis = structure.basis.as_ref().expect("chord mode needs a basis");
-                let states = &self.work.states;
-                let nc = basis.cables.len();
-                if self
-                    .factor
+                self.negate_residual_into_step();
+                self.factor
                     .active
-                    .set_slack_from(|c| states[basis.cables[c]].slack, nc)
-                    && self.factor.active.factor(basis).is_err()
-                {
-                    mode = Mode::Tangent;
-                }
+                    .apply_inverse(&structure, basis, &mut self.work.d);
             }
-            match mode {
-                Mode::Chord => {
-                    let basis = structure.basis.as_ref().expect("chord mode needs a basis");
+            Mode::Tangent => {
+                let reuse = p.k_valid
+                    && self.options.reuse_factorisation
+                    && !p.poor
+                    && self.work.slack == self.factor.factor_slack;
+                if reuse {
                     self.negate_residual_into_step();
-                    self.factor
-                        .active
-                        .apply_inverse(&structure, basis, &mut self.work.d);
-                }
-                Mode::Tangent => {
-                    let reuse = k_valid
-                        && opts.reuse_factorisation
-                        && !poor
-                        && self.work.slack == self.factor.factor_slack;
-                    if reuse {
-                        self.negate_residual_into_step();
-                        self.factor.k.solve_in_place(&mut self.work.d[..n]);
-                    } else {
-                        match self.model_step(iterations, &mut factorisations)? {
-                            Step::Newton { shift: mu } => {
-                                shift = mu;
-                                fresh = true;
-                                k_valid = true;
-                                prev_step = f64::INFINITY;
-                            }
-                            Step::Curvature => {
-                                curved = true;
-                                k_valid = false;
-                            }
+                    self.factor.k.solve_in_place(&mut self.work.d[..n]);
+                } else {
+                    match self.model_step(p.iterations, &mut p.factorisations)? {
+                        Step::Newton { shift } => {
+                            choice.shift = shift;
+                            choice.fresh = true;
+                            p.k_valid = true;
+                            p.prev_step = f64::INFINITY;
+                        }
+                        Step::Curvature => {
+                            choice.curved = true;
+                            p.k_valid = false;
                         }
                     }
                 }
             }
+        }
+        Ok(choice)
+    }
 
-            let residual_before = eval.residual;
-            let (alpha, new_eval, d_max) = match self.line_search(iterations, eval, curved) {
-                Ok(found) => found,
-                Err(e) => {
-                    // No step along this direction lowers the energy: damp the model steps
-                    // (towards steepest descent) and try again from the same point.
-                    if !self.raise_damping() {
-                        return Err(e);
-                    }
-                    mode = Mode::Tangent;
-                    k_valid = false;
-                    prev_step = f64::INFINITY;
-                    continue;
-                }
-            };
-            eval = new_eval;
-            step = alpha * d_max;
-            let u_max = max_abs(&self.work.u[..n]);
-            let far_from_floor = eval.residual
-                > STALL_FLOOR_FACTOR
-                    * opts.residual_floor
-                    * eval.force_scale.max(self.sample.force_ref);
-            if far_from_floor && step <= STUCK_STEP * u_max.max(self.sample.scale) {
-                // A step that no longer moves while the force is far from balanced: damp.
-                if !self.raise_damping() {
-                    return Err(SolveError::NotConverged {
-                        iterations,
-                        residual: eval.residual,
-                        step,
-                    });
-                }
-                mode = Mode::Tangent;
-                k_valid = false;
-            } else if self.step.damping > 0.0 && alpha >= FULL_STEP {
-                // Full steps again: relax the damping back towards Newton's method.
-                self.step.damping = if self.step.damping < DAMPING_OFF {
-                    0.0
-                } else {
-                    self.step.damping * DAMPING_RELAX
-                };
-                k_valid = false;
-            }
-            if opts.record_iterations {
-                let slack = self.slack_indices();
-                self.log.push(IterationRecord {
-                    iteration: iterations,
-                    residual: residual_before,
-                    step,
-                    alpha,
-                    refactorised: fresh,
-                    shift,
-                    slack,
-                    evaluations: self.evaluations,
+    /// After a line search: a step that no longer moves ([`STUCK_STEP`]) while the force
+    /// is far from its floor raises the damping (an error once it is beyond
+    /// [`DAMPING_MAX`]); full steps again relax it back towards Newton's method.
+    fn adapt_damping(
+        &mut self,
+        p: &mut Progress,
+        alpha: f64,
+        u_max: f64,
+    ) -> Result<(), SolveError> {
+        // (Multiplied in this order, as ever: the comparison's rounding is part of the
+        // results.)
+        let far_from_floor = p.eval.residual
+            > STALL_FLOOR_FACTOR
+                * self.options.residual_floor
+                * p.eval.force_scale.max(self.sample.force_ref);
+        if far_from_floor && p.step <= STUCK_STEP * u_max.max(self.sample.scale) {
+            if !self.raise_damping() {
+                return Err(SolveError::NotConverged {
+                    iterations: p.iterations,
+                    residual: p.eval.residual,
+                    step: p.step,
                 });
             }
-            // A model step that switched cables but whose switch did not come true (the line
-            // search stopped short and the slack set is unchanged) is followed by a plain
-            // step on the current piece.
-            self.update_slack();
-            let switched = fresh && self.factor.factor_slack != self.step.step_slack;
-            self.step.plain_step =
-                switched && alpha < FULL_STEP && self.work.slack == self.step.step_slack;
-            // Pin the cables whose switch failed for the next (plain) step, release the rest.
-            for ((p, f), s) in self
-                .step
-                .pinned
-                .iter_mut()
-                .zip(&self.factor.factor_slack)
-                .zip(&self.step.step_slack)
-            {
-                *p = self.step.plain_step && f != s;
-            }
-
-            // Convergence on the step.
-            let contraction = step / prev_step;
-            let small = step <= opts.step_tolerance * u_max;
-            let undamped = self.step.damping == 0.0;
-            if small && !curved && undamped && (fresh || contraction <= CONVERGED_CONTRACTION) {
-                break;
-            }
-            poor = !fresh && !curved && contraction > opts.reuse_contraction;
-            prev_step = if curved { f64::INFINITY } else { step };
+            p.mode = Mode::Tangent;
+            p.k_valid = false;
+        } else if self.step.damping > 0.0 && alpha >= FULL_STEP {
+            self.step.damping = if self.step.damping < DAMPING_OFF {
+                0.0
+            } else {
+                self.step.damping * DAMPING_RELAX
+            };
+            p.k_valid = false;
         }
-        Ok(SolveReport {
-            iterations,
-            factorisations,
-            residual: eval.residual,
-            step,
-            slack_cables: self.slack_cable_count(),
+        Ok(())
+    }
+
+    /// Appends the iteration's record to the log.
+    fn record(&mut self, p: &Progress, choice: &StepChoice, residual_before: f64, alpha: f64) {
+        let slack = self.slack_indices();
+        self.log.push(IterationRecord {
+            iteration: p.iterations,
+            residual: residual_before,
+            step: p.step,
+            alpha,
+            refactorised: choice.fresh,
+            shift: choice.shift,
+            slack,
             evaluations: self.evaluations,
-            loose_joints: self.loose_joint_count(),
-        })
+        });
+    }
+
+    /// A model step that switched cables but whose switch did not come true (the line
+    /// search stopped short of [`FULL_STEP`] and the slack set is unchanged) is followed
+    /// by a plain step on the current piece, with the cables whose switch failed pinned;
+    /// the others are released.
+    fn pin_failed_switches(&mut self, fresh: bool, alpha: f64) {
+        let switched = fresh && self.factor.factor_slack != self.step.step_slack;
+        self.step.plain_step =
+            switched && alpha < FULL_STEP && self.work.slack == self.step.step_slack;
+        for ((p, f), s) in self
+            .step
+            .pinned
+            .iter_mut()
+            .zip(&self.factor.factor_slack)
+            .zip(&self.step.step_slack)
+        {
+            *p = self.step.plain_step && f != s;
+        }
+    }
+
+    /// The step test of step 5: done when the step is at most `step_tolerance` of the
+    /// largest displacement, undamped and not along a curvature, and the error it leaves
+    /// is no larger than it (a fresh tangent's, or a contraction of at most
+    /// [`CONVERGED_CONTRACTION`]). Otherwise notes whether a reused operator's step
+    /// contracted too little to keep it.
+    fn step_converged(&self, p: &mut Progress, choice: &StepChoice, u_max: f64) -> Next {
+        let contraction = p.step / p.prev_step;
+        let small = p.step <= self.options.step_tolerance * u_max;
+        let undamped = self.step.damping == 0.0;
+        if small
+            && !choice.curved
+            && undamped
+            && (choice.fresh || contraction <= CONVERGED_CONTRACTION)
+        {
+            return Next::Done;
+        }
+        p.poor = !choice.fresh && !choice.curved && contraction > self.options.reuse_contraction;
+        p.prev_step = if choice.curved { f64::INFINITY } else { p.step };
+        Next::Step
     }
 
     /// Raises the Levenberg damping of model steps by [`DAMPING_RAISE`] (from
@@ -342,7 +462,7 @@ impl Solver {
             self.factor.factor_slack[m] =
                 c.is_cable && c.sense * (gather_b(s, m, &self.work.u) + self.work.stretch[m]) < 0.0;
         }
-        for _ in 0..50 {
+        for _ in 0..MAX_LINEARISED_PIECES {
             let slack = &self.factor.factor_slack;
             s.assemble_material(&mut self.factor.k, |m| {
                 if slack[m] {

@@ -34,6 +34,16 @@ const MAX_MODEL_PIECES: u32 = 8;
 /// step then keeps its elongation at zero, where an equilibrium on the kink lies.
 const PIN_FACTOR: f64 = 1e3;
 
+/// The first Levenberg shift μ tried where `K(S)` is not positive definite (undamped).
+const SHIFT_START: f64 = 1e-9;
+
+/// Each retry multiplies the shift by this.
+const SHIFT_RAISE: f64 = 100.0;
+
+/// Shifts are tried up to this many times the solver's damping (and at least up to 1);
+/// beyond, the structure is a mechanism.
+const SHIFT_LIMIT_FACTOR: f64 = 1e3;
+
 /// What a model step produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum Step {
@@ -189,7 +199,7 @@ impl Solver {
         allow_curvature: bool,
     ) -> Result<Option<f64>, SolveError> {
         let mut shift = self.step.damping;
-        let limit = (1e3 * self.step.damping).max(1.0);
+        let limit = (SHIFT_LIMIT_FACTOR * self.step.damping).max(1.0);
         loop {
             self.assemble_model();
             let s = &*self.structure;
@@ -207,7 +217,11 @@ impl Solver {
                         self.work.d[s.free] = 0.0;
                         return Ok(None);
                     }
-                    shift = if shift == 0.0 { 1e-9 } else { shift * 100.0 };
+                    shift = if shift == 0.0 {
+                        SHIFT_START
+                    } else {
+                        shift * SHIFT_RAISE
+                    };
                     if shift > limit {
                         let (node, dof) = s.describe_dof(e.index);
                         return Err(SolveError::Mechanism {
