@@ -89,11 +89,7 @@ pub fn cost(groups: &[GroupModel], sigmas: &[f64]) -> f64 {
 
 /// The cheapest σ per group \[mm\] with model θ_Pq = `target` \[rad\] (see the module doc).
 /// Every free group must have `S_g > 0` (the caller checks).
-pub fn allocate(
-    groups: &[GroupModel],
-    target: f64,
-    q: f64,
-) -> Result<Vec<f64>, AllocationError> {
+pub fn allocate(groups: &[GroupModel], target: f64, q: f64) -> Result<Vec<f64>, AllocationError> {
     let fixed: Vec<f64> = groups.iter().map(|g| g.fixed.unwrap_or(0.0)).collect();
     let theta_fixed = model_theta(groups, &fixed, q);
     if theta_fixed >= target {

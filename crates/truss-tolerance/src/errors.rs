@@ -92,7 +92,9 @@ pub enum ToleranceError {
         target: f64,
     },
     /// Some samples did not solve; none are dropped silently.
-    #[error("{failed} of {samples} samples of the {stage} run failed (first: sample {first}: {reason})")]
+    #[error(
+        "{failed} of {samples} samples of the {stage} run failed (first: sample {first}: {reason})"
+    )]
     FailedSamples {
         /// Which run (`sensitivity`, `verification`, `uniform`).
         stage: &'static str,

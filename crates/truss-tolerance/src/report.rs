@@ -12,7 +12,8 @@
 //! | `members` | per member with a length error: `{"id", "group", "share", "share_interval", "share_x", "share_y"}` |
 //! | `nonlinear_share`, `nonlinear_interval` | the variance share no linear model explains |
 //! | `input` | θ_Pq at the input σ: `{"theta_p", "interval", "samples", "model_theta_p"}` |
-//! | `uniform_sigma` | the common σ that meets the target |
+//! | `uniform_sigma` | the common σ that meets the target (found as the allocation is) |
+//! | `uniform_verified` | its run: `{"theta_p", "interval", "samples"}` |
 //! | `cost`, `uniform_cost`, `cost_ratio` | `Σ w_g n_g/σ_g` \[mm⁻¹\] of the allocation and of the uniform σ, and their ratio |
 //! | `verified` | the last run: `{"theta_p", "interval", "samples", "passed"}` |
 //! | `runs` | every verification run: `{"sigma": {group: σ}, "theta_p", "interval", "model_theta_p"}` |
@@ -110,6 +111,8 @@ pub fn json(t: &Tolerance) -> Value {
         "input": {"theta_p": num(t.input.theta), "interval": pair(t.input.interval),
                   "samples": t.input.samples, "model_theta_p": num(t.input_model)},
         "uniform_sigma": num(t.uniform_sigma),
+        "uniform_verified": {"theta_p": num(t.uniform_run.1.theta), "interval": pair(t.uniform_run.1.interval),
+                             "samples": t.uniform_run.1.samples},
         "cost": num(t.cost.0),
         "uniform_cost": num(t.cost.1),
         "cost_ratio": num(t.cost_ratio()),
@@ -193,8 +196,11 @@ pub fn markdown(t: &Tolerance) -> String {
     );
     let _ = writeln!(
         s,
-        "The uniform σ: the model's {:.4e} mm gave θ_P{q} = {:.4e} [{:.4e}, {:.4e}] rad; rescaled by homogeneity so that the upper end meets the target.\n",
-        t.uniform_run.0, t.uniform_run.1.theta, t.uniform_run.1.interval.0, t.uniform_run.1.interval.1
+        "The uniform σ, after {} run(s) (the model's value, then rescaled as the allocation is): θ_P{q} = {:.4e} [{:.4e}, {:.4e}] rad.\n",
+        t.uniform_run.0,
+        t.uniform_run.1.theta,
+        t.uniform_run.1.interval.0,
+        t.uniform_run.1.interval.1
     );
     let _ = writeln!(
         s,

@@ -179,8 +179,10 @@ pub fn fit(run: &Run, sigma: &[f64], weights: Option<&[u8]>) -> Option<Fit> {
     for j in 0..m {
         let (b_x, b_y) = (rhs[0][j + 1], rhs[1][j + 1]);
         f.share.push((b_x * b_x + b_y * b_y) / total);
-        f.share_x.push(if var_x > 0.0 { b_x * b_x / var_x } else { 0.0 });
-        f.share_y.push(if var_y > 0.0 { b_y * b_y / var_y } else { 0.0 });
+        f.share_x
+            .push(if var_x > 0.0 { b_x * b_x / var_x } else { 0.0 });
+        f.share_y
+            .push(if var_y > 0.0 { b_y * b_y / var_y } else { 0.0 });
         let (px, py) = (b_x / sigma[j], b_y / sigma[j]);
         f.covariance.push([px * px, px * py, py * py]);
     }

@@ -10,9 +10,9 @@
 use crate::errors::ToleranceError;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use truss_job::Job;
 use truss_job::distribution::DistributionSpec;
 use truss_job::job::{CaseSpec, JobSpec};
-use truss_job::Job;
 
 /// A group whose tolerance is studied.
 #[derive(Debug, Clone, PartialEq)]
@@ -102,17 +102,15 @@ impl Study {
         costs: &[String],
         fixes: &[String],
     ) -> Result<Self, ToleranceError> {
-        let case_index = job
-            .case_named(case)
-            .ok_or_else(|| ToleranceError::NoCase {
-                case: case.to_string(),
-                known: job
-                    .cases
-                    .iter()
-                    .map(|c| c.name.as_str())
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            })?;
+        let case_index = job.case_named(case).ok_or_else(|| ToleranceError::NoCase {
+            case: case.to_string(),
+            known: job
+                .cases
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })?;
         let validated = &job.cases[case_index];
         let unsupported = |reason: &str| ToleranceError::Unsupported {
             case: case.to_string(),
@@ -156,7 +154,8 @@ impl Study {
                 }
                 DistributionSpec::Constant { .. } => {
                     return Err(not(
-                        "its length error is a constant: a tolerance study needs random errors".into(),
+                        "its length error is a constant: a tolerance study needs random errors"
+                            .into(),
                     ));
                 }
                 _ => {}
@@ -191,14 +190,13 @@ impl Study {
             .join(", ");
         let find = |flag: &str, text: &str| -> Result<(usize, f64), ToleranceError> {
             let (group, value) = parse_pair(flag, text)?;
-            let i = groups
-                .iter()
-                .position(|g| g.name == group)
-                .ok_or_else(|| ToleranceError::UnknownGroup {
+            let i = groups.iter().position(|g| g.name == group).ok_or_else(|| {
+                ToleranceError::UnknownGroup {
                     flag: flag.to_string(),
                     group: group.clone(),
                     known: known.clone(),
-                })?;
+                }
+            })?;
             Ok((i, value))
         };
         let mut weights = Vec::new();
