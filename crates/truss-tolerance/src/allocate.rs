@@ -66,8 +66,8 @@ pub enum AllocationError {
 pub fn covariance(groups: &[GroupModel], sigmas: &[f64]) -> Covariance {
     let mut c = [0.0; 3];
     for (g, s) in groups.iter().zip(sigmas) {
-        for j in 0..3 {
-            c[j] += s * s * g.covariance[j];
+        for (cj, gj) in c.iter_mut().zip(&g.covariance) {
+            *cj += s * s * gj;
         }
     }
     c

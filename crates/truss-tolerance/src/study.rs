@@ -310,7 +310,6 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
             }
         })
     };
-    let mut sigmas = allocate_for(target)?;
 
     // 3. Verification, with the homogeneity rescale; 4. the uniform σ the same way.
     let verify_run = |stage: &'static str, sigmas: &[f64]| -> Result<Percentile, ToleranceError> {
