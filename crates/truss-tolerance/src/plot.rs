@@ -1,5 +1,8 @@
 //! SVG plots of the variance shares:
 //!
+//! Shares span many decades (a fixed bottom batten moves nothing), so the share axes are
+//! logarithmic.
+//!
 //! - `shares-groups.svg`: each group's share of Var tan θ_x + Var tan θ_y with its 95 %
 //!   interval, and the nonlinear remainder.
 //! - `shares-members.svg`: each member's share with its interval, by stage (x axis) and
@@ -47,18 +50,8 @@ fn groups_plot(path: &Path, t: &Tolerance) -> PlotResult {
         .map(|g| (g.name.clone(), g.share.0, g.share.1))
         .collect();
     bars.push(("nonlinear".into(), nl.0, nl.1));
-    let top = bars
-        .iter()
-        .map(|b| b.1.max(b.2.1))
-        .filter(|v| v.is_finite())
-        .fold(0.0f64, f64::max)
-        .max(1e-6)
-        * 1.1;
-    let bottom = bars
-        .iter()
-        .map(|b| b.1.min(b.2.0))
-        .filter(|v| v.is_finite())
-        .fold(0.0f64, f64::min);
+    let values: Vec<f64> = bars.iter().flat_map(|b| [b.1, b.2.0, b.2.1]).collect();
+    let (bottom, top) = log_range(&values);
     let n = bars.len();
     let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
     let mut chart = ChartBuilder::on(&root)
@@ -69,7 +62,7 @@ fn groups_plot(path: &Path, t: &Tolerance) -> PlotResult {
         .margin(14)
         .x_label_area_size(44)
         .y_label_area_size(64)
-        .build_cartesian_2d(-0.5..(n as f64 - 0.5), bottom..top)?;
+        .build_cartesian_2d(-0.5..(n as f64 - 0.5), (bottom..top).log_scale())?;
     chart
         .configure_mesh()
         .disable_x_mesh()
@@ -82,8 +75,10 @@ fn groups_plot(path: &Path, t: &Tolerance) -> PlotResult {
                 String::new()
             }
         })
-        .y_desc("share of Var tan θ_x + Var tan θ_y [-] (95 % interval)")
+        .y_desc("share of Var tan θ_x + Var tan θ_y [-] (95 % interval, log scale)")
+        .y_label_formatter(&|y| format!("{y:.0e}"))
         .draw()?;
+    let clamp = |v: f64| v.max(bottom);
     for (i, (_, v, (lo, hi))) in bars.iter().enumerate() {
         let c = if i + 1 == n {
             RGBColor(150, 150, 150)
@@ -92,15 +87,27 @@ fn groups_plot(path: &Path, t: &Tolerance) -> PlotResult {
         };
         let x = i as f64;
         chart.draw_series(std::iter::once(Rectangle::new(
-            [(x - 0.3, 0.0), (x + 0.3, *v)],
+            [(x - 0.3, bottom), (x + 0.3, clamp(*v))],
             c.mix(0.6).filled(),
         )))?;
         if lo.is_finite() && hi.is_finite() {
-            chart.draw_series(whisker(x, *lo, *hi, 0.1, BLACK))?;
+            chart.draw_series(whisker(x, clamp(*lo), clamp(*hi), 0.1, BLACK))?;
         }
     }
     root.present()?;
     Ok(())
+}
+
+/// A log axis's range covering the positive `values` (a decade's margin below, 50 % above);
+/// values at or below zero are drawn at the bottom.
+fn log_range(values: &[f64]) -> (f64, f64) {
+    let positive = values.iter().filter(|v| v.is_finite() && **v > 0.0);
+    let lo = positive.clone().fold(f64::MAX, |a, &b| a.min(b));
+    let hi = positive.fold(0.0f64, |a, &b| a.max(b));
+    if hi <= 0.0 {
+        return (1e-6, 1.0);
+    }
+    (10f64.powf(lo.log10().floor()), hi * 1.5)
 }
 
 /// (stage, position) of a member id, or None.
@@ -143,13 +150,13 @@ fn members_plot(path: &Path, t: &Tolerance) -> PlotResult {
     let (x_lo, x_hi) = places
         .iter()
         .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
-    let top = share
+    let values: Vec<f64> = share
         .iter()
-        .chain(intervals.iter().map(|i| &i.1))
-        .filter(|v| v.is_finite())
-        .fold(0.0f64, |a, &b| a.max(b))
-        .max(1e-6)
-        * 1.1;
+        .chain(intervals.iter().flat_map(|i| [&i.0, &i.1]))
+        .copied()
+        .collect();
+    let (bottom, top) = log_range(&values);
+    let clamp = |v: f64| v.max(bottom);
     let mut chart = ChartBuilder::on(&root)
         .caption(
             format!("Share of the tilt's variance per member, case {}", t.case),
@@ -158,7 +165,7 @@ fn members_plot(path: &Path, t: &Tolerance) -> PlotResult {
         .margin(14)
         .x_label_area_size(44)
         .y_label_area_size(64)
-        .build_cartesian_2d((x_lo - 0.6)..(x_hi + 0.6), 0.0..top)?;
+        .build_cartesian_2d((x_lo - 0.6)..(x_hi + 0.6), (bottom..top).log_scale())?;
     chart
         .configure_mesh()
         .x_desc(if all_parsed {
@@ -166,7 +173,8 @@ fn members_plot(path: &Path, t: &Tolerance) -> PlotResult {
         } else {
             "member (order within its group)"
         })
-        .y_desc("share of Var tan θ_x + Var tan θ_y [-] (95 % interval)")
+        .y_desc("share of Var tan θ_x + Var tan θ_y [-] (95 % interval, log scale)")
+        .y_label_formatter(&|y| format!("{y:.0e}"))
         .draw()?;
     for (g, group) in t.groups.iter().enumerate() {
         let c = palette(g);
@@ -176,20 +184,20 @@ fn members_plot(path: &Path, t: &Tolerance) -> PlotResult {
         chart
             .draw_series(
                 js.iter()
-                    .map(|&j| Circle::new((x_of(j), share[j]), 4, c.filled())),
+                    .map(|&j| Circle::new((x_of(j), clamp(share[j])), 4, c.filled())),
             )?
             .label(group.name.clone())
             .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
         for &j in &js {
             let (lo, hi) = intervals[j];
             if lo.is_finite() && hi.is_finite() {
-                chart.draw_series(whisker(x_of(j), lo, hi, 0.02, c))?;
+                chart.draw_series(whisker(x_of(j), clamp(lo), clamp(hi), 0.02, c))?;
             }
         }
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::MiddleRight)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()?;
