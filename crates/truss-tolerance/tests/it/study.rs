@@ -55,6 +55,14 @@ fn the_study_writes_what_the_issue_lists_and_verifies() {
     let ratio = doc["cost_ratio"].as_f64().unwrap();
     assert!(ratio > 0.0 && ratio < 1.0, "{ratio}");
     assert!(doc["uniform_sigma"].as_f64().unwrap() > sl);
+    // The group derivatives obey Euler's relation for a degree-1 homogeneous θ_P95:
+    // Σ σ_g ∂θ/∂σ_g = θ_P95 at the input σ (the calibrated model's finite differences).
+    let euler: f64 = t.groups.iter().map(|g| g.input_sigma * g.derivative).sum();
+    assert!(
+        (euler / t.input.theta - 1.0).abs() < 1e-6,
+        "{euler} vs {}",
+        t.input.theta
+    );
     // The allocated job: the input job with this case's σ replaced, runnable from anywhere.
     let allocated = Job::read(&out.join("allocated-job.json")).unwrap();
     assert_eq!(allocated.cases.len(), 2);
