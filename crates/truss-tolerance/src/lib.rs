@@ -11,6 +11,11 @@
 //! 3. **Verification** ([`verify`]): the allocated case is run (in-process, 20,000 samples by
 //!    default) and its θ_Pq with a 95 % interval is checked against the target.
 //!
+//! The sensitivity run has 4,000 samples by default (at least 1,000 and ten per member
+//! with an error). Every run draws sample `k` of the case as the job does (its seed, the case
+//! name, `k`), and the bootstraps are keyed by the job's seed and the sample index, so the
+//! whole study is a function of the job and the options, not of the thread count.
+//!
 //! ## What the method rests on (units: mm, rad; arcsec only where labelled)
 //!
 //! **Homogeneity.** With no loads, effects or clearances the equilibrium depends on the length
@@ -19,9 +24,9 @@
 //! sample `k` as `e_i = σ_g z_i` with `z` fixed by (seed, case, k), scaling every σ by `c`
 //! then scales every sample's θ_P, θ_Pq and its bootstrap interval by `c`. The paper's
 //! prism is homogeneous only approximately: Table 1's diagonals (537.4 mm) are 1.15 µm
-//! shorter than the face diagonal 380·√2 mm, a fixed pre-tension that does not scale with σ
-//! (on the 2-stage prism at σ = 0.0063 mm, a 1 % rescale moves single samples' θ_P by up to
-//! 0.5 % from exact proportion, median 5·10⁻⁵). So a rescale is always followed by a new run.
+//! shorter than the face diagonal 380·√2 mm, a fixed pre-tension that does not scale with σ,
+//! so near a change of slack set a sample's θ_P does not follow a rescale of σ in exact
+//! proportion. So a rescale is always followed by a new run.
 //!
 //! **Piecewise linearity.** Within one set of slack diagonals `t = J_s·e`; the set changes
 //! with `e`. The sensitivity is therefore measured on the Monte Carlo draws at the case's own
