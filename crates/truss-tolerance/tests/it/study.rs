@@ -52,6 +52,15 @@ fn the_study_writes_what_the_issue_lists_and_verifies() {
     // The allocation relaxes the insensitive battens and is cheaper than one common σ.
     let (sb, sl) = (t.groups[0].sigma, t.groups[1].sigma);
     assert!(sb > 3.0 * sl, "batten σ {sb}, longeron σ {sl}");
+    // The free groups' ratio is the closed form's, (n_b S_l / (n_l S_b))^{1/3}, with the
+    // sensitivities the study measured and reported.
+    let s = |g: &str| doc["groups"][g]["sensitivity"].as_f64().unwrap();
+    let closed = (9.0 * s("longeron") / (6.0 * s("batten"))).cbrt();
+    assert!(
+        (sb / sl / closed - 1.0).abs() < 1e-9,
+        "{} vs {closed}",
+        sb / sl
+    );
     let ratio = doc["cost_ratio"].as_f64().unwrap();
     assert!(ratio > 0.0 && ratio < 1.0, "{ratio}");
     assert!(doc["uniform_sigma"].as_f64().unwrap() > sl);
