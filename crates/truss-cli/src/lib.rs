@@ -12,6 +12,9 @@
 //!   the gap shrink (the `truss_diagnose` crate; [`diagnose`]).
 //! - `truss synth-measured --job J --case NAME --specimens N --seed S --effect NAME:P=V,…`
 //!   writes measured data with a hidden effect to stdout ([`truss_diagnose::synth`]).
+//! - `truss tolerance --job J --case NAME --target-arcsec A --out DIR` allocates per-group
+//!   length tolerances for a θ_P budget and verifies them (the `truss_tolerance` crate;
+//!   [`tolerance`]).
 //! - `truss completions bash|zsh|fish|elvish|powershell` writes a shell completion script
 //!   to stdout (`truss completions bash > ~/.local/share/bash-completion/completions/truss`),
 //!   and `truss man` the roff manual page (`truss man > truss.1; man ./truss.1`).
@@ -36,10 +39,12 @@
 //! | 2 | usage error (bad arguments) |
 //! | 3 | the model file, job or measured data is invalid (the message names the item or line) |
 //! | 4 | a file could not be read or written |
+//! | 6 | a tolerance allocation did not verify (its files are written) |
 //! | 7 | the solve failed (not converged, mechanism; the JSON result says why), or a diagnosis's simulation failed |
 
 pub mod diagnose;
 pub mod solve;
+pub mod tolerance;
 
 use clap::{Args, Parser, Subcommand};
 use std::io::Write;
@@ -85,6 +90,9 @@ pub enum Command {
     Diagnose(diagnose::DiagnoseArgs),
     /// Write measured data (CSV, stdout) made from a case with a hidden effect.
     SynthMeasured(diagnose::SynthArgs),
+    /// Which members matter, and the cheapest per-group length tolerances that keep θ_P at
+    /// a percentile within a budget; verified by Monte Carlo.
+    Tolerance(tolerance::ToleranceArgs),
     /// Write a shell completion script to stdout.
     Completions {
         /// The shell.
@@ -227,6 +235,9 @@ pub enum CliError {
     /// A diagnosis (or synthetic measurement) failed.
     #[error(transparent)]
     Diagnose(#[from] truss_diagnose::DiagnoseError),
+    /// A tolerance study failed.
+    #[error(transparent)]
+    Tolerance(#[from] truss_tolerance::ToleranceError),
 }
 
 impl From<truss_core::ModelError> for CliError {
@@ -243,6 +254,7 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
         Some(CliError::Model(_)) => EXIT_BAD_MODEL,
         Some(CliError::Solve(_)) => EXIT_SOLVE_FAILED,
         Some(CliError::Diagnose(e)) => diagnose::exit_code(e),
+        Some(CliError::Tolerance(e)) => tolerance::exit_code(e),
         // Anything unclassified is a bug, not an I/O error.
         None => truss_exit::INTERNAL,
     }
@@ -265,6 +277,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> anyhow::Result<()> {
         Command::Solve(args) => solve::run(&args, out)?,
         Command::Diagnose(args) => diagnose::run_diagnose(&args, out)?,
         Command::SynthMeasured(args) => diagnose::run_synth(&args, out)?,
+        Command::Tolerance(args) => tolerance::run(&args, out)?,
         Command::Completions { shell } => {
             // Into memory first: clap_complete panics on a failed write (a closed pipe).
             let mut script = Vec::new();

@@ -5,7 +5,8 @@
 //! - the runner (`mc-shard`) never links the merge (`mc-merge`) nor an async runtime;
 //! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
 //! - the solver links nothing of ours; nor do the statistics and the wire format;
-//! - the diagnosis links neither the runner, the merge nor the wire format.
+//! - the diagnosis links neither the runner, the merge nor the wire format;
+//! - the tolerance study links the solver, the job and the statistics, and nothing else of ours.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -70,6 +71,7 @@ fn dependencies_point_one_way() {
         "truss-job",
         "mc-shard",
         "mc-merge",
+        "truss-tolerance",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
     }
@@ -109,4 +111,11 @@ fn dependencies_point_one_way() {
         .cloned()
         .collect();
     assert_eq!(job, ["truss-core"]);
+    // truss-tolerance sits on the job, the solver and the statistics: not the runner, the
+    // merge, the wire format or the diagnosis.
+    let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
+        .intersection(&ours)
+        .cloned()
+        .collect();
+    assert_eq!(tolerance, ["truss-core", "truss-job", "truss-stats"]);
 }

@@ -1,0 +1,111 @@
+//! `truss tolerance`: argument parsing over the `truss_tolerance` library, which does the
+//! work (sensitivity shares, the cheapest per-group σ for a θ_P budget, its verification).
+
+use crate::{CliError, EXIT_BAD_MODEL, EXIT_IO, EXIT_SOLVE_FAILED, EXIT_USAGE};
+use clap::Args;
+use std::io::Write;
+use std::path::PathBuf;
+use truss_tolerance::ToleranceError;
+
+/// Options of `truss tolerance`.
+#[derive(Debug, Args)]
+pub struct ToleranceArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// The case whose groups' tolerances are allocated (its σ values are the starting point).
+    #[arg(long)]
+    pub case: String,
+    /// The budget: θ_P at the percentile must not exceed this angle \[arcsec\].
+    #[arg(long)]
+    pub target_arcsec: f64,
+    /// The percentile of θ_P the budget applies to \[%\].
+    #[arg(long, default_value_t = 95.0)]
+    pub percentile: f64,
+    /// A group's cost weight, `GROUP=WEIGHT` (default 1: cost = members / σ); repeatable.
+    #[arg(long = "cost", value_name = "GROUP=WEIGHT")]
+    pub costs: Vec<String>,
+    /// Pin a group at a supplier's tolerance, `GROUP=SIGMA` \[mm\]; repeatable.
+    #[arg(long = "fix", value_name = "GROUP=SIGMA")]
+    pub fixes: Vec<String>,
+    /// Samples of each verification run.
+    #[arg(long, default_value_t = 20_000)]
+    pub samples: usize,
+    /// Samples of the sensitivity (regression) run.
+    #[arg(long, default_value_t = 4_000)]
+    pub sensitivity_samples: usize,
+    /// Worker threads (default: all cores; results do not depend on it).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Output directory (tolerance.json, tolerance.md, allocated-job.json, plots).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// No SVG plots.
+    #[arg(long)]
+    pub no_plots: bool,
+    /// No progress on stderr.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// The exit code of a tolerance error (see the crate doc).
+pub fn exit_code(e: &ToleranceError) -> u8 {
+    match e {
+        ToleranceError::Job(truss_job::JobError::Io { .. })
+        | ToleranceError::Write { .. }
+        | ToleranceError::Plot { .. } => EXIT_IO,
+        e if e.is_usage() => EXIT_USAGE,
+        ToleranceError::FailedSamples { .. } => EXIT_SOLVE_FAILED,
+        ToleranceError::Verification { .. } => truss_exit::VERIFICATION,
+        ToleranceError::Statistics(_) => truss_exit::INTERNAL,
+        _ => EXIT_BAD_MODEL,
+    }
+}
+
+/// Runs `truss tolerance`; prints the allocation and the files written.
+pub fn run(args: &ToleranceArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let options = truss_tolerance::Options {
+        percentile: args.percentile,
+        costs: args.costs.clone(),
+        fixes: args.fixes.clone(),
+        samples: args.samples,
+        sensitivity_samples: args.sensitivity_samples,
+        plots: !args.no_plots,
+        threads: args.threads,
+        quiet: args.quiet,
+        ..truss_tolerance::Options::new(
+            args.job.clone(),
+            &args.case,
+            args.target_arcsec,
+            args.out.clone(),
+        )
+    };
+    let t = truss_tolerance::run(&options)?;
+    let (_, last, _) = t.verified_run();
+    for g in &t.groups {
+        writeln!(
+            out,
+            "{}: sigma {:.4e} mm (share {:.4}{})",
+            g.name,
+            g.sigma,
+            g.share.0,
+            if g.fixed { ", fixed" } else { "" }
+        )?;
+    }
+    writeln!(
+        out,
+        "theta_p{}: {:.4e} rad [{:.4e}, {:.4e}] over {} samples, target {:.4e} rad\nuniform_sigma: {:.4e} mm\ncost_ratio: {:.4}",
+        t.percentile,
+        last.theta,
+        last.interval.0,
+        last.interval.1,
+        last.samples,
+        t.target_rad,
+        t.uniform_sigma,
+        t.cost_ratio()
+    )?;
+    for f in &t.files {
+        writeln!(out, "wrote {}", f.display())?;
+    }
+    Ok(())
+}

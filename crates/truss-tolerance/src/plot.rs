@@ -1,0 +1,225 @@
+//! SVG plots of the variance shares:
+//!
+//! Shares span many decades (a fixed bottom batten moves nothing), so the share axes are
+//! logarithmic.
+//!
+//! - `shares-groups.svg`: each group's share of Var tan θ_x + Var tan θ_y with its 95 %
+//!   interval, and the nonlinear remainder.
+//! - `shares-members.svg`: each member's share with its interval, by stage (x axis) and
+//!   position (offset within the stage), one colour per group. Stage and position are read
+//!   from member ids of the form `GROUP.STAGE.POSITION` (the prism's `longeron.3.1`); other
+//!   ids are placed by their order within the group.
+
+use crate::errors::ToleranceError;
+use crate::study::Tolerance;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+type PlotResult = Result<(), Box<dyn std::error::Error>>;
+
+const SIZE: (u32, u32) = (960, 600);
+const FONT: &str = "sans-serif";
+
+fn palette(i: usize) -> RGBColor {
+    const C: [RGBColor; 6] = [
+        RGBColor(200, 30, 30),
+        RGBColor(30, 90, 200),
+        RGBColor(20, 140, 60),
+        RGBColor(150, 60, 170),
+        RGBColor(220, 130, 0),
+        RGBColor(0, 150, 160),
+    ];
+    C[i % C.len()]
+}
+
+fn whisker(x: f64, lo: f64, hi: f64, half: f64, c: RGBColor) -> Vec<PathElement<(f64, f64)>> {
+    vec![
+        PathElement::new(vec![(x, lo), (x, hi)], c.stroke_width(1)),
+        PathElement::new(vec![(x - half, lo), (x + half, lo)], c.stroke_width(1)),
+        PathElement::new(vec![(x - half, hi), (x + half, hi)], c.stroke_width(1)),
+    ]
+}
+
+fn groups_plot(path: &Path, t: &Tolerance) -> PlotResult {
+    let root = SVGBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE)?;
+    let nl = t.sensitivity.nonlinear;
+    let mut bars: Vec<(String, f64, (f64, f64))> = t
+        .groups
+        .iter()
+        .map(|g| (g.name.clone(), g.share.0, g.share.1))
+        .collect();
+    bars.push(("nonlinear".into(), nl.0, nl.1));
+    let values: Vec<f64> = bars.iter().flat_map(|b| [b.1, b.2.0, b.2.1]).collect();
+    let (bottom, top) = log_range(&values);
+    let n = bars.len();
+    let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("Share of the tilt's variance per group, case {}", t.case),
+            (FONT, 20),
+        )
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d(-0.5..(n as f64 - 0.5), (bottom..top).log_scale())?;
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_labels(n)
+        .x_label_formatter(&|x| {
+            let i = x.round();
+            if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
+                labels[i as usize].clone()
+            } else {
+                String::new()
+            }
+        })
+        .y_desc("share of Var tan θ_x + Var tan θ_y [-] (95 % interval, log scale)")
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .draw()?;
+    let clamp = |v: f64| v.max(bottom);
+    for (i, (_, v, (lo, hi))) in bars.iter().enumerate() {
+        let c = if i + 1 == n {
+            RGBColor(150, 150, 150)
+        } else {
+            palette(i)
+        };
+        let x = i as f64;
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(x - 0.3, bottom), (x + 0.3, clamp(*v))],
+            c.mix(0.6).filled(),
+        )))?;
+        if lo.is_finite() && hi.is_finite() {
+            chart.draw_series(whisker(x, clamp(*lo), clamp(*hi), 0.1, BLACK))?;
+        }
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// A log axis's range covering the positive `values` (a decade's margin below, 50 % above);
+/// values at or below zero are drawn at the bottom.
+fn log_range(values: &[f64]) -> (f64, f64) {
+    let positive = values.iter().filter(|v| v.is_finite() && **v > 0.0);
+    let lo = positive.clone().fold(f64::MAX, |a, &b| a.min(b));
+    let hi = positive.fold(0.0f64, |a, &b| a.max(b));
+    if hi <= 0.0 {
+        return (1e-6, 1.0);
+    }
+    (10f64.powf(lo.log10().floor()), hi * 1.5)
+}
+
+/// (stage, position) of a member id, or None.
+fn stage_position(id: &str) -> Option<(f64, f64)> {
+    let mut parts = id.split('.').skip(1);
+    let stage = parts.next()?.parse::<f64>().ok()?;
+    let position = parts.next()?.parse::<f64>().ok()?;
+    Some((stage, position))
+}
+
+fn members_plot(path: &Path, t: &Tolerance) -> PlotResult {
+    let root = SVGBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE)?;
+    let share = &t.sensitivity.fit.share;
+    let intervals = &t.sensitivity.share_interval;
+    let groups = t.groups.len().max(1) as f64;
+    // Positions per stage, for the offsets.
+    let parsed: Vec<Option<(f64, f64)>> = t.members.iter().map(|m| stage_position(&m.0)).collect();
+    let all_parsed = parsed.iter().all(Option::is_some);
+    let mut counter = vec![0usize; t.groups.len()];
+    let places: Vec<(f64, f64)> = t
+        .members
+        .iter()
+        .zip(&parsed)
+        .map(|((_, g), p)| {
+            let k = counter[*g];
+            counter[*g] += 1;
+            match (all_parsed, p) {
+                (true, Some(sp)) => *sp,
+                _ => (k as f64, 0.0),
+            }
+        })
+        .collect();
+    let positions = places.iter().map(|p| p.1).fold(0.0f64, f64::max) + 1.0;
+    let x_of = |j: usize| -> f64 {
+        let (stage, pos) = places[j];
+        let g = t.members[j].1 as f64;
+        stage + 0.8 * ((g * positions + pos + 0.5) / (groups * positions) - 0.5)
+    };
+    let (x_lo, x_hi) = places
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let values: Vec<f64> = share
+        .iter()
+        .chain(intervals.iter().flat_map(|i| [&i.0, &i.1]))
+        .copied()
+        .collect();
+    let (bottom, top) = log_range(&values);
+    let clamp = |v: f64| v.max(bottom);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("Share of the tilt's variance per member, case {}", t.case),
+            (FONT, 20),
+        )
+        .margin(14)
+        .x_label_area_size(44)
+        .y_label_area_size(64)
+        .build_cartesian_2d((x_lo - 0.6)..(x_hi + 0.6), (bottom..top).log_scale())?;
+    chart
+        .configure_mesh()
+        .x_desc(if all_parsed {
+            "stage (members of one stage side by side: by group, then position)"
+        } else {
+            "member (order within its group)"
+        })
+        .y_desc("share of Var tan θ_x + Var tan θ_y [-] (95 % interval, log scale)")
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .draw()?;
+    for (g, group) in t.groups.iter().enumerate() {
+        let c = palette(g);
+        let js: Vec<usize> = (0..t.members.len())
+            .filter(|&j| t.members[j].1 == g)
+            .collect();
+        chart
+            .draw_series(
+                js.iter()
+                    .map(|&j| Circle::new((x_of(j), clamp(share[j])), 4, c.filled())),
+            )?
+            .label(group.name.clone())
+            .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
+        for &j in &js {
+            let (lo, hi) = intervals[j];
+            if lo.is_finite() && hi.is_finite() {
+                chart.draw_series(whisker(x_of(j), clamp(lo), clamp(hi), 0.02, c))?;
+            }
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::MiddleRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
+
+/// Draws both plots into `out`; returns their paths.
+pub fn draw_all(t: &Tolerance, out: &Path) -> Result<Vec<PathBuf>, ToleranceError> {
+    let mut files = Vec::new();
+    type Draw = fn(&Path, &Tolerance) -> PlotResult;
+    let plots: [(&str, Draw); 2] = [
+        ("shares-groups.svg", groups_plot),
+        ("shares-members.svg", members_plot),
+    ];
+    for (name, draw) in plots {
+        let path = out.join(name);
+        draw(&path, t).map_err(|e| ToleranceError::Plot {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        files.push(path);
+    }
+    Ok(files)
+}

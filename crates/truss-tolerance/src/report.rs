@@ -1,0 +1,279 @@
+//! The study's files: `allocated-job.json`, `tolerance.json`, `tolerance.md` (and the plots,
+//! [`crate::plot`]).
+//!
+//! ## `tolerance.json` (σ in mm, angles in rad; arcsec only in fields named so)
+//!
+//! | field | meaning |
+//! |---|---|
+//! | `format`, `version` | `"truss-tolerance"`, 1 |
+//! | `job_id`, `case` | the input job's id and the case studied |
+//! | `target_rad`, `target_arcsec`, `percentile` | θ* and the percentile q (in %) |
+//! | `groups` | map group → `{"sigma", "share", "share_interval": [lo, hi], "members", "fixed", "input_sigma", "weight", "sensitivity" (S_g, mm⁻²), "dtheta_dsigma" (∂θ_Pq/∂σ_g at the input σ, rad/mm)}` |
+//! | `members` | per member with a length error: `{"id", "group", "share", "share_interval", "share_x", "share_y"}` |
+//! | `nonlinear_share`, `nonlinear_interval` | the variance share no linear model explains |
+//! | `input` | θ_Pq at the input σ: `{"theta_p", "interval", "samples", "model_theta_p"}` |
+//! | `uniform_sigma` | the common σ that meets the target (found as the allocation is) |
+//! | `uniform_verified` | its run: `{"theta_p", "interval", "samples"}` |
+//! | `cost`, `uniform_cost`, `cost_ratio` | `Σ w_g n_g/σ_g` \[mm⁻¹\] of the allocation and of the uniform σ, and their ratio |
+//! | `verified` | the last run: `{"theta_p", "interval", "samples", "passed"}` |
+//! | `runs` | every verification run: `{"sigma": {group: σ}, "theta_p", "interval", "model_theta_p"}` |
+//! | `isotropy` | λ₂/λ₁ of the tilt's model covariance at the allocation (1: Rayleigh) |
+//!
+//! Intervals are 95 %: Poisson bootstrap, percentile method (B = 200) for shares, BCa
+//! (B = 2000) for θ_Pq.
+
+use crate::errors::ToleranceError;
+use crate::setup::Study;
+use crate::study::Tolerance;
+use crate::{ARCSEC_PER_RAD, plot};
+use serde_json::{Map, Value, json};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+fn write(path: &Path, text: &str) -> Result<(), ToleranceError> {
+    std::fs::write(path, text).map_err(|source| ToleranceError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// A finite number, or null.
+fn num(x: f64) -> Value {
+    if x.is_finite() { json!(x) } else { Value::Null }
+}
+
+fn pair(p: (f64, f64)) -> Value {
+    json!([num(p.0), num(p.1)])
+}
+
+/// The `tolerance.json` document.
+pub fn json(t: &Tolerance) -> Value {
+    let mut groups = Map::new();
+    for g in &t.groups {
+        groups.insert(
+            g.name.clone(),
+            json!({
+                "sigma": num(g.sigma),
+                "share": num(g.share.0),
+                "share_interval": pair(g.share.1),
+                "members": g.members,
+                "fixed": g.fixed,
+                "input_sigma": num(g.input_sigma),
+                "weight": num(g.weight),
+                "sensitivity": num(g.sensitivity),
+                "dtheta_dsigma": num(g.derivative),
+            }),
+        );
+    }
+    let fit = &t.sensitivity.fit;
+    let members: Vec<Value> = t
+        .members
+        .iter()
+        .enumerate()
+        .map(|(j, (id, g))| {
+            json!({
+                "id": id,
+                "group": t.groups[*g].name,
+                "share": num(fit.share[j]),
+                "share_interval": pair(t.sensitivity.share_interval[j]),
+                "share_x": num(fit.share_x[j]),
+                "share_y": num(fit.share_y[j]),
+            })
+        })
+        .collect();
+    let runs: Vec<Value> = t
+        .runs
+        .iter()
+        .map(|(s, p, m)| {
+            let sigma: Map<String, Value> = t
+                .groups
+                .iter()
+                .zip(s)
+                .map(|(g, s)| (g.name.clone(), num(*s)))
+                .collect();
+            json!({"sigma": sigma, "theta_p": num(p.theta), "interval": pair(p.interval),
+                   "model_theta_p": num(*m)})
+        })
+        .collect();
+    let (_, last, _) = t.verified_run();
+    json!({
+        "format": "truss-tolerance",
+        "version": 1,
+        "job_id": t.job_id,
+        "case": t.case,
+        "target_rad": num(t.target_rad),
+        "target_arcsec": num(t.target_rad * ARCSEC_PER_RAD),
+        "percentile": num(t.percentile),
+        "groups": groups,
+        "members": members,
+        "nonlinear_share": num(t.sensitivity.nonlinear.0),
+        "nonlinear_interval": pair(t.sensitivity.nonlinear.1),
+        "input": {"theta_p": num(t.input.theta), "interval": pair(t.input.interval),
+                  "samples": t.input.samples, "model_theta_p": num(t.input_model)},
+        "uniform_sigma": num(t.uniform_sigma),
+        "uniform_verified": {"theta_p": num(t.uniform_run.1.theta), "interval": pair(t.uniform_run.1.interval),
+                             "samples": t.uniform_run.1.samples},
+        "cost": num(t.cost.0),
+        "uniform_cost": num(t.cost.1),
+        "cost_ratio": num(t.cost_ratio()),
+        "verified": {"theta_p": num(last.theta), "interval": pair(last.interval),
+                     "samples": last.samples, "passed": t.verified},
+        "runs": runs,
+        "isotropy": num(t.isotropy),
+    })
+}
+
+fn arcsec(x: f64) -> f64 {
+    x * ARCSEC_PER_RAD
+}
+
+/// The `tolerance.md` text.
+pub fn markdown(t: &Tolerance) -> String {
+    let mut s = String::new();
+    let q = t.percentile;
+    let (_, last, _) = t.verified_run();
+    let _ = writeln!(s, "# Tolerance allocation: case `{}`\n", t.case);
+    let _ = writeln!(
+        s,
+        "Target: θ_P{q} ≤ {:.4e} rad ({:.2}\"). Job `{}`. Units: σ in mm, angles in rad.\n",
+        t.target_rad,
+        arcsec(t.target_rad),
+        &t.job_id[..12.min(t.job_id.len())]
+    );
+    let _ = writeln!(
+        s,
+        "**Verified:** θ_P{q} = {:.4e} rad ({:.2}\"), 95 % BCa interval [{:.4e}, {:.4e}] over {} samples: {}.\n",
+        last.theta,
+        arcsec(last.theta),
+        last.interval.0,
+        last.interval.1,
+        last.samples,
+        if t.verified {
+            "meets the target at its upper bound, within 10 % of it"
+        } else {
+            "**does not verify**"
+        }
+    );
+    let _ = writeln!(s, "## Groups\n");
+    let _ = writeln!(
+        s,
+        "| group | members | input σ | share of Var tan θ [95 %] | ∂θ_P{q}/∂σ [rad/mm] | weight | allocated σ | |\n|---|---|---|---|---|---|---|---|"
+    );
+    for g in &t.groups {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.4e} | {:.4} [{:.4}, {:.4}] | {:.4e} | {} | {:.4e} | {} |",
+            g.name,
+            g.members,
+            g.input_sigma,
+            g.share.0,
+            g.share.1.0,
+            g.share.1.1,
+            g.derivative,
+            g.weight,
+            g.sigma,
+            if g.fixed { "fixed" } else { "" }
+        );
+    }
+    let nl = &t.sensitivity.nonlinear;
+    let _ = writeln!(
+        s,
+        "\nNot explained by a linear model (slack-set nonlinearity): {:.4} [{:.4}, {:.4}]. Shares: regression of the tilts of {} samples on the drawn errors; intervals: Poisson bootstrap, B = {}.\n",
+        nl.0,
+        nl.1.0,
+        nl.1.1,
+        t.sensitivity.samples,
+        crate::sensitivity::REPLICATES
+    );
+    let _ = writeln!(
+        s,
+        "## Cost\n\nCost Σ w·n/σ: allocated {:.5e}, uniform σ = {:.4e} mm {:.5e}; ratio **{:.4}** (a saving of {:.1} %).\n",
+        t.cost.0,
+        t.uniform_sigma,
+        t.cost.1,
+        t.cost_ratio(),
+        100.0 * (1.0 - t.cost_ratio())
+    );
+    let _ = writeln!(
+        s,
+        "The uniform σ, after {} run(s) (the model's value, then rescaled as the allocation is): θ_P{q} = {:.4e} [{:.4e}, {:.4e}] rad.\n",
+        t.uniform_run.0,
+        t.uniform_run.1.theta,
+        t.uniform_run.1.interval.0,
+        t.uniform_run.1.interval.1
+    );
+    let _ = writeln!(
+        s,
+        "## Runs\n\nAt the input σ: θ_P{q} = {:.4e} [{:.4e}, {:.4e}] rad (model {:.4e}). Tilt isotropy λ₂/λ₁ = {:.4} at the allocation.\n",
+        t.input.theta, t.input.interval.0, t.input.interval.1, t.input_model, t.isotropy
+    );
+    let _ = writeln!(
+        s,
+        "| run | σ per group | θ_P{q} [95 %] | model | upper / target |\n|---|---|---|---|---|"
+    );
+    for (i, (sig, p, m)) in t.runs.iter().enumerate() {
+        let sig: Vec<String> = t
+            .groups
+            .iter()
+            .zip(sig)
+            .map(|(g, v)| format!("{} {:.4e}", g.name, v))
+            .collect();
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.4e} [{:.4e}, {:.4e}] | {:.4e} | {:.4} |",
+            i + 1,
+            sig.join(", "),
+            p.theta,
+            p.interval.0,
+            p.interval.1,
+            m,
+            p.interval.1 / t.target_rad
+        );
+    }
+    let mut order: Vec<usize> = (0..t.members.len()).collect();
+    let share = &t.sensitivity.fit.share;
+    order.sort_by(|&a, &b| share[b].total_cmp(&share[a]));
+    let _ = writeln!(
+        s,
+        "\n## Members with the largest shares\n\n| member | group | share [95 %] |\n|---|---|---|"
+    );
+    for &j in order.iter().take(10) {
+        let (lo, hi) = t.sensitivity.share_interval[j];
+        let _ = writeln!(
+            s,
+            "| {} | {} | {:.4} [{:.4}, {:.4}] |",
+            t.members[j].0, t.groups[t.members[j].1].name, share[j], lo, hi
+        );
+    }
+    s
+}
+
+/// Writes every file into `out` (created if missing); returns their paths.
+pub fn write_all(
+    study: &Study,
+    t: &Tolerance,
+    out: &Path,
+    plots: bool,
+) -> Result<Vec<PathBuf>, ToleranceError> {
+    std::fs::create_dir_all(out).map_err(|source| ToleranceError::Write {
+        path: out.to_path_buf(),
+        source,
+    })?;
+    let mut files = Vec::new();
+    let (sigmas, _, _) = t.verified_run();
+    let job = out.join("allocated-job.json");
+    write(&job, &study.allocated_spec(sigmas).to_json())?;
+    files.push(job);
+    let path = out.join("tolerance.json");
+    let mut text = serde_json::to_string_pretty(&json(t)).expect("a JSON value serialises");
+    text.push('\n');
+    write(&path, &text)?;
+    files.push(path);
+    let path = out.join("tolerance.md");
+    write(&path, &markdown(t))?;
+    files.push(path);
+    if plots {
+        files.extend(plot::draw_all(t, out)?);
+    }
+    Ok(files)
+}

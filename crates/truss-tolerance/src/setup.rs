@@ -1,0 +1,296 @@
+//! The study's input: the job and case, the groups whose tolerance is allocated, the
+//! `--cost` and `--fix` values, and jobs of the same case with other σ values.
+//!
+//! A group's length error must be zero-mean and scalable: `{"normal": {"sigma": σ}}` (mean 0)
+//! or `{"uniform": {"low": −a, "high": a}}` (σ = a/√3). Changing a group's σ keeps its
+//! distribution's type: the normal gets the new σ, the uniform the half-width √3·σ. The draws
+//! of a sample are `σ·z` with `z` from the sample's stream (see `truss_job::sampler`), so two
+//! runs of the same case at different σ see the same `z`: common random numbers.
+
+use crate::errors::ToleranceError;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use truss_job::Job;
+use truss_job::distribution::DistributionSpec;
+use truss_job::job::{CaseSpec, JobSpec};
+
+/// A group whose tolerance is studied.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Group {
+    /// Group name (the model's).
+    pub name: String,
+    /// Its distribution in the input case.
+    pub distribution: DistributionSpec,
+    /// Its σ in the input case \[mm\].
+    pub sigma: f64,
+    /// Number of members in the group.
+    pub members: usize,
+    /// Cost weight `w` (default 1).
+    pub weight: f64,
+    /// The σ it is pinned at by `--fix` \[mm\], if any.
+    pub fixed: Option<f64>,
+}
+
+/// The job, the case and its groups.
+#[derive(Debug, Clone)]
+pub struct Study {
+    /// The job as read (model file paths made absolute).
+    pub spec: JobSpec,
+    /// The case's index in `spec.cases`.
+    pub case_index: usize,
+    /// The groups with length errors, by name.
+    pub groups: Vec<Group>,
+    /// Where the job file is (model paths are resolved against it).
+    pub base: PathBuf,
+}
+
+/// The distribution `d` (zero-mean normal or symmetric uniform) with standard deviation `sigma`.
+pub fn with_sigma(d: &DistributionSpec, sigma: f64) -> DistributionSpec {
+    match *d {
+        DistributionSpec::Uniform { .. } => DistributionSpec::Uniform {
+            low: -3f64.sqrt() * sigma,
+            high: 3f64.sqrt() * sigma,
+        },
+        _ => DistributionSpec::Normal { mean: 0.0, sigma },
+    }
+}
+
+/// Parses `GROUP=NUMBER` of `flag`.
+fn parse_pair(flag: &str, text: &str) -> Result<(String, f64), ToleranceError> {
+    let bad = |message: String| ToleranceError::BadValue {
+        flag: flag.to_string(),
+        message,
+    };
+    let (group, value) = text
+        .split_once('=')
+        .ok_or_else(|| bad(format!("expected GROUP=NUMBER, got {text:?}")))?;
+    let value: f64 = value
+        .trim()
+        .parse()
+        .map_err(|_| bad(format!("{group}: {value:?} is not a number")))?;
+    if !value.is_finite() {
+        return Err(bad(format!("{group}: {value} is not a finite number")));
+    }
+    Ok((group.trim().to_string(), value))
+}
+
+impl Study {
+    /// Reads the job at `path`, picks `case`, and applies the `--cost` and `--fix` values.
+    pub fn read(
+        path: &Path,
+        case: &str,
+        costs: &[String],
+        fixes: &[String],
+    ) -> Result<Self, ToleranceError> {
+        let text = std::fs::read_to_string(path).map_err(|source| truss_job::JobError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let spec = JobSpec::from_json(&text).map_err(|e| e.in_file(path))?;
+        // Validate the whole job as given (names the file and JSON path of any fault).
+        let job = Job::new(&spec, &base).map_err(|e| e.in_file(path))?;
+        Self::new(spec, &job, base, case, costs, fixes)
+    }
+
+    /// The study of `case` of a parsed and validated job.
+    pub fn new(
+        mut spec: JobSpec,
+        job: &Job,
+        base: PathBuf,
+        case: &str,
+        costs: &[String],
+        fixes: &[String],
+    ) -> Result<Self, ToleranceError> {
+        let case_index = job.case_named(case).ok_or_else(|| ToleranceError::NoCase {
+            case: case.to_string(),
+            known: job
+                .cases
+                .iter()
+                .map(|c| c.name.as_str())
+                .collect::<Vec<_>>()
+                .join(", "),
+        })?;
+        let validated = &job.cases[case_index];
+        let unsupported = |reason: &str| ToleranceError::Unsupported {
+            case: case.to_string(),
+            reason: reason.to_string(),
+        };
+        if !validated.effects.is_empty() {
+            return Err(unsupported(
+                "has effects (gravity, thermal_gradient): the tilt is then not homogeneous in \
+                 the length errors, which the allocation rests on; remove them for the study",
+            ));
+        }
+        if validated.backlash.is_some() || !validated.model.joints().is_empty() {
+            return Err(unsupported(
+                "has pin joints with clearance: the tilt is then not homogeneous in the length \
+                 errors, which the allocation rests on; study the case without backlash",
+            ));
+        }
+        if validated.length_errors.is_empty() {
+            return Err(ToleranceError::NoLengthErrors {
+                case: case.to_string(),
+            });
+        }
+        let mut groups = Vec::new();
+        for (name, d) in &validated.length_errors {
+            let not = |reason: String| ToleranceError::NotScalable {
+                case: case.to_string(),
+                group: name.clone(),
+                reason,
+            };
+            match *d {
+                DistributionSpec::Normal { mean, .. } if mean != 0.0 => {
+                    return Err(not(format!(
+                        "its length error has mean {mean} mm: a tolerance study needs zero-mean errors"
+                    )));
+                }
+                DistributionSpec::Uniform { low, high } if low != -high => {
+                    return Err(not(format!(
+                        "its uniform length error on [{low}, {high}] mm is not centred on 0: a \
+                         tolerance study needs zero-mean errors"
+                    )));
+                }
+                DistributionSpec::Constant { .. } => {
+                    return Err(not(
+                        "its length error is a constant: a tolerance study needs random errors"
+                            .into(),
+                    ));
+                }
+                _ => {}
+            }
+            let sigma = d.std_dev();
+            if sigma <= 0.0 {
+                return Err(not(
+                    "its length error has σ = 0, so its influence on the tilt cannot be \
+                     measured: give it a σ > 0 in the case (the study's starting point)"
+                        .into(),
+                ));
+            }
+            let members = validated
+                .model
+                .members()
+                .iter()
+                .filter(|m| &m.group == name)
+                .count();
+            groups.push(Group {
+                name: name.clone(),
+                distribution: *d,
+                sigma,
+                members,
+                weight: 1.0,
+                fixed: None,
+            });
+        }
+        let known = groups
+            .iter()
+            .map(|g| g.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
+        let find = |flag: &str, text: &str| -> Result<(usize, f64), ToleranceError> {
+            let (group, value) = parse_pair(flag, text)?;
+            let i = groups.iter().position(|g| g.name == group).ok_or_else(|| {
+                ToleranceError::UnknownGroup {
+                    flag: flag.to_string(),
+                    group: group.clone(),
+                    known: known.clone(),
+                }
+            })?;
+            Ok((i, value))
+        };
+        let mut weights = Vec::new();
+        for c in costs {
+            let (i, w) = find("--cost", c)?;
+            if w <= 0.0 {
+                return Err(ToleranceError::BadValue {
+                    flag: "--cost".into(),
+                    message: format!("{c}: a cost weight must be positive"),
+                });
+            }
+            weights.push((i, w));
+        }
+        let mut pins = Vec::new();
+        for f in fixes {
+            let (i, s) = find("--fix", f)?;
+            if s < 0.0 {
+                return Err(ToleranceError::BadValue {
+                    flag: "--fix".into(),
+                    message: format!("{f}: a σ must not be negative [mm]"),
+                });
+            }
+            pins.push((i, s));
+        }
+        for (i, w) in weights {
+            groups[i].weight = w;
+        }
+        for (i, s) in pins {
+            groups[i].fixed = Some(s);
+        }
+        if groups.iter().all(|g| g.fixed.is_some()) {
+            return Err(ToleranceError::BadValue {
+                flag: "--fix".into(),
+                message: "every group is fixed: there is nothing left to allocate".into(),
+            });
+        }
+        spec.model = spec.model.clone().absolute(&base);
+        for c in &mut spec.cases {
+            c.model = c.model.take().map(|m| m.absolute(&base));
+        }
+        Ok(Self {
+            spec,
+            case_index,
+            groups,
+            base,
+        })
+    }
+
+    /// The case as written.
+    pub fn case(&self) -> &CaseSpec {
+        &self.spec.cases[self.case_index]
+    }
+
+    /// The case's name.
+    pub fn case_name(&self) -> &str {
+        &self.case().name
+    }
+
+    /// The case with the groups' σ replaced by `sigmas` (mm, in group order) and `samples`
+    /// samples.
+    pub fn case_with(&self, sigmas: &[f64], samples: u64) -> CaseSpec {
+        let mut case = self.case().clone();
+        case.samples = samples;
+        case.length_errors = self
+            .groups
+            .iter()
+            .zip(sigmas)
+            .map(|(g, &s)| (g.name.clone(), with_sigma(&g.distribution, s)))
+            .collect::<BTreeMap<_, _>>();
+        case
+    }
+
+    /// A job of this one case with σ values `sigmas` (group order) and `samples` samples:
+    /// sample `k` of it draws the same `z` as sample `k` of the input case.
+    pub fn job_with(&self, sigmas: &[f64], samples: u64) -> Result<Job, ToleranceError> {
+        let spec = JobSpec {
+            model: self.spec.model.clone(),
+            seed: self.spec.seed,
+            cases: vec![self.case_with(sigmas, samples)],
+        };
+        Ok(Job::new(&spec, &self.base)?)
+    }
+
+    /// The input job with this case's σ values replaced (everything else as given; model
+    /// file paths absolute).
+    pub fn allocated_spec(&self, sigmas: &[f64]) -> JobSpec {
+        let mut spec = self.spec.clone();
+        let samples = self.case().samples;
+        spec.cases[self.case_index] = self.case_with(sigmas, samples);
+        spec
+    }
+
+    /// The input σ of every group \[mm\].
+    pub fn input_sigmas(&self) -> Vec<f64> {
+        self.groups.iter().map(|g| g.sigma).collect()
+    }
+}

@@ -1,0 +1,389 @@
+//! The whole study: sensitivity run, allocation, verification with one homogeneity rescale,
+//! the uniform σ for comparison, and the output files (see the crate doc for the method).
+
+use crate::allocate::{self, AllocationError, GroupModel};
+use crate::errors::ToleranceError;
+use crate::sensitivity::{Sensitivity, sensitivity};
+use crate::setup::Study;
+use crate::simulate::{run_case, threads};
+use crate::verify::{Percentile, percentile};
+use crate::{ARCSEC_PER_RAD, report};
+use std::path::PathBuf;
+
+/// The target's margin: the rescale aims the interval's upper end at θ*(1 − MARGIN), so that
+/// the residual non-homogeneity (see the crate doc) rarely tips a rescaled run over θ*.
+pub const MARGIN: f64 = 3e-3;
+
+/// Least share of the variance a free group must have to be allocated.
+pub const LEAST_SHARE: f64 = 1e-9;
+
+/// Verification runs at most (the first, then rescaled ones).
+const MAX_RUNS: usize = 3;
+
+/// What to study.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// The job file.
+    pub job: PathBuf,
+    /// The case's name.
+    pub case: String,
+    /// The target θ* \[arcsec\].
+    pub target_arcsec: f64,
+    /// The percentile, in % (0 < p < 100).
+    pub percentile: f64,
+    /// `GROUP=WEIGHT` cost weights.
+    pub costs: Vec<String>,
+    /// `GROUP=SIGMA` pinned σ \[mm\].
+    pub fixes: Vec<String>,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Samples of each verification run.
+    pub samples: usize,
+    /// Samples of the sensitivity run.
+    pub sensitivity_samples: usize,
+    /// Draw the SVG plots.
+    pub plots: bool,
+    /// Worker threads (None: the machine's; results do not depend on it).
+    pub threads: Option<usize>,
+    /// No progress on stderr.
+    pub quiet: bool,
+}
+
+impl Options {
+    /// Default options for a job, case, target and output directory.
+    pub fn new(job: PathBuf, case: &str, target_arcsec: f64, out: PathBuf) -> Self {
+        Self {
+            job,
+            case: case.to_string(),
+            target_arcsec,
+            percentile: 95.0,
+            costs: Vec::new(),
+            fixes: Vec::new(),
+            out,
+            samples: 20_000,
+            sensitivity_samples: 4_000,
+            plots: true,
+            threads: None,
+            quiet: true,
+        }
+    }
+}
+
+/// One group's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroupResult {
+    /// Name.
+    pub name: String,
+    /// Allocated σ \[mm\] (the pinned one if fixed).
+    pub sigma: f64,
+    /// σ in the input case \[mm\].
+    pub input_sigma: f64,
+    /// Share of the tilt's variance at the input σ, with its 95 % interval.
+    pub share: (f64, (f64, f64)),
+    /// `S_g` \[mm⁻²\]: the tilt's half-trace variance per unit σ_g².
+    pub sensitivity: f64,
+    /// `∂θ_Pq/∂σ_g` at the input σ \[rad/mm\].
+    pub derivative: f64,
+    /// Members.
+    pub members: usize,
+    /// Cost weight.
+    pub weight: f64,
+    /// Pinned by `--fix`.
+    pub fixed: bool,
+}
+
+/// The study's result.
+#[derive(Debug, Clone)]
+pub struct Tolerance {
+    /// The case.
+    pub case: String,
+    /// The input job's id.
+    pub job_id: String,
+    /// θ* \[rad\].
+    pub target_rad: f64,
+    /// The percentile in %.
+    pub percentile: f64,
+    /// Per group.
+    pub groups: Vec<GroupResult>,
+    /// Per member (with errors): id, group index, the sensitivity fit's shares.
+    pub members: Vec<(String, usize)>,
+    /// The member shares with intervals.
+    pub sensitivity: Sensitivity,
+    /// θ_Pq at the input σ, from the sensitivity run.
+    pub input: Percentile,
+    /// The model's θ_Pq at the input σ \[rad\].
+    pub input_model: f64,
+    /// The common σ meeting the target \[mm\].
+    pub uniform_sigma: f64,
+    /// The uniform σ's runs (how many) and the last one's θ_Pq.
+    pub uniform_run: (usize, Percentile),
+    /// Costs (allocated, uniform).
+    pub cost: (f64, f64),
+    /// Every verification run in order: (σ per group \[mm\], θ_Pq, model θ_Pq \[rad\]).
+    pub runs: Vec<(Vec<f64>, Percentile, f64)>,
+    /// The tilt covariance's eigenvalue ratio λ₂/λ₁ at the allocation (1: isotropic).
+    pub isotropy: f64,
+    /// Whether the last run verifies.
+    pub verified: bool,
+    /// Files written.
+    pub files: Vec<PathBuf>,
+}
+
+impl Tolerance {
+    /// The last verification run.
+    pub fn verified_run(&self) -> &(Vec<f64>, Percentile, f64) {
+        self.runs.last().expect("at least one verification run")
+    }
+
+    /// The cost ratio, allocated over uniform.
+    pub fn cost_ratio(&self) -> f64 {
+        self.cost.0 / self.cost.1
+    }
+}
+
+fn bad(flag: &str, message: String) -> ToleranceError {
+    ToleranceError::BadValue {
+        flag: flag.into(),
+        message,
+    }
+}
+
+fn say(quiet: bool, message: &str) {
+    if !quiet {
+        eprintln!("tolerance: {message}");
+    }
+}
+
+/// Runs σ values from `sigmas_for(model target)` until one verifies (at most [`MAX_RUNS`]
+/// runs): first at the target, then at `θ*(1 − MARGIN)/f` with `f` the last run's
+/// `θ_Pq,upper(MC) / θ_Pq(model)`. Returns every run: (σ, θ_Pq, model θ_Pq).
+fn meet_target(
+    target: f64,
+    models: &[GroupModel],
+    q: f64,
+    sigmas_for: impl Fn(f64) -> Result<Vec<f64>, ToleranceError>,
+    run: impl Fn(&[f64]) -> Result<Percentile, ToleranceError>,
+) -> Result<Vec<(Vec<f64>, Percentile, f64)>, ToleranceError> {
+    let aim = target * (1.0 - MARGIN);
+    let mut sigmas = sigmas_for(target)?;
+    let mut runs: Vec<(Vec<f64>, Percentile, f64)> = Vec::new();
+    loop {
+        let p = run(&sigmas)?;
+        let m = allocate::model_theta(models, &sigmas, q);
+        runs.push((sigmas.clone(), p, m));
+        if (runs.len() > 1 && p.verifies(target)) || runs.len() == MAX_RUNS {
+            return Ok(runs);
+        }
+        sigmas = sigmas_for(aim * m / p.interval.1)?;
+    }
+}
+
+/// Runs the study and writes its files (see the crate doc). Returns
+/// [`ToleranceError::Verification`] (after writing the files) if the allocation does not
+/// verify.
+pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
+    let o = options;
+    if !(o.target_arcsec.is_finite() && o.target_arcsec > 0.0 && o.target_arcsec < 324_000.0) {
+        return Err(bad(
+            "--target-arcsec",
+            format!("{} is not an angle in (0, 324000) arcsec", o.target_arcsec),
+        ));
+    }
+    if !(o.percentile.is_finite() && o.percentile > 0.0 && o.percentile < 100.0) {
+        return Err(bad(
+            "--percentile",
+            format!("{} is not a percentage in (0, 100)", o.percentile),
+        ));
+    }
+    if o.samples < 1000 {
+        return Err(bad(
+            "--samples",
+            format!("{} verification samples: need at least 1000", o.samples),
+        ));
+    }
+    let study = Study::read(&o.job, &o.case, &o.costs, &o.fixes)?;
+    let job_id = truss_job::Job::new(&study.spec, &study.base)?.id;
+    let target = o.target_arcsec / ARCSEC_PER_RAD;
+    let q = o.percentile / 100.0;
+    let threads = o.threads.unwrap_or_else(threads).max(1);
+    let seed = study.spec.seed;
+
+    // 1. Sensitivity at the input σ.
+    let input_sigmas = study.input_sigmas();
+    let probe = study.job_with(&input_sigmas, 1)?;
+    let model = probe.cases[0].model.clone();
+    let names: Vec<&str> = study.groups.iter().map(|g| g.name.as_str()).collect();
+    let (columns, group_of): (Vec<usize>, Vec<usize>) = model
+        .members()
+        .iter()
+        .enumerate()
+        .filter_map(|(i, m)| names.iter().position(|n| *n == m.group).map(|g| (i, g)))
+        .unzip();
+    let least = 10 * (columns.len() + 1);
+    if o.sensitivity_samples < least.max(1000) {
+        return Err(bad(
+            "--sensitivity-samples",
+            format!(
+                "{} samples: the regression on {} members needs at least {}",
+                o.sensitivity_samples,
+                columns.len(),
+                least.max(1000)
+            ),
+        ));
+    }
+    say(
+        o.quiet,
+        &format!(
+            "sensitivity: {} samples of case {:?}",
+            o.sensitivity_samples, o.case
+        ),
+    );
+    let sens_job = study.job_with(&input_sigmas, o.sensitivity_samples as u64)?;
+    let sens_run = run_case(&sens_job, &columns, threads, "sensitivity")?;
+    let column_sigma: Vec<f64> = group_of.iter().map(|&g| input_sigmas[g]).collect();
+    let sens = sensitivity(
+        &sens_run,
+        &column_sigma,
+        &group_of,
+        study.groups.len(),
+        seed,
+        threads,
+    )?;
+    let input = percentile(&sens_run.theta_p, q, seed, threads)?;
+
+    // 2. The groups' model, derivatives, allocation.
+    let mut models: Vec<GroupModel> = study
+        .groups
+        .iter()
+        .map(|g| GroupModel {
+            covariance: [0.0; 3],
+            members: g.members,
+            weight: g.weight,
+            fixed: g.fixed,
+        })
+        .collect();
+    for (j, &g) in group_of.iter().enumerate() {
+        for k in 0..3 {
+            models[g].covariance[k] += sens.fit.covariance[j][k];
+        }
+    }
+    for ((g, m), &(share, _)) in study.groups.iter().zip(&models).zip(&sens.group_share) {
+        if m.fixed.is_none() && (share < LEAST_SHARE || m.sensitivity() <= 0.0) {
+            return Err(ToleranceError::ZeroSensitivity {
+                group: g.name.clone(),
+                share,
+            });
+        }
+    }
+    let input_model = allocate::model_theta(&models, &input_sigmas, q);
+    let calibration = input.theta / input_model;
+    let derivative = |g: usize| {
+        let h = 1e-4 * input_sigmas[g];
+        let mut up = input_sigmas.clone();
+        let mut down = input_sigmas.clone();
+        up[g] += h;
+        down[g] -= h;
+        calibration
+            * (allocate::model_theta(&models, &up, q) - allocate::model_theta(&models, &down, q))
+            / (2.0 * h)
+    };
+    let unreachable = |theta_fixed: f64| {
+        let fixed: Vec<&str> = study
+            .groups
+            .iter()
+            .filter(|g| g.fixed.is_some())
+            .map(|g| g.name.as_str())
+            .collect();
+        ToleranceError::Unreachable {
+            groups: fixed.join(", "),
+            percentile: o.percentile,
+            theta_fixed,
+            arcsec: theta_fixed * ARCSEC_PER_RAD,
+            target,
+        }
+    };
+    let allocate_for = |model_target: f64| {
+        allocate::allocate(&models, model_target, q).map_err(|e| match e {
+            AllocationError::Unreachable { theta_fixed } => {
+                // Said in measured terms: the model's value times the calibration.
+                unreachable(theta_fixed * target / model_target)
+            }
+        })
+    };
+
+    // 3. Verification, with the homogeneity rescale; 4. the uniform σ the same way.
+    let verify_run = |stage: &'static str, sigmas: &[f64]| -> Result<Percentile, ToleranceError> {
+        say(o.quiet, &format!("{stage} run: {} samples", o.samples));
+        let job = study.job_with(sigmas, o.samples as u64)?;
+        let r = run_case(&job, &[], threads, stage)?;
+        percentile(&r.theta_p, q, seed, threads)
+    };
+    let runs = meet_target(target, &models, q, allocate_for, |s| {
+        verify_run("verification", s)
+    })?;
+    let (last_sigmas, last, _) = runs.last().expect("one run").clone();
+    let (l1, l2) = crate::percentile::eigenvalues(&allocate::covariance(&models, &last_sigmas));
+    let isotropy = if l1 > 0.0 { l2 / l1 } else { 1.0 };
+    let uniform_runs = meet_target(
+        target,
+        &models,
+        q,
+        |t| Ok(vec![allocate::uniform(&models, t, q); models.len()]),
+        |s| verify_run("uniform", s),
+    )?;
+    let (u_sigmas, u_p, _) = uniform_runs.last().expect("one run").clone();
+    let uniform_sigma = u_sigmas[0];
+    let uniform_cost = allocate::cost(&models, &u_sigmas);
+    let cost = (allocate::cost(&models, &last_sigmas), uniform_cost);
+
+    let groups = study
+        .groups
+        .iter()
+        .enumerate()
+        .map(|(g, s)| GroupResult {
+            name: s.name.clone(),
+            sigma: last_sigmas[g],
+            input_sigma: s.sigma,
+            share: sens.group_share[g],
+            sensitivity: models[g].sensitivity(),
+            derivative: derivative(g),
+            members: s.members,
+            weight: s.weight,
+            fixed: s.fixed.is_some(),
+        })
+        .collect();
+    let members = columns
+        .iter()
+        .zip(&group_of)
+        .map(|(&i, &g)| (model.members()[i].id.clone(), g))
+        .collect();
+    let mut result = Tolerance {
+        case: o.case.clone(),
+        job_id,
+        target_rad: target,
+        percentile: o.percentile,
+        groups,
+        members,
+        sensitivity: sens,
+        input,
+        input_model,
+        uniform_sigma,
+        uniform_run: (uniform_runs.len(), u_p),
+        cost,
+        runs,
+        isotropy,
+        verified: last.verifies(target),
+        files: Vec::new(),
+    };
+    result.files = report::write_all(&study, &result, &o.out, o.plots)?;
+    if !result.verified {
+        return Err(ToleranceError::Verification {
+            percentile: o.percentile,
+            theta: last.theta,
+            lower: last.interval.0,
+            upper: last.interval.1,
+            target,
+        });
+    }
+    Ok(result)
+}
