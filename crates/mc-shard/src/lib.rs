@@ -18,7 +18,7 @@
 //!
 //! ## Commands (see `mc-shard --help`)
 //!
-//! - `mc-shard plan JOB.json` — job id, cases, sample count, an estimate of the CPU time and
+//! - `mc-shard plan --job JOB.json` — job id, cases, sample count, an estimate of the CPU time and
 //!   a suggestion: this machine, and a cluster split only for a job of more than ten minutes.
 //! - `mc-shard run --job JOB.json --out DIR [--shard I/K | --range A..B] [--threads T]` —
 //!   one shard (selection in [`select`]); crash-safe and resumable ([`shard`]).
@@ -41,8 +41,10 @@
 //! (another job's, locked by another process, or damaged), 130 / 143 `run` or `work`
 //! stopped by SIGINT / SIGTERM, every finished sample kept ([`interrupt`]).
 
+pub mod audit;
 pub mod cli;
 pub mod errors;
+pub mod inputs;
 pub mod interrupt;
 pub mod progress;
 pub mod reproduce;
