@@ -166,6 +166,15 @@ impl ShardWriter {
         self.encoder.failed()
     }
 
+    /// Ends an interrupted file: a stop checkpoint (so a rerun keeps every line written;
+    /// see [`shard_record`]'s format) and a sync to disk.
+    pub fn stop(&mut self) -> Result<(), ShardError> {
+        if let Some(line) = self.encoder.stop_checkpoint() {
+            self.write_raw(&line)?;
+        }
+        self.sync()
+    }
+
     /// Syncs the lines written so far to disk (before stopping without the end line).
     pub fn sync(&self) -> Result<(), ShardError> {
         self.file.sync_all().map_err(|source| ShardError::Io {

@@ -62,6 +62,23 @@ impl ShardEncoder {
         }
     }
 
+    /// The bytes of a *stop checkpoint* for an incomplete file's last line, when lines
+    /// follow the last scheduled checkpoint: it verifies them, so a resume keeps them (and
+    /// cuts the stop checkpoint off). `None` when no line is unverified.
+    pub fn stop_checkpoint(&self) -> Option<Vec<u8>> {
+        let every = self.every?;
+        let samples = self.digest.samples();
+        if samples.is_multiple_of(every) {
+            return None;
+        }
+        let checkpoint = Checkpoint {
+            samples,
+            sha256: self.digest.sha256(),
+            begin_sha256: self.begin_sha256.clone(),
+        };
+        Some(to_line(&Record::Checkpoint(checkpoint)).into_bytes())
+    }
+
     /// The end record and its line's bytes.
     pub fn end(&self) -> (End, Vec<u8>) {
         let mut end = self.digest.end();

@@ -38,6 +38,11 @@
 //!    ([`Checkpoint`]): `samples` (the sample lines so far), `sha256` (the SHA-256 of the
 //!    exact bytes of those sample lines in file order, each with its `\n`) and `begin_sha256`
 //!    (the SHA-256 of the begin line's bytes with its `\n`).
+//!
+//!    A writer that stops on purpose (SIGINT, SIGTERM) may end an incomplete file with one
+//!    more checkpoint line off that schedule, a *stop checkpoint*, covering every sample
+//!    line written. It is only valid as the file's last line; a writer resuming the file
+//!    cuts it off (the finished file has only the scheduled checkpoints).
 //! 4. One `end` line ([`End`]): `samples` (the number of sample lines), `failed` (how many of
 //!    them failed), `sha256` (as a checkpoint's, over all sample lines; checkpoint lines are
 //!    not hashed) and `begin_sha256`.
@@ -70,7 +75,8 @@
 //!   N − 1, or N when the writer stopped just before the checkpoint line) cannot be told from
 //!   edited ones; they are counted in [`ShardScan::unverified`] and a writer resuming the file
 //!   cuts them off and solves them again. Resuming therefore costs one read of the file
-//!   (SHA-256) and at most N samples' solves.
+//!   (SHA-256) and, after a crash, at most N samples' solves; after a stop on a signal
+//!   (a stop checkpoint), none.
 //! - Nothing checks that the numbers are the *right* ones for the job: a shard rewritten
 //!   with fresh digests verifies. That is what `mc-shard audit` is for: it re-solves a seeded
 //!   random sample of lines and compares them byte for byte.

@@ -205,7 +205,9 @@ pub fn scan_shard(
                 }
             }
             Record::Checkpoint(checkpoint) => {
-                if !due {
+                // Off schedule, a checkpoint may only be the last line: a stop checkpoint.
+                let stop = !due && every.is_some() && read > last_checkpoint;
+                if !due && !stop {
                     return Err(corrupt(
                         line_no,
                         format!(
@@ -228,6 +230,22 @@ pub fn scan_shard(
                     visit(at, &sample, &bytes).map_err(|m| corrupt(at, m))?;
                 }
                 digest = pending_digest.clone();
+                if stop {
+                    // The verified prefix ends before the stop checkpoint, which a resuming
+                    // writer cuts off so the finished file has only scheduled checkpoints.
+                    valid_len += pending_len;
+                    buf.clear();
+                    if reader.read_until(b'\n', &mut buf).map_err(io_err)? != 0 {
+                        return Err(corrupt(
+                            line_no,
+                            format!(
+                                "a checkpoint line after sample line {read} is neither due (checkpoint_every {}) nor the last line",
+                                every.unwrap_or(0)
+                            ),
+                        ));
+                    }
+                    return Ok(open(begin, digest, valid_len, 0, Tail::Open));
+                }
                 valid_len += pending_len + n as u64;
                 pending_len = 0;
                 last_checkpoint = read;

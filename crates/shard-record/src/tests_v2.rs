@@ -217,3 +217,42 @@ fn version_checks_of_the_header() {
     assert!(v1.check().is_ok());
     assert!(b.same_shard(&v1));
 }
+
+#[test]
+fn a_stop_checkpoint_verifies_every_line_and_is_cut_off_on_resume() {
+    let range = ShardRange::new(0, 10);
+    let (mut encoder, mut bytes) = ShardEncoder::new(&begin(range));
+    for i in 0..6 {
+        let s = sample(i);
+        encoder.push(
+            s.to_line().as_bytes(),
+            s.status == Status::Failed,
+            &mut bytes,
+        );
+    }
+    let kept = bytes.len() as u64;
+    bytes.extend_from_slice(&encoder.stop_checkpoint().unwrap());
+    let f = write_temp(std::str::from_utf8(&bytes).unwrap());
+    let scan = scan_shard(f.path(), |_, _, _| Ok(())).unwrap();
+    assert_eq!((scan.digest.samples(), scan.unverified), (6, 0));
+    assert_eq!(scan.valid_len, kept, "the stop checkpoint is not kept");
+    // Resumed from there, the file is the uninterrupted one.
+    let mut resumed = bytes[..kept as usize].to_vec();
+    let mut encoder = ShardEncoder::resume(&scan);
+    for i in 6..10 {
+        let s = sample(i);
+        encoder.push(s.to_line().as_bytes(), false, &mut resumed);
+    }
+    resumed.extend_from_slice(&encoder.end().1);
+    assert_eq!(String::from_utf8(resumed).unwrap(), shard_text(range));
+    // Anywhere but last, an off-schedule checkpoint is refused; a stale one is too.
+    let mut more = bytes.clone();
+    more.extend_from_slice(sample(6).to_line().as_bytes());
+    let f = write_temp(std::str::from_utf8(&more).unwrap());
+    let err = scan_shard(f.path(), |_, _, _| Ok(())).unwrap_err();
+    assert!(err.to_string().contains("nor the last line"), "{err}");
+    let text = String::from_utf8(bytes).unwrap();
+    let edited = text.replacen("\"iterations\":3", "\"iterations\":4", 1);
+    let f = write_temp(&edited);
+    assert!(scan_shard(f.path(), |_, _, _| Ok(())).is_err());
+}

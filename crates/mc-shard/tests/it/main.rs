@@ -7,5 +7,7 @@ mod common;
 mod determinism;
 mod interrupt;
 mod job;
+mod pool;
 mod sampling;
+mod verify;
 mod work;
