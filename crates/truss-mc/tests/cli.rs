@@ -123,24 +123,52 @@ fn run_all_exit_codes() {
     assert_eq!(r.status.code(), Some(5), "{stderr}");
     assert!(stderr.contains("shard 0/2"), "{stderr}");
     assert!(stderr.contains("move it away"), "{stderr}");
-    assert!(!stderr.contains("run the same command again to resume them"), "{stderr}");
+    assert!(
+        !stderr.contains("run the same command again to resume them"),
+        "{stderr}"
+    );
     assert_eq!(sample_lines(&out).len(), 10, "the other shard completed");
 
     // Another job's shards in the directory: 5 and the same advice.
     let other = dir.path().join("other");
-    let job2 = write(dir.path(), "job2.json", &small_job(10).replace("\"seed\": 7", "\"seed\": 8"));
+    let job2 = write(
+        dir.path(),
+        "job2.json",
+        &small_job(10).replace("\"seed\": 7", "\"seed\": 8"),
+    );
     let r = truss_mc(
-        &["run", "--job", job2.to_str().unwrap(), "-o", other.to_str().unwrap(), "--shard", "0/2", "-q"],
+        &[
+            "run",
+            "--job",
+            job2.to_str().unwrap(),
+            "-o",
+            other.to_str().unwrap(),
+            "--shard",
+            "0/2",
+            "-q",
+        ],
         &[],
     );
     assert!(r.status.success());
     let r = truss_mc(
-        &["run-all", "--job", job.to_str().unwrap(), "-o", other.to_str().unwrap(), "--shards", "2", "-q"],
+        &[
+            "run-all",
+            "--job",
+            job.to_str().unwrap(),
+            "-o",
+            other.to_str().unwrap(),
+            "--shards",
+            "2",
+            "-q",
+        ],
         &[],
     );
     let stderr = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(5), "{stderr}");
-    assert!(stderr.contains("holds a shard of job") && stderr.contains("move it away"), "{stderr}");
+    assert!(
+        stderr.contains("holds a shard of job") && stderr.contains("move it away"),
+        "{stderr}"
+    );
 }
 
 /// Failed samples: the merge's code 7 with advice `run-all` accepts (`--allow-failed`),
@@ -183,7 +211,10 @@ fn run_all_failed_samples_advice_and_audit() {
     let r = base(&["--audit-samples", "40"]);
     let stderr = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(6), "{stderr}");
-    assert!(stderr.contains("index 3 (case \"normal\", sample 3)"), "{stderr}");
+    assert!(
+        stderr.contains("index 3 (case \"normal\", sample 3)"),
+        "{stderr}"
+    );
     let r = base(&["--audit-samples", "0"]);
     let stderr = String::from_utf8_lossy(&r.stderr);
     assert_eq!(r.status.code(), Some(7), "{stderr}");
@@ -201,7 +232,10 @@ fn truss_mc_completions_and_man() {
     assert!(String::from_utf8_lossy(&r.stdout).contains("run-all"));
     let r = truss_mc(&["man"], &[]);
     let text = String::from_utf8_lossy(&r.stdout);
-    assert!(text.contains(".TH truss-mc-run-all") && text.contains("audit"), "{text}");
+    assert!(
+        text.contains(".TH truss-mc-run-all") && text.contains("audit"),
+        "{text}"
+    );
 }
 
 /// The pids whose parent is `pid` (from /proc).

@@ -9,5 +9,6 @@ mod interrupt;
 mod job;
 mod pool;
 mod sampling;
+mod schema;
 mod verify;
 mod work;
