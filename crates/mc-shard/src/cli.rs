@@ -62,6 +62,20 @@ pub const MAX_SHARDS: u64 = 1_000_000;
 /// The longest `--heartbeat` or `--stale-after` \[s\]: one week.
 pub const MAX_SECONDS: f64 = 7.0 * 24.0 * 3600.0;
 
+/// The most threads (or `run-all` workers) a command starts.
+pub const MAX_THREADS: usize = 1024;
+
+/// Checks a thread or worker count given as `--NAME` (1 to [`MAX_THREADS`]).
+pub fn check_threads(name: &str, threads: usize) -> Result<usize, RunError> {
+    if (1..=MAX_THREADS).contains(&threads) {
+        Ok(threads)
+    } else {
+        Err(RunError::Usage(format!(
+            "--{name} must be 1 to {MAX_THREADS}, not {threads}"
+        )))
+    }
+}
+
 /// Checks a shard count given as `--shards` (1 to [`MAX_SHARDS`]).
 pub fn check_shards(shards: u64) -> Result<u64, RunError> {
     if (1..=MAX_SHARDS).contains(&shards) {
@@ -328,11 +342,12 @@ pub fn man_page(cmd: clap::Command, out: &mut dyn Write) -> Result<(), CliError>
 
 /// `mc-shard audit`: re-solve a seeded sample of lines; exit 6 on a mismatch.
 fn audit_command(a: AuditArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let threads = check_threads("threads", a.threads.unwrap_or_else(default_threads))?;
     let job = Job::read(&a.job)?;
     let options = crate::audit::AuditOptions {
         samples: a.samples,
         seed: a.seed,
-        threads: a.threads.unwrap_or_else(default_threads).max(1),
+        threads,
     };
     let report = crate::audit::audit(&job, &a.paths, &options)?;
     audit_result(&report, out)
@@ -415,9 +430,7 @@ fn run_command(a: RunArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let threads = a
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    if threads == 0 {
-        return Err(RunError::Usage("--threads must be at least 1".into()).into());
-    }
+    check_threads("threads", threads)?;
     crate::interrupt::install()?;
     let summary = run_shard(
         &job,
@@ -505,10 +518,7 @@ fn work_command(a: WorkArgs, out: &mut dyn Write) -> Result<(), CliError> {
         ))
         .into());
     }
-    let threads = a.threads.unwrap_or_else(default_threads);
-    if threads == 0 {
-        return Err(RunError::Usage("--threads must be at least 1".into()).into());
-    }
+    let threads = check_threads("threads", a.threads.unwrap_or_else(default_threads))?;
     let job = Job::read(&a.job)?;
     let options = crate::work::WorkOptions {
         shards: a.shards,

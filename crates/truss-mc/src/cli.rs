@@ -113,10 +113,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
         Command::Shard(command) => Ok(mc_shard::cli::run(mc_shard::cli::Cli { command }, out)?),
         Command::RunAll(a) => {
             let workers = a.workers.unwrap_or_else(default_threads);
-            if workers == 0 {
-                let usage = RunError::Usage("--workers must be at least 1".into());
-                return Err(CliError::Run(usage).into());
-            }
+            mc_shard::cli::check_threads("workers", workers).map_err(CliError::from)?;
             if let Some(k) = a.shards {
                 mc_shard::cli::check_shards(k).map_err(CliError::from)?;
             }

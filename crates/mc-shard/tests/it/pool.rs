@@ -2,7 +2,7 @@
 //! real worker processes (real claims, real file locks) complete the others; the worker
 //! exits 5 at the end, `status` lists the quarantined shard, a later worker skips it, and a
 //! worker with another `--shards` count on the directory is refused. Also the bounds of
-//! `work`'s flags.
+//! `work`'s and `run`'s flags.
 
 use crate::common::*;
 use std::path::Path;
@@ -177,6 +177,17 @@ fn a_worker_refuses_a_directory_of_another_split_and_absurd_durations() {
         assert!(stderr.contains(flag), "{stderr}");
     }
     assert_eq!(work(&job, &out, "0", &[]).status.code(), Some(2));
+    let o = mc_shard(&[
+        "run",
+        "--job",
+        job.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--threads",
+        "5000",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--threads must be 1 to 1024"));
 }
 
 /// `inputs` writes the draws `reproduce --detail` shows, keyed by index, at full precision.
