@@ -49,6 +49,10 @@ pub fn shard_states(
                     ),
                     Ok(scan) => match scan.tail {
                         Tail::Complete(_) => ShardState::Complete,
+                        _ if scan.begin.checkpoint_every.is_none() => ShardState::Bad(format!(
+                            "an incomplete shard of format version {} (no checkpoints): it is not resumed",
+                            scan.begin.format_version
+                        )),
                         _ => ShardState::Partial(scan.digest.samples()),
                     },
                 }

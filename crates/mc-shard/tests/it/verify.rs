@@ -189,3 +189,52 @@ fn audit_replays_a_seeded_sample_and_names_a_forged_line() {
     assert_eq!(audit("0", "1").status.code(), Some(2));
     assert_eq!(audit("1000001", "1").status.code(), Some(2));
 }
+
+/// An incomplete shard of format version 1 (no checkpoints: its lines cannot be verified)
+/// is not resumed (5) and `status` says why; a complete one whose header matches the job is
+/// still accepted as complete.
+#[test]
+fn a_version_1_partial_shard_is_not_resumed() {
+    let dir = tempfile::tempdir().unwrap();
+    let job_path = write(dir.path(), "job.json", &job_text());
+    let job = mc_shard::Job::read(&job_path).unwrap();
+    let out = dir.path().join("s");
+    assert!(run(&job_path, &out).status.success());
+    let path = only_shard(&out);
+    let whole = std::fs::read_to_string(&path).unwrap();
+    let samples: Vec<&str> = whole
+        .split_inclusive('\n')
+        .filter(|l| l.starts_with(r#"{"record":"sample""#))
+        .collect();
+    let range = shard_record::ShardRange::new(0, 300);
+    let mut v1 = mc_shard::shard::begin(&job, range);
+    (v1.format_version, v1.checkpoint_every) = (1, None);
+    let header = shard_record::to_line(&shard_record::Record::Begin(v1));
+    std::fs::write(&path, format!("{header}{}", samples[..5].concat())).unwrap();
+    let o = run(&job_path, &out);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(5), "{stderr}");
+    assert!(stderr.contains("format version 1"), "{stderr}");
+    let o = mc_shard(&[
+        "status",
+        "--job",
+        job_path.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--shards",
+        "1",
+    ]);
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("bad: an incomplete shard of format version 1")
+    );
+    // Complete in version 1 (its end line's digest covers the samples): accepted as is.
+    let mut digest = shard_record::SampleDigest::new();
+    for l in &samples {
+        digest.add_line(l.as_bytes(), false);
+    }
+    let end = shard_record::to_line(&shard_record::Record::End(digest.end()));
+    std::fs::write(&path, format!("{header}{}{end}", samples.concat())).unwrap();
+    let o = run(&job_path, &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("already complete and verified"));
+}
