@@ -42,8 +42,94 @@ pub enum Command {
     /// Show which of K shards in a directory are complete, partial or missing.
     Status(StatusArgs),
     /// Claim the next unclaimed shard, run it, and repeat until none is left (for cron on
-    /// machines sharing the directory).
+    /// machines sharing the directory); a damaged shard is quarantined and the others run.
     Work(WorkArgs),
+    /// Re-solve a seeded random sample of a run's lines and compare them byte for byte;
+    /// writes audit.json beside the shards.
+    Audit(AuditArgs),
+    /// Write each sample's drawn member length errors and joint clearances (mm) as CSV,
+    /// regenerated from the seed and keyed by the shard lines' index.
+    Inputs(InputsArgs),
+    /// Print a shell completion script (bash, zsh or fish) to stdout.
+    Completions(CompletionsArgs),
+    /// Print the man page (roff) to stdout.
+    Man,
+}
+
+/// The largest `--shards` count: each shard is a file (and for `run-all` a process).
+pub const MAX_SHARDS: u64 = 1_000_000;
+
+/// The longest `--heartbeat` or `--stale-after` \[s\]: one week.
+pub const MAX_SECONDS: f64 = 7.0 * 24.0 * 3600.0;
+
+/// The most threads (or `run-all` workers) a command starts.
+pub const MAX_THREADS: usize = 1024;
+
+/// Checks a thread or worker count given as `--NAME` (1 to [`MAX_THREADS`]).
+pub fn check_threads(name: &str, threads: usize) -> Result<usize, RunError> {
+    if (1..=MAX_THREADS).contains(&threads) {
+        Ok(threads)
+    } else {
+        Err(RunError::Usage(format!(
+            "--{name} must be 1 to {MAX_THREADS}, not {threads}"
+        )))
+    }
+}
+
+/// Checks a shard count given as `--shards` (1 to [`MAX_SHARDS`]).
+pub fn check_shards(shards: u64) -> Result<u64, RunError> {
+    if (1..=MAX_SHARDS).contains(&shards) {
+        Ok(shards)
+    } else {
+        Err(RunError::Usage(format!(
+            "--shards must be 1 to {MAX_SHARDS}, not {shards}"
+        )))
+    }
+}
+
+/// `mc-shard audit`.
+#[derive(Debug, Args)]
+pub struct AuditArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// Shard directories or files.
+    #[arg(required = true, value_name = "DIR_OR_FILE")]
+    pub paths: Vec<PathBuf>,
+    /// Sample lines to re-solve (at most 1,000,000).
+    #[arg(long, default_value_t = 100)]
+    pub samples: u64,
+    /// Seed of the random choice of lines (the same seed and files give the same choice).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+/// `mc-shard inputs`.
+#[derive(Debug, Args)]
+pub struct InputsArgs {
+    /// The job file.
+    #[arg(long)]
+    pub job: PathBuf,
+    /// Only this case's samples.
+    #[arg(long)]
+    pub case: Option<String>,
+    /// Only the global sample indices A..B.
+    #[arg(long, value_name = "A..B")]
+    pub range: Option<String>,
+    /// The CSV file to write.
+    #[arg(long, short = 'o')]
+    pub out: PathBuf,
+}
+
+/// `mc-shard completions`.
+#[derive(Debug, Args)]
+pub struct CompletionsArgs {
+    /// The shell.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
 }
 
 /// `mc-shard work`.
@@ -53,7 +139,7 @@ pub struct WorkArgs {
     #[arg(long)]
     pub job: PathBuf,
     /// The shared shard directory.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     pub out: PathBuf,
     /// The number of shards the job is split into (the same for every worker).
     #[arg(long)]
@@ -61,14 +147,15 @@ pub struct WorkArgs {
     /// Threads per shard (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Seconds between heartbeats of a claim.
+    /// Seconds between heartbeats of a claim (more than 0, at most a week, less than
+    /// --stale-after).
     #[arg(long, default_value_t = 5.0)]
     pub heartbeat: f64,
-    /// Seconds after which an untouched claim is stale and taken over.
+    /// Seconds after which an untouched claim is stale and taken over (at most a week).
     #[arg(long, default_value_t = 60.0)]
     pub stale_after: f64,
     /// Show no progress.
-    #[arg(long)]
+    #[arg(long, short = 'q')]
     pub quiet: bool,
 }
 
@@ -76,6 +163,7 @@ pub struct WorkArgs {
 #[derive(Debug, Args)]
 pub struct PlanArgs {
     /// The job file.
+    #[arg(long)]
     pub job: PathBuf,
     /// Print JSON instead of text.
     #[arg(long)]
@@ -89,7 +177,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub job: PathBuf,
     /// Directory for the shard file.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     pub out: PathBuf,
     /// Run shard I of K (0-based).
     #[arg(long, value_name = "I/K", conflicts_with = "range")]
@@ -104,7 +192,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub threads: Option<usize>,
     /// Show no progress.
-    #[arg(long)]
+    #[arg(long, short = 'q')]
     pub quiet: bool,
 }
 
@@ -132,15 +220,18 @@ pub struct StatusArgs {
     #[arg(long)]
     pub job: PathBuf,
     /// The shard directory.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     pub out: PathBuf,
     /// The number of shards the job was split into.
     #[arg(long)]
     pub shards: u64,
     /// Print only the 0-based indices of the shards not complete, comma-separated (a Slurm
     /// --array list; an empty line when none).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "json")]
     pub missing: bool,
+    /// Print JSON: one object per shard (`shard`, `range`, `state`, `samples`, `reason`).
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// An error of a command, with its exit code.
@@ -152,6 +243,27 @@ pub enum CliError {
     /// Writing output failed.
     #[error("cannot write output: {0}")]
     Output(#[from] std::io::Error),
+    /// An audit could not be completed.
+    #[error(transparent)]
+    Audit(#[from] crate::audit::AuditError),
+    /// An audit found lines that differ from their re-solve.
+    #[error("audit: {} of {checked} re-solved lines differ from the shards (verification failed; details in {}): {}", .mismatches.len(), .report.display(), .mismatches.iter().take(5).map(|m| format!("{}:{}: index {} (case {:?}, sample {})", m.file.display(), m.line, m.index, m.case, m.sample)).collect::<Vec<_>>().join("; "))]
+    AuditMismatch {
+        /// The lines that differ.
+        mismatches: Vec<crate::audit::Mismatch>,
+        /// Lines compared.
+        checked: u64,
+        /// The audit.json written.
+        report: PathBuf,
+    },
+    /// Workers set shards aside as damaged; the other shards ran.
+    #[error("{} shard(s) quarantined as damaged (the other shards ran): {}; move each file away (or repair it), delete its marker in {}, and run again", .shards.len(), .shards.iter().map(|(i, why)| format!("shard {i}: {why}")).collect::<Vec<_>>().join("; "), .dir.display())]
+    Quarantined {
+        /// Each quarantined shard with its reason.
+        shards: Vec<(u64, String)>,
+        /// The quarantine directory.
+        dir: PathBuf,
+    },
     /// Stopped by SIGINT or SIGTERM; `kept` sample lines are in the shard files.
     #[error("{}", crate::interrupt::message(*.kept))]
     Interrupted {
@@ -174,6 +286,9 @@ impl CliError {
         match self {
             CliError::Run(e) => run_exit_code(e),
             CliError::Output(_) => exit::IO,
+            CliError::Audit(e) => e.exit_code(),
+            CliError::AuditMismatch { .. } => exit::VERIFICATION,
+            CliError::Quarantined { .. } => exit::IN_THE_WAY,
             CliError::Interrupted { signal, .. } => signal.exit_code(),
         }
     }
@@ -203,7 +318,103 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Reproduce(a) => reproduce_command(a, out),
         Command::Work(a) => work_command(a, out),
         Command::Status(a) => status_command(a, out),
+        Command::Audit(a) => audit_command(a, out),
+        Command::Inputs(a) => inputs_command(a, out),
+        Command::Completions(a) => {
+            let mut cmd = <Cli as clap::CommandFactory>::command();
+            clap_complete::generate(a.shell, &mut cmd, "mc-shard", out);
+            Ok(())
+        }
+        Command::Man => man_page(<Cli as clap::CommandFactory>::command(), out),
     }
+}
+
+/// Writes `cmd`'s man page (roff), with a section per subcommand, to `out`.
+pub fn man_page(cmd: clap::Command, out: &mut dyn Write) -> Result<(), CliError> {
+    let cmd = cmd.after_help(truss_exit::SUMMARY);
+    clap_mangen::Man::new(cmd.clone()).render(out)?;
+    for sub in cmd.get_subcommands() {
+        let name = format!("{}-{}", cmd.get_name(), sub.get_name());
+        clap_mangen::Man::new(sub.clone()).title(name).render(out)?;
+    }
+    Ok(())
+}
+
+/// `mc-shard audit`: re-solve a seeded sample of lines; exit 6 on a mismatch.
+fn audit_command(a: AuditArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let threads = check_threads("threads", a.threads.unwrap_or_else(default_threads))?;
+    let job = Job::read(&a.job)?;
+    let options = crate::audit::AuditOptions {
+        samples: a.samples,
+        seed: a.seed,
+        threads,
+    };
+    let report = crate::audit::audit(&job, &a.paths, &options)?;
+    audit_result(&report, out)
+}
+
+/// Prints an audit's summary line; a mismatch is an error (exit 6).
+pub fn audit_result(
+    report: &crate::audit::AuditReport,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    if !report.mismatches.is_empty() {
+        return Err(CliError::AuditMismatch {
+            mismatches: report.mismatches.clone(),
+            checked: report.samples_checked,
+            report: report.written_to.clone(),
+        });
+    }
+    writeln!(
+        out,
+        "audit: {} of {} sample lines in {} file(s) re-solved in {:.2} s (seed {}): all byte-identical; {}",
+        report.samples_checked,
+        report.lines_in_shards,
+        report.files.len(),
+        report.seconds,
+        report.seed,
+        report.written_to.display()
+    )?;
+    Ok(())
+}
+
+/// `mc-shard inputs`: the drawn inputs as CSV.
+fn inputs_command(a: InputsArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    let job = Job::read(&a.job)?;
+    let case = match &a.case {
+        None => None,
+        Some(name) => Some(job.case_named(name).ok_or_else(|| {
+            RunError::Usage(format!("no case {name:?} (cases: {})", case_names(&job)))
+        })?),
+    };
+    let range = match &a.range {
+        None => shard_record::ShardRange::new(0, job.samples()),
+        Some(text) => text
+            .parse::<shard_record::ShardRange>()
+            .and_then(|r| r.within(job.samples()))
+            .map_err(|e| RunError::Usage(format!("--range: {e}")))?,
+    };
+    let io = |source| {
+        CliError::Run(RunError::Shard(ShardError::Io {
+            path: a.out.clone(),
+            source,
+        }))
+    };
+    let file = std::fs::File::create(&a.out).map_err(io)?;
+    let mut w = std::io::BufWriter::new(file);
+    let rows = crate::inputs::write_inputs(&job, case, range, &mut w).map_err(io)?;
+    w.flush().map_err(io)?;
+    writeln!(out, "{}: {rows} samples' inputs (mm)", a.out.display())?;
+    Ok(())
+}
+
+/// The job's case names, comma-separated.
+fn case_names(job: &Job) -> String {
+    job.cases
+        .iter()
+        .map(|c| c.name.as_str())
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// `mc-shard run`: one shard, crash-safe and resumable.
@@ -219,9 +430,7 @@ fn run_command(a: RunArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let threads = a
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    if threads == 0 {
-        return Err(RunError::Usage("--threads must be at least 1".into()).into());
-    }
+    check_threads("threads", threads)?;
     crate::interrupt::install()?;
     let summary = run_shard(
         &job,
@@ -249,7 +458,7 @@ fn run_command(a: RunArgs, out: &mut dyn Write) -> Result<(), CliError> {
     } else {
         writeln!(
             out,
-            "{}: {} samples ({} computed now{}, {} failed) in {:.2} s, {:.0} samples/s [range from {:?}]",
+            "{}: {} samples ({} computed now{}, {} failed) in {:.2} s, {:.0} samples/s (range from {})",
             summary.path.display(),
             range.len(),
             summary.computed,
@@ -274,11 +483,7 @@ fn reproduce_command(a: ReproduceArgs, out: &mut dyn Write) -> Result<(), CliErr
         RunError::Usage(format!(
             "no case {:?} (cases: {})",
             a.case,
-            job.cases
-                .iter()
-                .map(|c| c.name.as_str())
-                .collect::<Vec<_>>()
-                .join(", ")
+            case_names(&job)
         ))
     })?;
     if a.sample >= job.cases[c].samples {
@@ -294,21 +499,32 @@ fn reproduce_command(a: ReproduceArgs, out: &mut dyn Write) -> Result<(), CliErr
 
 /// `mc-shard work`: claim, run and repeat until no shard is left.
 fn work_command(a: WorkArgs, out: &mut dyn Write) -> Result<(), CliError> {
-    let job = Job::read(&a.job)?;
+    check_shards(a.shards)?;
     let seconds = |name: &str, v: f64| {
-        if v.is_finite() && v > 0.0 {
+        if v.is_finite() && v > 0.0 && v <= MAX_SECONDS {
             Ok(std::time::Duration::from_secs_f64(v))
         } else {
             Err(RunError::Usage(format!(
-                "--{name} must be a positive number of seconds"
+                "--{name} must be a number of seconds above 0 and at most {MAX_SECONDS} (a week), not {v}"
             )))
         }
     };
+    let heartbeat = seconds("heartbeat", a.heartbeat)?;
+    let stale_after = seconds("stale-after", a.stale_after)?;
+    if heartbeat >= stale_after {
+        return Err(RunError::Usage(format!(
+            "--heartbeat ({} s) must be shorter than --stale-after ({} s), or live claims would be taken over",
+            a.heartbeat, a.stale_after
+        ))
+        .into());
+    }
+    let threads = check_threads("threads", a.threads.unwrap_or_else(default_threads))?;
+    let job = Job::read(&a.job)?;
     let options = crate::work::WorkOptions {
         shards: a.shards,
-        threads: a.threads.unwrap_or_else(default_threads),
-        heartbeat: seconds("heartbeat", a.heartbeat)?,
-        stale_after: seconds("stale-after", a.stale_after)?,
+        threads,
+        heartbeat,
+        stale_after,
         quiet: a.quiet,
     };
     crate::interrupt::install()?;
@@ -325,17 +541,49 @@ fn work_command(a: WorkArgs, out: &mut dyn Write) -> Result<(), CliError> {
             kept: kept_samples(&job, &a.out, a.shards),
         });
     }
-    match failed {
-        Some(e) => Err(e.into()),
-        None => Ok(()),
+    if let Some(e) = failed {
+        return Err(e.into());
     }
+    let quarantined: Vec<(u64, String)> = (0..a.shards)
+        .filter_map(|i| crate::work::quarantined(&a.out, i, a.shards).map(|why| (i, why)))
+        .collect();
+    if !quarantined.is_empty() {
+        return Err(CliError::Quarantined {
+            shards: quarantined,
+            dir: a.out.join("quarantine"),
+        });
+    }
+    Ok(())
 }
 
 /// `mc-shard status`: which shards are complete, partial, missing or bad.
 fn status_command(a: StatusArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    check_shards(a.shards)?;
     let job = Job::read(&a.job)?;
     let states = shard_states(&job, &a.out, a.shards).map_err(RunError::Usage)?;
-    if a.missing {
+    if a.json {
+        let shards: Vec<serde_json::Value> = states
+            .iter()
+            .enumerate()
+            .map(|(i, (r, s))| {
+                let (state, samples, reason) = match s {
+                    ShardState::Complete => ("complete", r.len(), None),
+                    ShardState::Partial(n) => ("partial", *n, None),
+                    ShardState::Missing => ("missing", 0, None),
+                    ShardState::Bad(why) => ("bad", 0, Some(why.as_str())),
+                    ShardState::Quarantined(why) => ("quarantined", 0, Some(why.as_str())),
+                };
+                serde_json::json!({"shard": i, "range": r, "state": state,
+                                   "samples": samples, "reason": reason})
+            })
+            .collect();
+        let value = serde_json::json!({"job_id": job.id, "shards": a.shards, "status": shards});
+        writeln!(
+            out,
+            "{}",
+            serde_json::to_string_pretty(&value).expect("serialises")
+        )?;
+    } else if a.missing {
         let missing: Vec<String> = states
             .iter()
             .enumerate()
@@ -350,6 +598,7 @@ fn status_command(a: StatusArgs, out: &mut dyn Write) -> Result<(), CliError> {
                 ShardState::Partial(n) => format!("partial ({n} of {} samples)", r.len()),
                 ShardState::Missing => "missing".to_string(),
                 ShardState::Bad(why) => format!("bad: {why}"),
+                ShardState::Quarantined(why) => format!("quarantined: {why}"),
             };
             writeln!(out, "shard {i}/{} {r}: {what}", a.shards)?;
         }
@@ -366,7 +615,7 @@ pub fn kept_samples(job: &Job, dir: &std::path::Path, shards: u64) -> u64 {
             .map(|(r, s)| match s {
                 ShardState::Complete => r.len(),
                 ShardState::Partial(n) => *n,
-                ShardState::Missing | ShardState::Bad(_) => 0,
+                ShardState::Missing | ShardState::Bad(_) | ShardState::Quarantined(_) => 0,
             })
             .sum()
     })

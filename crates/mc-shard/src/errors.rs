@@ -28,6 +28,30 @@ pub enum ShardError {
         /// Our range.
         range: shard_record::ShardRange,
     },
+    /// The file's header names this job and range but differs from the job in its cases or
+    /// their parameters: it was edited, or written from another version of the job.
+    #[error("{}: its begin line names this job and range but its cases or parameters differ from the job's (the header was changed); it is never appended to or counted (move it away and run again)", path.display())]
+    HeaderMismatch {
+        /// The file.
+        path: PathBuf,
+    },
+    /// An incomplete file of a format version without checkpoints: its kept lines could not
+    /// be verified, so it is not resumed.
+    #[error("{}: an incomplete shard of format version {version}, which has no checkpoints, so its lines cannot be verified; it is not resumed (move it away and run again)", path.display())]
+    OldFormat {
+        /// The file.
+        path: PathBuf,
+        /// Its format version.
+        version: u32,
+    },
+    /// The directory's worker pool record (`claims/pool.json`) is of another job, or damaged.
+    #[error("{}: {message}", path.display())]
+    Pool {
+        /// The pool record.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
     /// Another process holds the file's lock: it is writing this shard now.
     #[error("{}: another process is writing this shard (its lock is held)", path.display())]
     Locked {

@@ -18,16 +18,32 @@
 //!
 //! ## Commands (see `mc-shard --help`)
 //!
-//! - `mc-shard plan JOB.json` — job id, cases, sample count, an estimate of the CPU time and
+//! - `mc-shard plan --job JOB.json` — job id, cases, sample count, an estimate of the CPU time and
 //!   a suggestion: this machine, and a cluster split only for a job of more than ten minutes.
 //! - `mc-shard run --job JOB.json --out DIR [--shard I/K | --range A..B] [--threads T]` —
 //!   one shard (selection in [`select`]); crash-safe and resumable ([`shard`]).
 //! - `mc-shard reproduce --job JOB.json --case NAME --sample K [--detail]` — the exact line
 //!   of one sample, or its draws, iterations, displacements and forces ([`reproduce`]).
-//! - `mc-shard status --job JOB.json --out DIR --shards K [--missing]` — which shards are
-//!   complete ([`status`]).
+//! - `mc-shard status --job JOB.json --out DIR --shards K [--missing | --json]` — which
+//!   shards are complete, partial, missing, bad or quarantined ([`status`]).
 //! - `mc-shard work --job JOB.json --out DIR --shards K` — claim, run and repeat until no
-//!   shard is left: for cron on machines sharing DIR ([`work`]).
+//!   shard is left: for cron on machines sharing DIR; a damaged shard is quarantined and the
+//!   others run ([`work`]).
+//! - `mc-shard audit --job JOB.json DIR… [--samples K] [--seed S]` — re-solve K seeded
+//!   random lines of a run and compare them byte for byte; `audit.json` ([`audit`]).
+//! - `mc-shard inputs --job JOB.json [--case C] [--range A..B] --out inputs.csv` — each
+//!   sample's drawn length errors and clearances in mm, keyed by index ([`inputs`]).
+//! - `mc-shard completions bash|zsh|fish`, `mc-shard man` — shell completions and the man
+//!   page, generated from the same definitions as `--help`.
+//!
+//! ## What is verified
+//!
+//! Shard files are format version 2 of [`shard_record`]: a checkpoint line every
+//! [`shard_record::CHECKPOINT_EVERY`] sample lines and digests that cover the begin line. A
+//! resume keeps only lines a checkpoint verifies (the rest, at most 100, are solved again;
+//! after SIGINT/SIGTERM a stop checkpoint covers every line); a complete shard is verified
+//! in full before it is skipped; a shard is resumed or skipped only if its header matches
+//! the job (id, range, cases and their parameters). `audit` checks the numbers themselves.
 //!
 //! Running every shard on one machine and merging (`truss-mc run-all`) lives in the crate
 //! above both runner and merge, `truss-mc`: this crate, the worker that runs on every
@@ -38,11 +54,15 @@
 //! The scheme every truss-mc binary shares (`truss-exit`): 0 success, 1 internal error, 2
 //! usage error or a range outside the job, 3 invalid job (the message gives the JSON path of
 //! the fault), 4 a file could not be read or written, 5 the shard file is in the way
-//! (another job's, locked by another process, or damaged), 130 / 143 `run` or `work`
-//! stopped by SIGINT / SIGTERM, every finished sample kept ([`interrupt`]).
+//! (another job's, locked by another process, damaged, a changed header; for `work`: a
+//! shard quarantined), 6 an audit found a line that differs from its re-solve or a shard
+//! that does not verify, 130 / 143 `run` or `work` stopped by SIGINT / SIGTERM, every
+//! finished sample kept ([`interrupt`]).
 
+pub mod audit;
 pub mod cli;
 pub mod errors;
+pub mod inputs;
 pub mod interrupt;
 pub mod progress;
 pub mod reproduce;

@@ -158,7 +158,7 @@ pub fn run_shard(
     let path = writer.path().to_path_buf();
     if written < range.end {
         // Interrupted (the only way the workers stop early without an error).
-        writer.sync()?;
+        writer.stop()?;
         return Ok(RunSummary {
             path,
             range,

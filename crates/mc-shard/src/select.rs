@@ -27,6 +27,18 @@ pub enum Source {
     Whole,
 }
 
+impl std::fmt::Display for Source {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Source::Range => "--range",
+            Source::Shard => "--shard",
+            Source::Slurm => "SLURM_ARRAY_TASK_ID",
+            Source::Kubernetes => "JOB_COMPLETION_INDEX",
+            Source::Whole => "the whole job",
+        })
+    }
+}
+
 /// Chooses the range (see the module doc); `env` looks up environment variables.
 pub fn select(
     range: Option<&str>,

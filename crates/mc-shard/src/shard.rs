@@ -4,18 +4,24 @@
 //! - takes an exclusive lock on the file (an OS file lock, `flock`), so two processes never
 //!   write one shard; a second gets [`ShardError::Locked`];
 //! - an empty file, or one torn while its header was written, starts afresh;
-//! - a file of another job id or range is an error and is left untouched;
-//! - a complete file is verified (every line, and the closing digest) and left as it is;
-//! - otherwise the valid prefix is kept (a torn last line is cut off) and writing resumes at
-//!   the next index, with the digest of the lines kept: the finished file is byte-identical
-//!   to one written without interruption.
+//! - a file of another job id or range, or whose header differs from the job's in any case
+//!   or parameter, is an error and is left untouched;
+//! - a complete file is verified (every line, every checkpoint, the closing digests, which
+//!   cover the begin line) and left as it is;
+//! - otherwise the prefix verified by its last checkpoint is kept (the lines after it, at
+//!   most [`shard_record::CHECKPOINT_EVERY`], and a torn last line are cut off and solved
+//!   again), and writing resumes at the next index: the finished file is byte-identical to
+//!   one written without interruption. A kept line that no longer matches its checkpoint is
+//!   an error ([`ShardError::Corrupt`]), never sealed under a fresh digest;
+//! - an incomplete file of format version 1 (no checkpoints: its lines cannot be verified)
+//!   is not resumed ([`ShardError::OldFormat`]).
 //!
 //! Each batch of lines is written with one `write` call as soon as it is complete and in
 //! order, so a crash loses at most the lines not yet written.
 
 use crate::errors::ShardError;
 use shard_record::{
-    Begin, Record, SampleDigest, ScanError, ShardRange, ShardScan, Tail, scan_shard, to_line,
+    Begin, CHECKPOINT_EVERY, ScanError, ShardEncoder, ShardRange, ShardScan, Tail, scan_shard,
 };
 use std::fs::{File, OpenOptions};
 use std::io::Write;
@@ -41,7 +47,7 @@ pub enum Opened {
 pub struct ShardWriter {
     path: PathBuf,
     file: File,
-    digest: SampleDigest,
+    encoder: ShardEncoder,
     range: ShardRange,
     /// Lines kept from an earlier, interrupted run.
     resumed: u64,
@@ -76,14 +82,15 @@ impl ShardWriter {
         }
         let fresh = |file: File| -> Result<Opened, ShardError> {
             file.set_len(0).map_err(io)?;
+            let (encoder, header) = ShardEncoder::new(begin);
             let mut w = ShardWriter {
                 path: path.clone(),
                 file,
-                digest: SampleDigest::new(),
+                encoder,
                 range,
                 resumed: 0,
             };
-            w.write_raw(to_line(&Record::Begin(begin.clone())).as_bytes())?;
+            w.write_raw(&header)?;
             Ok(Opened::Writer(w))
         };
         if file.metadata().map_err(io)?.len() == 0 {
@@ -103,16 +110,25 @@ impl ShardWriter {
                 range,
             });
         }
+        if !scan.begin.same_shard(begin) {
+            return Err(ShardError::HeaderMismatch { path });
+        }
         if matches!(scan.tail, Tail::Complete(_)) {
             return Ok(Opened::Complete { path, scan });
         }
-        // Keep the valid prefix: header and whole sample lines.
+        if scan.begin.checkpoint_every.is_none() {
+            return Err(ShardError::OldFormat {
+                path,
+                version: scan.begin.format_version,
+            });
+        }
+        // Keep the verified prefix: header, and sample lines up to the last checkpoint.
         file.set_len(scan.valid_len).map_err(io)?;
         Ok(Opened::Writer(ShardWriter {
             path: path.clone(),
             file,
             resumed: scan.digest.samples(),
-            digest: scan.digest,
+            encoder: ShardEncoder::resume(&scan),
             range,
         }))
     }
@@ -124,7 +140,7 @@ impl ShardWriter {
 
     /// The global index of the next sample line.
     pub fn next_index(&self) -> u64 {
-        self.range.start + self.digest.samples()
+        self.range.start + self.encoder.samples()
     }
 
     /// Sample lines kept from an interrupted run.
@@ -134,18 +150,29 @@ impl ShardWriter {
 
     /// Appends sample lines (each with its `\n`, the next indices in order), given with
     /// whether each failed, in one write.
+    /// Checkpoint lines fall between them as the format requires.
     pub fn append(&mut self, bytes: &[u8], lines: &[(usize, bool)]) -> Result<(), ShardError> {
+        let mut out = Vec::with_capacity(bytes.len() + 256);
         let mut at = 0;
         for &(len, failed) in lines {
-            self.digest.add_line(&bytes[at..at + len], failed);
+            self.encoder.push(&bytes[at..at + len], failed, &mut out);
             at += len;
         }
-        self.write_raw(bytes)
+        self.write_raw(&out)
     }
 
     /// Failed samples among the lines so far.
     pub fn failed(&self) -> u64 {
-        self.digest.end().failed
+        self.encoder.failed()
+    }
+
+    /// Ends an interrupted file: a stop checkpoint (so a rerun keeps every line written;
+    /// see [`shard_record`]'s format) and a sync to disk.
+    pub fn stop(&mut self) -> Result<(), ShardError> {
+        if let Some(line) = self.encoder.stop_checkpoint() {
+            self.write_raw(&line)?;
+        }
+        self.sync()
     }
 
     /// Syncs the lines written so far to disk (before stopping without the end line).
@@ -163,8 +190,8 @@ impl ShardWriter {
             self.range.end,
             "finish before the last sample"
         );
-        let end = self.digest.end();
-        self.write_raw(to_line(&Record::End(end.clone())).as_bytes())?;
+        let (end, line) = self.encoder.end();
+        self.write_raw(&line)?;
         self.file.sync_all().map_err(|source| ShardError::Io {
             path: self.path.clone(),
             source,
@@ -190,6 +217,7 @@ pub fn begin(job: &crate::job::Job, range: ShardRange) -> Begin {
         job.samples(),
         case_infos(job),
     )
+    .with_checkpoints(CHECKPOINT_EVERY)
 }
 
 /// The job's cases as a shard header lists them.

@@ -1,5 +1,6 @@
 //! The state of a job's shards in a directory: which of K shards are complete, partial,
-//! missing or in the way (another job's file), for resubmitting what is missing.
+//! missing, in the way (another job's file, a changed header) or quarantined by a worker, for
+//! resubmitting what is missing. A partial shard counts its lines verified by a checkpoint.
 
 use crate::job::Job;
 use shard_record::{ShardRange, Tail, scan_shard};
@@ -16,6 +17,8 @@ pub enum ShardState {
     Missing,
     /// The file is damaged or belongs to another job; the reason.
     Bad(String),
+    /// A worker set the shard aside (`DIR/quarantine/`); the reason it recorded.
+    Quarantined(String),
 }
 
 /// The state of each of the `count` shards of `job` in `dir`.
@@ -27,9 +30,13 @@ pub fn shard_states(
     let ranges = ShardRange::partition(count, job.samples()).map_err(|e| e.to_string())?;
     Ok(ranges
         .into_iter()
-        .map(|r| {
+        .enumerate()
+        .map(|(i, r)| {
             let path = dir.join(r.file_name());
-            let state = if !path.exists() {
+            let expected = crate::shard::begin(job, r);
+            let state = if let Some(why) = crate::work::quarantined(dir, i as u64, count) {
+                ShardState::Quarantined(why)
+            } else if !path.exists() {
                 ShardState::Missing
             } else {
                 match scan_shard(&path, |_, _, _| Ok(())) {
@@ -37,8 +44,15 @@ pub fn shard_states(
                     Ok(scan) if scan.begin.job_id != job.id => {
                         ShardState::Bad(format!("holds job {}", scan.begin.job_id))
                     }
+                    Ok(scan) if !scan.begin.same_shard(&expected) => ShardState::Bad(
+                        "its header differs from the job's cases or parameters".into(),
+                    ),
                     Ok(scan) => match scan.tail {
                         Tail::Complete(_) => ShardState::Complete,
+                        _ if scan.begin.checkpoint_every.is_none() => ShardState::Bad(format!(
+                            "an incomplete shard of format version {} (no checkpoints): it is not resumed",
+                            scan.begin.format_version
+                        )),
                         _ => ShardState::Partial(scan.digest.samples()),
                     },
                 }

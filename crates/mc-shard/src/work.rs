@@ -21,6 +21,20 @@
 //! - **A finished shard is never rerun**: a complete file is recognised (its end line) and
 //!   skipped; the claim of a finished shard is removed.
 //!
+//! - **One split per directory.** The first worker writes `DIR/claims/pool.json` (the job id
+//!   and the shard count K, created atomically by a hard link); a worker started with another
+//!   `--shards` count is refused (usage, exit 2), one of another job as a file in the way
+//!   (exit 5), before it claims anything. Without `pool.json`, shard files whose ranges are
+//!   not of this split (left by `mc-shard run` with another K) refuse the worker the same way.
+//! - **A damaged shard is set aside, not a stop.** A shard file that cannot be resumed or
+//!   skipped (a line that breaks the format or its checkpoint, a changed header, another
+//!   job's file, an old format) is quarantined: `DIR/quarantine/shard-i-of-K.json` records
+//!   the reason, host, pid and time, the claim is released, the file is left untouched for
+//!   inspection, and the worker goes on with the other shards. Later workers skip a
+//!   quarantined shard. When no shard is left, a worker exits with the file-in-the-way code
+//!   (5) if any shard is quarantined, naming them; `mc-shard status` lists them. To retry a
+//!   shard: move its file away (or repair it), delete its marker, and run again.
+//!
 //! Claims and locks need a shared filesystem with atomic `O_EXCL` create and working file
 //! locks across machines (a local disk, NFSv4, CephFS, Lustre).
 //!
@@ -58,7 +72,8 @@ pub struct Action {
     /// Shard index.
     pub shard: u64,
     /// `completed`, `already-complete`, `claimed-elsewhere`, `locked-elsewhere`, `took-over`,
-    /// `interrupted` (SIGINT/SIGTERM: the claim is released, the shard left to resume).
+    /// `interrupted` (SIGINT/SIGTERM: the claim is released, the shard left to resume),
+    /// `quarantined` (set aside now, with `reason`), `skipped-quarantined` (set aside before).
     pub action: &'static str,
     /// Samples computed by this worker.
     pub computed: u64,
@@ -68,6 +83,122 @@ pub struct Action {
     pub host: String,
     /// This worker's pid.
     pub pid: u32,
+    /// Why the shard was quarantined.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
+/// The quarantine marker of shard `i` of `k` in `dir`.
+pub fn quarantine_path(dir: &Path, i: u64, k: u64) -> PathBuf {
+    dir.join("quarantine")
+        .join(format!("shard-{i}-of-{k}.json"))
+}
+
+/// The reason recorded in shard `i` of `k`'s quarantine marker, if it has one.
+pub fn quarantined(dir: &Path, i: u64, k: u64) -> Option<String> {
+    let text = std::fs::read_to_string(quarantine_path(dir, i, k)).ok()?;
+    Some(
+        serde_json::from_str::<serde_json::Value>(&text)
+            .ok()
+            .and_then(|v| v["reason"].as_str().map(String::from))
+            .unwrap_or_else(|| format!("(unreadable marker) {}", text.trim())),
+    )
+}
+
+/// Writes shard `i` of `k`'s quarantine marker.
+fn quarantine(
+    dir: &Path,
+    i: u64,
+    k: u64,
+    range: ShardRange,
+    reason: &str,
+    host: &str,
+    pid: u32,
+) -> Result<(), RunError> {
+    let path = quarantine_path(dir, i, k);
+    let io = |source| {
+        RunError::Shard(ShardError::Io {
+            path: path.clone(),
+            source,
+        })
+    };
+    std::fs::create_dir_all(path.parent().expect("a marker has a directory")).map_err(io)?;
+    let since = SystemTime::now()
+        .duration_since(SystemTime::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    let marker = serde_json::json!({
+        "shard": i, "shards": k, "range": range, "file": range.file_name(),
+        "reason": reason, "host": host, "pid": pid, "quarantined_at_unix": since,
+    });
+    let tmp = path.with_extension(format!("json.tmp-{pid}"));
+    std::fs::write(&tmp, format!("{marker}\n")).map_err(io)?;
+    std::fs::rename(&tmp, &path).map_err(io)
+}
+
+/// Checks that the directory's worker pool is of this job and split (see the module doc),
+/// writing `DIR/claims/pool.json` if no worker has yet.
+fn check_pool(job: &Job, dir: &Path, claims: &Path, ranges: &[ShardRange]) -> Result<(), RunError> {
+    let shards = ranges.len() as u64;
+    let pool = claims.join("pool.json");
+    let io = |path: &Path, source| {
+        RunError::Shard(ShardError::Io {
+            path: path.to_path_buf(),
+            source,
+        })
+    };
+    if !pool.exists() {
+        // Shard files of another split (from `mc-shard run --shard I/K'`).
+        let ours: std::collections::BTreeSet<String> =
+            ranges.iter().map(|r| r.file_name()).collect();
+        let entries = std::fs::read_dir(dir).map_err(|e| io(dir, e))?;
+        for entry in entries.flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name.starts_with("shard-") && name.ends_with(".jsonl") && !ours.contains(&name) {
+                return Err(RunError::Usage(format!(
+                    "{}: holds a shard that is not one of {shards} shards of this job; workers on one directory must all use the split its files were made with (check `mc-shard status`), or use another --out",
+                    entry.path().display()
+                )));
+            }
+        }
+        let pid = std::process::id();
+        let tmp = claims.join(format!("pool.json.tmp-{}-{pid}", host_name()));
+        let text = serde_json::json!({"job_id": job.id, "shards": shards});
+        std::fs::write(&tmp, format!("{text}\n")).map_err(|e| io(&tmp, e))?;
+        let linked = std::fs::hard_link(&tmp, &pool);
+        let _ = std::fs::remove_file(&tmp);
+        match linked {
+            Ok(()) => return Ok(()),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+            Err(e) => return Err(io(&pool, e)),
+        }
+    }
+    let text = std::fs::read_to_string(&pool).map_err(|e| io(&pool, e))?;
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
+        RunError::Shard(ShardError::Pool {
+            path: pool.clone(),
+            message: format!("not valid JSON ({e})"),
+        })
+    })?;
+    if value["job_id"].as_str() != Some(job.id.as_str()) {
+        return Err(RunError::Shard(ShardError::Pool {
+            path: pool.clone(),
+            message: format!(
+                "the directory's workers run job {}, not this job {}; use another --out",
+                value["job_id"], job.id
+            ),
+        }));
+    }
+    match value["shards"].as_u64() {
+        Some(k) if k == shards => Ok(()),
+        Some(k) => Err(RunError::Usage(format!(
+            "{}: the directory's workers split the job into {k} shards; this worker was started with --shards {shards} (every worker on a directory must use the same --shards)",
+            pool.display()
+        ))),
+        None => Err(RunError::Shard(ShardError::Pool {
+            path: pool.clone(),
+            message: "no shard count".into(),
+        })),
+    }
 }
 
 /// This machine's host name.
@@ -95,10 +226,11 @@ pub fn work(
         path: claims.clone(),
         source,
     })?;
+    check_pool(job, dir, &claims, &ranges)?;
     let host = host_name();
     let pid = std::process::id();
     let mut actions = Vec::new();
-    let mut act = |shard: u64, action: &'static str, computed: u64, kept: u64| {
+    let mut act = |shard: u64, action: &'static str, computed: u64, kept: u64, reason| {
         let a = Action {
             shard,
             action,
@@ -106,28 +238,34 @@ pub fn work(
             kept,
             host: host.clone(),
             pid,
+            reason,
         };
         report(&a);
         actions.push(a);
     };
+    let expected = |range: ShardRange| crate::shard::begin(job, range);
     for (i, range) in ranges.iter().enumerate() {
         let i = i as u64;
         if crate::interrupt::requested().is_some() {
             break;
         }
-        if looks_complete(&dir.join(range.file_name())) {
+        if quarantined(dir, i, options.shards).is_some() {
+            act(i, "skipped-quarantined", 0, 0, None);
+            continue;
+        }
+        if looks_complete(&dir.join(range.file_name()), &expected(*range)) {
             continue;
         }
         let claim = claims.join(format!("shard-{i}-of-{}.claim", options.shards));
         let took_over = match try_claim(&claim, &host, pid, options.stale_after)? {
             Claim::Ours { took_over } => took_over,
             Claim::Live => {
-                act(i, "claimed-elsewhere", 0, 0);
+                act(i, "claimed-elsewhere", 0, 0, None);
                 continue;
             }
         };
         if took_over {
-            act(i, "took-over", 0, 0);
+            act(i, "took-over", 0, 0, None);
         }
         let result = with_heartbeat(&claim, options.heartbeat, || {
             run_shard(
@@ -145,31 +283,55 @@ pub fn work(
                 let _ = std::fs::remove_file(&claim);
                 if summary.interrupted.is_some() {
                     // Released at once for another worker (or a rerun) to resume.
-                    act(i, "interrupted", summary.computed, summary.resumed);
+                    act(i, "interrupted", summary.computed, summary.resumed, None);
                     break;
                 }
                 if summary.already_complete {
-                    act(i, "already-complete", 0, summary.resumed);
+                    act(i, "already-complete", 0, summary.resumed, None);
                 } else {
-                    act(i, "completed", summary.computed, summary.resumed);
+                    act(i, "completed", summary.computed, summary.resumed, None);
                 }
             }
             Err(RunError::Shard(ShardError::Locked { .. })) => {
                 // Another worker writes it: its claim will show it; leave ours to go stale.
                 let _ = std::fs::remove_file(&claim);
-                act(i, "locked-elsewhere", 0, 0);
+                act(i, "locked-elsewhere", 0, 0, None);
             }
-            Err(e) => return Err(e),
+            Err(RunError::Shard(
+                e @ (ShardError::Corrupt(_)
+                | ShardError::OtherJob { .. }
+                | ShardError::HeaderMismatch { .. }
+                | ShardError::OldFormat { .. }),
+            )) => {
+                let reason = e.to_string();
+                let marked = quarantine(dir, i, options.shards, *range, &reason, &host, pid);
+                let _ = std::fs::remove_file(&claim);
+                marked?;
+                act(i, "quarantined", 0, 0, Some(reason));
+            }
+            Err(e) => {
+                let _ = std::fs::remove_file(&claim);
+                return Err(e);
+            }
         }
     }
     Ok(actions)
 }
 
-/// Whether a shard file ends with an end line (a cheap look; running it verifies).
-fn looks_complete(path: &Path) -> bool {
+/// Whether a shard file's header is `begin`'s and it ends with an end line (a cheap look;
+/// running it verifies every line).
+fn looks_complete(path: &Path, begin: &shard_record::Begin) -> bool {
     let Ok(mut f) = File::open(path) else {
         return false;
     };
+    let mut header = Vec::new();
+    let same = std::io::BufRead::read_until(&mut std::io::BufReader::new(&f), b'\n', &mut header)
+        .is_ok()
+        && matches!(shard_record::parse_record(&header),
+                    Ok(shard_record::Record::Begin(b)) if b.same_shard(begin));
+    if !same {
+        return false;
+    }
     let len = f.metadata().map_or(0, |m| m.len());
     let tail = len.min(512);
     let mut buf = vec![0; tail as usize];

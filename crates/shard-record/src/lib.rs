@@ -10,7 +10,7 @@
 //! range `start..end` of that index, computed by one process and written to one file,
 //! `shard-{start:010}-{end:010}.jsonl` (see [`ShardRange::file_name`]).
 //!
-//! ## Wire format
+//! ## Wire format (version 2)
 //!
 //! The file is [JSON Lines](https://jsonlines.org): UTF-8, one JSON object per line, each line
 //! ended by `\n`. Every object has a `record` field naming its kind:
@@ -18,9 +18,11 @@
 //! 1. One `begin` line ([`Begin`]): `format` (always `"truss-mc-shard"`), `format_version`
 //!    ([`FORMAT_VERSION`]), `program` and `program_version` (the writer), `job_id` (64 lower-case
 //!    hex digits: the SHA-256 of the job's canonical form), `range` (`{"start": A, "end": B}`),
-//!    `job_samples`, and `cases`: every case of the job (not only those in this range) with its
+//!    `job_samples`, `cases`: every case of the job (not only those in this range) with its
 //!    `name`, the global index of its first sample `start`, its `samples` count and `parameters`,
-//!    named numbers that describe the case for sweeps (for example `sigma` in mm, `stages`).
+//!    named numbers that describe the case for sweeps (for example `sigma` in mm, `stages`),
+//!    and `checkpoint_every` (N, 1 ≤ N ≤ [`MAX_CHECKPOINT_EVERY`]; mc-shard writes
+//!    [`CHECKPOINT_EVERY`]).
 //! 2. One `sample` line ([`Sample`]) for each global index of the range, in increasing order
 //!    with no gaps: `index` (global), `case` (name), `sample` (index within the case),
 //!    `status` (`"converged"` or `"failed"`), `iterations` (Newton iterations), and
@@ -31,9 +33,19 @@
 //!    - when failed: `reason`, a sentence saying why.
 //!
 //!    A failed solve is a line with its status, never a missing line.
-//! 3. One `end` line ([`End`]): `samples` (the number of sample lines), `failed` (how many of
-//!    them failed) and `sha256`, the SHA-256 (lower-case hex) of the exact bytes of all sample
-//!    lines in file order, each including its terminating `\n`.
+//! 3. After every N-th sample line (N = `checkpoint_every`; after sample line N, 2N, …, the
+//!    last one included when the range's length is a multiple of N), one `checkpoint` line
+//!    ([`Checkpoint`]): `samples` (the sample lines so far), `sha256` (the SHA-256 of the
+//!    exact bytes of those sample lines in file order, each with its `\n`) and `begin_sha256`
+//!    (the SHA-256 of the begin line's bytes with its `\n`).
+//!
+//!    A writer that stops on purpose (SIGINT, SIGTERM) may end an incomplete file with one
+//!    more checkpoint line off that schedule, a *stop checkpoint*, covering every sample
+//!    line written. It is only valid as the file's last line; a writer resuming the file
+//!    cuts it off (the finished file has only the scheduled checkpoints).
+//! 4. One `end` line ([`End`]): `samples` (the number of sample lines), `failed` (how many of
+//!    them failed), `sha256` (as a checkpoint's, over all sample lines; checkpoint lines are
+//!    not hashed) and `begin_sha256`.
 //!
 //! Numbers are written in the shortest form that reads back to the same `f64` (serde_json with
 //! `float_roundtrip`), so a reader recovers every bit the writer had.
@@ -43,25 +55,53 @@
 //! ## Example
 //!
 //! ```text
-//! {"record":"begin","format":"truss-mc-shard","format_version":1,"program":"mc-shard","program_version":"0.1.0","job_id":"6f1e…","range":{"start":0,"end":2},"job_samples":2,"cases":[{"name":"sigma-0.0063","start":0,"samples":2,"parameters":{"sigma":0.0063,"stages":5.0}}]}
+//! {"record":"begin","format":"truss-mc-shard","format_version":2,"program":"mc-shard","program_version":"0.1.0","job_id":"6f1e…","range":{"start":0,"end":2},"job_samples":2,"cases":[{"name":"sigma-0.0063","start":0,"samples":2,"parameters":{"sigma":0.0063,"stages":5.0}}],"checkpoint_every":100}
 //! {"record":"sample","index":0,"case":"sigma-0.0063","sample":0,"status":"converged","iterations":3,"theta_p":4.1e-5,"tan_theta_x":-2.2e-5,"tan_theta_y":3.5e-5,"residual":2.1e-11,"slack_cables":4}
 //! {"record":"sample","index":1,"case":"sigma-0.0063","sample":1,"status":"failed","iterations":60,"reason":"Newton did not converge in 60 iterations (residual 3.2e-4 N)"}
-//! {"record":"end","samples":2,"failed":1,"sha256":"9b0c…"}
+//! {"record":"end","samples":2,"failed":1,"sha256":"9b0c…","begin_sha256":"41d7…"}
 //! ```
+//!
+//! ## What is verified
+//!
+//! Every digest of a version-2 file covers the begin line as well as the sample lines, so a
+//! changed header parameter (a case's `sigma`, say) breaks the first checkpoint or the end
+//! line, exactly as a changed digit of θ_P does.
+//!
+//! - A complete file (one with its end line) is verified in full by [`scan_shard`] and
+//!   [`read_shard`]: every line's shape and order, every checkpoint, the end line.
+//! - An incomplete file is verified **up to its last checkpoint**: [`scan_shard`] reports
+//!   that prefix ([`ShardScan::valid_len`], [`ShardScan::digest`]) and calls its `visit`
+//!   only for lines so verified. The whole sample lines after the last checkpoint (at most
+//!   N − 1, or N when the writer stopped just before the checkpoint line) cannot be told from
+//!   edited ones; they are counted in [`ShardScan::unverified`] and a writer resuming the file
+//!   cuts them off and solves them again. Resuming therefore costs one read of the file
+//!   (SHA-256) and, after a crash, at most N samples' solves; after a stop on a signal
+//!   (a stop checkpoint), none.
+//! - Nothing checks that the numbers are the *right* ones for the job: a shard rewritten
+//!   with fresh digests verifies. That is what `mc-shard audit` is for: it re-solves a seeded
+//!   random sample of lines and compares them byte for byte.
 //!
 //! ## Torn and incomplete files
 //!
 //! A writer appends and flushes whole lines. A file whose last line lacks its `\n` was torn by
-//! a crash: [`scan_shard`] reports the valid prefix so that a writer can truncate and resume,
-//! and a reader can name the torn line. A file without an `end` line is incomplete.
+//! a crash: [`scan_shard`] reports the verified prefix so that a writer can truncate and
+//! resume, and a reader can name the torn line. A file without an `end` line is incomplete.
 //!
 //! ## Versioning
 //!
 //! Readers accept `format_version` up to [`FORMAT_VERSION`] and ignore unknown fields, so a
 //! later version may add optional fields; a change in meaning increments the version.
+//! Version 1 (no `checkpoint_every`, no `checkpoint` lines, no `begin_sha256`: the begin
+//! line and an incomplete file's lines were not covered by any digest) is still read, so
+//! that older runs still merge; [`Begin::new`] writes it (plain files, test fixtures), and
+//! [`Begin::with_checkpoints`] turns a header into version 2. mc-shard writes version 2, and
+//! does not resume a version-1 file (its kept lines cannot be verified).
 
+mod encode;
 mod range;
 mod scan;
+
+pub use encode::ShardEncoder;
 
 pub use range::{ShardRange, ShardRangeError};
 
@@ -91,8 +131,17 @@ use std::collections::BTreeMap;
 /// The value of the `format` field of every begin line.
 pub const FORMAT: &str = "truss-mc-shard";
 
-/// The format version this crate writes and the highest it reads.
-pub const FORMAT_VERSION: u32 = 1;
+/// The format version this crate writes and the highest it reads. Version 2 added
+/// checkpoints and the begin line's digest (see the crate doc).
+pub const FORMAT_VERSION: u32 = 2;
+
+/// The checkpoint interval mc-shard writes: a `checkpoint` line after every 100 sample lines
+/// (about 0.3 % of the file), so a resume re-solves at most 100 samples.
+pub const CHECKPOINT_EVERY: u64 = 100;
+
+/// The largest `checkpoint_every` a reader accepts (it holds that many lines while it
+/// verifies them).
+pub const MAX_CHECKPOINT_EVERY: u64 = 100_000;
 
 /// One line of a shard file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -102,6 +151,8 @@ pub enum Record {
     Begin(Begin),
     /// One line per sample.
     Sample(Sample),
+    /// After every `checkpoint_every` sample lines (format version 2).
+    Checkpoint(Checkpoint),
     /// The last line.
     End(End),
 }
@@ -132,6 +183,10 @@ pub struct Begin {
     pub job_samples: u64,
     /// Every case of the job, in order.
     pub cases: Vec<CaseInfo>,
+    /// A checkpoint line after every this many sample lines (format version 2; absent in
+    /// version 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub checkpoint_every: Option<u64>,
 }
 
 /// One case of a job, as the header describes it.
@@ -280,6 +335,21 @@ pub struct End {
     pub failed: u64,
     /// SHA-256 (hex) of all sample lines' bytes, each with its `\n`.
     pub sha256: String,
+    /// SHA-256 (hex) of the begin line's bytes with its `\n` (format version 2).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub begin_sha256: Option<String>,
+}
+
+/// A checkpoint line (format version 2): the digest of the sample lines so far and of the
+/// begin line, so that an incomplete file is verified up to it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Checkpoint {
+    /// Number of sample lines before this checkpoint.
+    pub samples: u64,
+    /// SHA-256 (hex) of those sample lines' bytes, each with its `\n`.
+    pub sha256: String,
+    /// SHA-256 (hex) of the begin line's bytes with its `\n`.
+    pub begin_sha256: String,
 }
 
 /// Serialises a record as one line with its terminating `\n`.
@@ -325,14 +395,30 @@ impl SampleDigest {
         self.samples
     }
 
-    /// The end record for the lines added so far.
+    /// Number of failed lines added so far.
+    pub fn failed(&self) -> u64 {
+        self.failed
+    }
+
+    /// The SHA-256 (hex) of the lines added so far.
+    pub fn sha256(&self) -> String {
+        hex(&self.hasher.clone().finalize())
+    }
+
+    /// The end record of a version-1 file (no begin digest) for the lines added so far.
     pub fn end(&self) -> End {
         End {
             samples: self.samples,
             failed: self.failed,
-            sha256: hex(&self.hasher.clone().finalize()),
+            sha256: self.sha256(),
+            begin_sha256: None,
         }
     }
+}
+
+/// SHA-256 (lower-case hex) of `bytes`: of a begin line, for `begin_sha256`.
+pub fn sha256_hex(bytes: &[u8]) -> String {
+    hex(&Sha256::digest(bytes))
 }
 
 /// Lower-case hex of bytes.
@@ -347,7 +433,9 @@ pub fn hex(bytes: &[u8]) -> String {
 }
 
 impl Begin {
-    /// A header for `range` of job `job_id`, written by this program version.
+    /// A header for `range` of job `job_id`, written by this program version, in format
+    /// version 1 (no checkpoints, the begin line not covered by a digest): the plain form
+    /// for fixtures. Writers chain [`Begin::with_checkpoints`] to write version 2.
     pub fn new(
         program: &str,
         program_version: &str,
@@ -358,14 +446,32 @@ impl Begin {
     ) -> Self {
         Self {
             format: FORMAT.to_string(),
-            format_version: FORMAT_VERSION,
+            format_version: 1,
             program: program.to_string(),
             program_version: program_version.to_string(),
             job_id: job_id.to_string(),
             range,
             job_samples,
             cases,
+            checkpoint_every: None,
         }
+    }
+
+    /// This header in the current format version ([`FORMAT_VERSION`]) with a checkpoint
+    /// line after every `every` sample lines.
+    pub fn with_checkpoints(mut self, every: u64) -> Self {
+        self.format_version = FORMAT_VERSION;
+        self.checkpoint_every = Some(every);
+        self
+    }
+
+    /// Whether `self` describes the same job and shard as `other`: job id, range, sample
+    /// count and cases with their parameters (not the writer, its version, or the format).
+    pub fn same_shard(&self, other: &Begin) -> bool {
+        self.job_id == other.job_id
+            && self.range == other.range
+            && self.job_samples == other.job_samples
+            && self.cases == other.cases
     }
 
     /// Checks the header's own consistency: format name and version, job id shape, the
@@ -379,6 +485,21 @@ impl Begin {
                 "format_version {} is not supported (this reader knows 1..={FORMAT_VERSION})",
                 self.format_version
             ));
+        }
+        match (self.format_version, self.checkpoint_every) {
+            (1, None) => {}
+            (1, Some(_)) => {
+                return Err("checkpoint_every in a format_version 1 header".into());
+            }
+            (_, Some(n)) if (1..=MAX_CHECKPOINT_EVERY).contains(&n) => {}
+            (v, Some(n)) => {
+                return Err(format!(
+                    "checkpoint_every {n} is outside 1..={MAX_CHECKPOINT_EVERY} (format_version {v})"
+                ));
+            }
+            (v, None) => {
+                return Err(format!("format_version {v} needs checkpoint_every"));
+            }
         }
         if self.job_id.len() != 64
             || !self
@@ -405,7 +526,9 @@ impl Begin {
                     case.name, case.start, next
                 ));
             }
-            next += case.samples;
+            next = next
+                .checked_add(case.samples)
+                .ok_or_else(|| format!("case {:?}: sample counts overflow", case.name))?;
         }
         if next != self.job_samples {
             return Err(format!(
@@ -428,3 +551,6 @@ impl Begin {
 
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod tests_v2;

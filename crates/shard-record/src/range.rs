@@ -37,7 +37,7 @@ pub enum ShardRangeError {
         text: String,
     },
     /// Shard index out of range.
-    #[error("shard {index} of {count} does not exist: shards are numbered from 0 to {count} - 1")]
+    #[error("shard {index} of {count} does not exist: {}", if *count == 0 { "the shard count must be at least 1".to_string() } else { format!("shards are numbered 0 to {}", count - 1) })]
     NoSuchShard {
         /// The index given.
         index: u64,

@@ -4,8 +4,12 @@
 //! and reports it, so a writer can resume; it is strict about everything else (a corrupt line
 //! in the middle, an index out of order, a wrong digest), which no crash can produce.
 //! [`read_shard`] is the strict reader used by merging: it also requires a complete file.
+//!
+//! In a version-2 file, sample lines are held back until the next checkpoint (or the end
+//! line) verifies them: only then are they passed to `visit` and counted in the scan's
+//! digest and valid prefix (see the crate doc, "What is verified").
 
-use crate::{Begin, End, Record, Sample, SampleDigest};
+use crate::{Begin, End, Record, Sample, SampleDigest, sha256_hex};
 use std::fs::File;
 use std::io::{self, BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -72,15 +76,22 @@ pub enum Tail {
     },
 }
 
-/// What a scan found: the header, the digest of the valid sample lines, and how the file ends.
+/// What a scan found: the header, the digest of the verified sample lines, and how the file
+/// ends.
 #[derive(Debug, Clone)]
 pub struct ShardScan {
     /// The begin line.
     pub begin: Begin,
-    /// Digest (and count) of the valid sample lines.
+    /// SHA-256 (hex) of the begin line's bytes with its `\n`.
+    pub begin_sha256: String,
+    /// Digest (and count) of the verified sample lines (in a version-1 file: every whole one).
     pub digest: SampleDigest,
-    /// Byte length of the valid prefix: header, valid sample lines and, if complete, the end line.
+    /// Byte length of the verified prefix: header, verified sample lines with their
+    /// checkpoints and, if complete, the end line.
     pub valid_len: u64,
+    /// Whole sample lines after the last checkpoint of an incomplete version-2 file: not
+    /// verified, not visited, not in `digest` (a resuming writer solves them again).
+    pub unverified: u64,
     /// How the file ends.
     pub tail: Tail,
 }
@@ -132,114 +143,215 @@ pub fn scan_shard(
         Err(e) => return Err(corrupt(1, e)),
     };
     begin.check().map_err(|m| corrupt(1, m))?;
+    let begin_sha256 = sha256_hex(&buf);
+    let every = begin.checkpoint_every;
+    // The verified prefix, and the lines read since (held back until a checkpoint).
     let mut valid_len = n as u64;
     let mut digest = SampleDigest::new();
+    let mut pending_digest = SampleDigest::new();
+    let mut pending_len = 0u64;
+    let mut pending: Vec<(u64, Sample, Vec<u8>)> = Vec::new();
+    let mut last_checkpoint = 0;
     let mut line_no = 1;
+    let open = |begin: Begin, digest, valid_len, pending: usize, tail| ShardScan {
+        begin,
+        begin_sha256: begin_sha256.clone(),
+        digest,
+        valid_len,
+        unverified: pending as u64,
+        tail,
+    };
 
     loop {
         buf.clear();
         let n = reader.read_until(b'\n', &mut buf).map_err(io_err)?;
         if n == 0 {
-            return Ok(ShardScan {
-                begin,
-                digest,
-                valid_len,
-                tail: Tail::Open,
-            });
+            return Ok(open(begin, digest, valid_len, pending.len(), Tail::Open));
         }
         line_no += 1;
         if buf.last() != Some(&b'\n') {
-            return Ok(ShardScan {
-                begin,
-                digest,
-                valid_len,
-                tail: Tail::Torn { line: line_no },
-            });
+            let tail = Tail::Torn { line: line_no };
+            return Ok(open(begin, digest, valid_len, pending.len(), tail));
         }
-        match parse_record(&buf).map_err(|m| corrupt(line_no, m))? {
+        let read = pending_digest.samples();
+        let due = every.is_some_and(|k| read > last_checkpoint && read.is_multiple_of(k));
+        let record = parse_record(&buf).map_err(|m| corrupt(line_no, m))?;
+        if due && !matches!(record, Record::Checkpoint(_)) {
+            return Err(corrupt(
+                line_no,
+                format!(
+                    "a checkpoint line was due after sample line {} (checkpoint_every {})",
+                    pending_digest.samples(),
+                    every.unwrap_or(0)
+                ),
+            ));
+        }
+        match record {
             Record::Begin(_) => {
                 return Err(corrupt(line_no, "a second begin record".into()));
             }
             Record::Sample(sample) => {
-                let expected = begin.range.start + digest.samples();
-                if expected >= begin.range.end {
+                let expected = begin.range.start + pending_digest.samples();
+                check_sample(&begin, &sample, expected).map_err(|m| corrupt(line_no, m))?;
+                pending_digest.add_line(&buf, sample.angles().is_none());
+                pending_len += n as u64;
+                if every.is_none() {
+                    visit(line_no, &sample, &buf).map_err(|m| corrupt(line_no, m))?;
+                    digest = pending_digest.clone();
+                    valid_len += pending_len;
+                    pending_len = 0;
+                } else {
+                    pending.push((line_no, sample, buf.clone()));
+                }
+            }
+            Record::Checkpoint(checkpoint) => {
+                // Off schedule, a checkpoint may only be the last line: a stop checkpoint.
+                let stop = !due && every.is_some() && read > last_checkpoint;
+                if !due && !stop {
                     return Err(corrupt(
                         line_no,
                         format!(
-                            "sample line beyond the range {} (an end line was expected)",
-                            begin.range
+                            "a checkpoint line after sample line {} (checkpoint_every {})",
+                            pending_digest.samples(),
+                            every.map_or("absent: format_version 1".into(), |k| k.to_string())
                         ),
                     ));
                 }
-                if sample.index != expected {
-                    return Err(corrupt(
-                        line_no,
-                        format!("index {} where {expected} was expected", sample.index),
-                    ));
+                check_digests(
+                    &pending_digest,
+                    &begin_sha256,
+                    checkpoint.samples,
+                    &checkpoint.sha256,
+                    Some(&checkpoint.begin_sha256),
+                    true,
+                )
+                .map_err(|m| corrupt(line_no, format!("checkpoint: {m}")))?;
+                for (at, sample, bytes) in pending.drain(..) {
+                    visit(at, &sample, &bytes).map_err(|m| corrupt(at, m))?;
                 }
-                match begin.case_of(sample.index) {
-                    Some((case, k)) if case.name == sample.case && k == sample.sample => {}
-                    Some((case, k)) => {
+                digest = pending_digest.clone();
+                if stop {
+                    // The verified prefix ends before the stop checkpoint, which a resuming
+                    // writer cuts off so the finished file has only scheduled checkpoints.
+                    valid_len += pending_len;
+                    buf.clear();
+                    if reader.read_until(b'\n', &mut buf).map_err(io_err)? != 0 {
                         return Err(corrupt(
                             line_no,
                             format!(
-                                "index {} is sample {k} of case {:?}, but the line says sample {} of case {:?}",
-                                sample.index, case.name, sample.sample, sample.case
+                                "a checkpoint line after sample line {read} is neither due (checkpoint_every {}) nor the last line",
+                                every.unwrap_or(0)
                             ),
                         ));
                     }
-                    None => {
-                        return Err(corrupt(
-                            line_no,
-                            format!("index {} belongs to no case", sample.index),
-                        ));
-                    }
+                    return Ok(open(begin, digest, valid_len, 0, Tail::Open));
                 }
-                sample.check().map_err(|m| corrupt(line_no, m))?;
-                visit(line_no, &sample, &buf).map_err(|m| corrupt(line_no, m))?;
-                digest.add_line(&buf, sample.angles().is_none());
-                valid_len += n as u64;
+                valid_len += pending_len + n as u64;
+                pending_len = 0;
+                last_checkpoint = read;
             }
             Record::End(end) => {
-                let ours = digest.end();
-                if digest.samples() != begin.range.len() {
+                if pending_digest.samples() != begin.range.len() {
                     return Err(corrupt(
                         line_no,
                         format!(
                             "end line after {} sample lines; the range {} needs {}",
-                            digest.samples(),
+                            pending_digest.samples(),
                             begin.range,
                             begin.range.len()
                         ),
                     ));
                 }
-                if end != ours {
+                if end.failed != pending_digest.failed() {
                     return Err(corrupt(
                         line_no,
                         format!(
-                            "end line says {} samples, {} failed, sha256 {}; the sample lines give {} samples, {} failed, sha256 {}",
-                            end.samples,
+                            "end line says {} failed; the sample lines have {}",
                             end.failed,
-                            end.sha256,
-                            ours.samples,
-                            ours.failed,
-                            ours.sha256
+                            pending_digest.failed()
                         ),
                     ));
                 }
-                valid_len += n as u64;
+                check_digests(
+                    &pending_digest,
+                    &begin_sha256,
+                    end.samples,
+                    &end.sha256,
+                    end.begin_sha256.as_deref(),
+                    every.is_some(),
+                )
+                .map_err(|m| corrupt(line_no, format!("end line: {m}")))?;
+                for (at, sample, bytes) in pending.drain(..) {
+                    visit(at, &sample, &bytes).map_err(|m| corrupt(at, m))?;
+                }
+                digest = pending_digest;
+                valid_len += pending_len + n as u64;
                 buf.clear();
                 if reader.read_until(b'\n', &mut buf).map_err(io_err)? != 0 {
                     return Err(corrupt(line_no + 1, "data after the end line".into()));
                 }
-                return Ok(ShardScan {
-                    begin,
-                    digest,
-                    valid_len,
-                    tail: Tail::Complete(end),
-                });
+                return Ok(open(begin, digest, valid_len, 0, Tail::Complete(end)));
             }
         }
+    }
+}
+
+/// Checks a sample line against its place: the `expected` global index, inside the range,
+/// the case and within-case index the header gives it, and its fields against its status.
+fn check_sample(begin: &Begin, sample: &Sample, expected: u64) -> Result<(), String> {
+    if expected >= begin.range.end {
+        return Err(format!(
+            "sample line beyond the range {} (an end line was expected)",
+            begin.range
+        ));
+    }
+    if sample.index != expected {
+        return Err(format!(
+            "index {} where {expected} was expected",
+            sample.index
+        ));
+    }
+    match begin.case_of(sample.index) {
+        Some((case, k)) if case.name == sample.case && k == sample.sample => {}
+        Some((case, k)) => {
+            return Err(format!(
+                "index {} is sample {k} of case {:?}, but the line says sample {} of case {:?}",
+                sample.index, case.name, sample.sample, sample.case
+            ));
+        }
+        None => return Err(format!("index {} belongs to no case", sample.index)),
+    }
+    sample.check()
+}
+
+/// Checks a checkpoint's or end line's count and digests against the lines read.
+/// `need_begin`: the format requires the begin line's digest.
+fn check_digests(
+    lines: &SampleDigest,
+    begin_sha256: &str,
+    samples: u64,
+    sha256: &str,
+    claimed_begin: Option<&str>,
+    need_begin: bool,
+) -> Result<(), String> {
+    if samples != lines.samples() {
+        return Err(format!(
+            "says {samples} sample lines; {} were read",
+            lines.samples()
+        ));
+    }
+    let ours = lines.sha256();
+    if sha256 != ours {
+        return Err(format!(
+            "sha256 {sha256} does not match the sample lines' {ours} (a sample line was changed)"
+        ));
+    }
+    match (claimed_begin, need_begin) {
+        (Some(b), _) if b != begin_sha256 => Err(format!(
+            "begin_sha256 {b} does not match the begin line's {begin_sha256} (the header was changed)"
+        )),
+        (None, true) => Err("begin_sha256 is missing (format_version 2)".into()),
+        _ => Ok(()),
     }
 }
 

@@ -27,7 +27,7 @@ pub struct Cli {
 pub enum Command {
     /// Run every shard on this machine as concurrent processes, then merge into DIR/report.
     RunAll(RunAllArgs),
-    /// mc-shard's commands.
+    /// mc-shard's commands (completions and man pages are truss-mc's own).
     #[command(flatten)]
     Shard(mc_shard::cli::Command),
 }
@@ -39,20 +39,27 @@ pub struct RunAllArgs {
     #[arg(long)]
     pub job: PathBuf,
     /// Directory for the shard files; the report goes to DIR/report.
-    #[arg(long)]
+    #[arg(long, short = 'o')]
     pub out: PathBuf,
-    /// Number of shards (default: the number of workers).
+    /// Number of shards (1 to 1,000,000; default: the number of workers).
     #[arg(long)]
     pub shards: Option<u64>,
     /// Concurrent worker processes (default: all cores).
     #[arg(long)]
     pub workers: Option<usize>,
     /// Show no progress.
-    #[arg(long)]
+    #[arg(long, short = 'q')]
     pub quiet: bool,
-    /// Do not merge at the end.
+    /// Do not audit or merge at the end.
     #[arg(long)]
     pub no_merge: bool,
+    /// Sample lines re-solved and compared byte for byte before the merge (0: no audit).
+    #[arg(long, default_value_t = crate::run_all::DEFAULT_AUDIT_SAMPLES)]
+    pub audit_samples: u64,
+    /// Merge even with failed samples present, on the converged ones (mc-merge's
+    /// --allow-failed; the report says so in every affected case).
+    #[arg(long)]
+    pub allow_failed: bool,
 }
 
 /// An error of a command, with its exit code.
@@ -72,7 +79,8 @@ impl Error {
         match self {
             Error::Shard(e) => e.exit_code(),
             Error::RunAll(RunAllError::Run(e)) => run_exit_code(e),
-            Error::RunAll(RunAllError::Workers(_)) => truss_exit::VERIFICATION,
+            Error::RunAll(RunAllError::Workers(f)) => crate::run_all::worker_failure(f).0,
+            Error::RunAll(RunAllError::Audit(e)) => e.exit_code(),
             Error::RunAll(RunAllError::Merge(e)) => e.exit_code(),
             Error::RunAll(RunAllError::Interrupted { signal, .. }) => signal.exit_code(),
         }
@@ -93,14 +101,30 @@ impl Error {
 /// Runs a command, writing its report to `out`; progress goes to stderr.
 pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
     match cli.command {
+        Command::Shard(mc_shard::cli::Command::Completions(a)) => {
+            let mut cmd = <Cli as clap::CommandFactory>::command();
+            clap_complete::generate(a.shell, &mut cmd, "truss-mc", out);
+            Ok(())
+        }
+        Command::Shard(mc_shard::cli::Command::Man) => Ok(mc_shard::cli::man_page(
+            <Cli as clap::CommandFactory>::command(),
+            out,
+        )?),
         Command::Shard(command) => Ok(mc_shard::cli::run(mc_shard::cli::Cli { command }, out)?),
         Command::RunAll(a) => {
-            let job = Job::read(&a.job).map_err(CliError::from)?;
             let workers = a.workers.unwrap_or_else(default_threads);
-            if workers == 0 {
-                let usage = RunError::Usage("--workers must be at least 1".into());
+            mc_shard::cli::check_threads("workers", workers).map_err(CliError::from)?;
+            if let Some(k) = a.shards {
+                mc_shard::cli::check_shards(k).map_err(CliError::from)?;
+            }
+            if a.audit_samples > mc_shard::audit::MAX_AUDIT_SAMPLES {
+                let usage = RunError::Usage(format!(
+                    "--audit-samples must be at most {}",
+                    mc_shard::audit::MAX_AUDIT_SAMPLES
+                ));
                 return Err(CliError::Run(usage).into());
             }
+            let job = Job::read(&a.job).map_err(CliError::from)?;
             let options = RunAllOptions {
                 job_path: a.job.clone(),
                 out: a.out.clone(),
@@ -108,6 +132,8 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
                 workers,
                 quiet: a.quiet,
                 no_merge: a.no_merge,
+                audit_samples: a.audit_samples,
+                allow_failed: a.allow_failed,
             };
             let exe = std::env::current_exe().map_err(CliError::from)?;
             let started = Instant::now();

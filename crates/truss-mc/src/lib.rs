@@ -17,10 +17,15 @@
 //!
 //! ## Exit codes
 //!
-//! The scheme every truss-mc binary shares (`truss-exit`); `run-all` exits with the
-//! verification code (6) when a shard process failed, with the merge's code when the
-//! merge failed, and with 130 / 143 when SIGINT / SIGTERM stopped it (its workers stopped
-//! too, every finished sample kept; see [`run_all`]).
+//! The scheme every truss-mc binary shares (`truss-exit`); `run-all` exits with 2 for bad
+//! arguments (`--shards 0`, `--workers 0`) before anything starts, with 5 when a shard
+//! process met a file in the way (another job's shard, a damaged file: move it away), with
+//! the verification code (6) when a shard process failed otherwise or the audit before the
+//! merge found a line that differs from its re-solve, with the merge's code when the merge
+//! failed (7 for failed samples: rerun with `--allow-failed`), and with 130 / 143 when
+//! SIGINT / SIGTERM stopped it (its workers stopped too, every finished sample kept; see
+//! [`run_all`]). `truss-mc completions bash|zsh|fish` and `truss-mc man` print its shell
+//! completions and man page.
 
 pub mod cli;
 pub mod run_all;

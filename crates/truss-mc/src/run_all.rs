@@ -6,7 +6,15 @@
 //! i/K --threads 1 --quiet` (mc-shard's `run`) (so a crash of one loses only its sample in flight, and a rerun
 //! resumes every shard where it stopped). tokio runs the children and a single progress
 //! display that counts the sample lines the shard files have gained. When all shards are
-//! complete the directory is merged with mc-merge into `DIR/report`.
+//! complete, a seeded sample of [`DEFAULT_AUDIT_SAMPLES`] lines is re-solved and compared
+//! byte for byte (`mc-shard audit`; `--audit-samples N`, 0 to skip; exit 6 on a mismatch),
+//! then the directory is merged with mc-merge into `DIR/report` (`--allow-failed` passed
+//! on).
+//!
+//! **Failed shard processes** map to one exit code and advice ([`worker_failure`]): a file
+//! in the way (another job's shard, a damaged or locked file: 5) is named with the advice to
+//! move it away, since a rerun would meet it again; otherwise 6 and "run the same command
+//! again to resume".
 //!
 //! **Interrupts.** On SIGINT or SIGTERM sent to `run-all` alone (`kill PID`, a supervisor, a
 //! batch system's time limit) or to its whole process group (Ctrl-C), no further shard
@@ -32,11 +40,15 @@ pub enum RunAllError {
     /// The job, the shard directory or the arguments.
     #[error(transparent)]
     Run(#[from] RunError),
-    /// Shard processes failed (each with its stderr).
-    #[error("{} shard process(es) failed: {}; run the same command again to resume them", .0.len(), .0.join("; "))]
-    Workers(Vec<String>),
+    /// Shard processes failed (each with its exit code and stderr); the code `run-all`
+    /// exits with and the advice follow from the children's codes ([`worker_failure`]).
+    #[error("{} shard process(es) failed: {}; {}", .0.len(), .0.iter().map(|(_, m)| m.as_str()).collect::<Vec<_>>().join("; "), worker_failure(.0).1)]
+    Workers(Vec<(u8, String)>),
+    /// The audit before the merge could not be completed, or found lines that differ.
+    #[error("{0}")]
+    Audit(mc_shard::cli::CliError),
     /// The merge failed.
-    #[error("merge failed: {0}")]
+    #[error("merge failed: {0}{hint}", hint = merge_hint(.0))]
     Merge(mc_merge::MergeError),
     /// Stopped by SIGINT or SIGTERM; `kept` sample lines are in the shard files.
     #[error("{}", mc_shard::interrupt::message(*.kept))]
@@ -47,6 +59,46 @@ pub enum RunAllError {
         kept: u64,
     },
 }
+
+/// The exit code and advice for failed shard processes: a file in the way (5: another
+/// job's shard, a damaged or locked file) when any child says so, which a rerun does not
+/// cure; the children's own code when they agree on another (a usage or input error);
+/// otherwise the verification code (6), which a rerun resumes.
+pub fn worker_failure(failures: &[(u8, String)]) -> (u8, &'static str) {
+    if failures.iter().any(|(c, _)| *c == truss_exit::IN_THE_WAY) {
+        return (
+            truss_exit::IN_THE_WAY,
+            "a file is in the way: move it away (or use another --out), then run the same command again; the other shards are kept",
+        );
+    }
+    match failures.first() {
+        Some((c, _))
+            if failures.iter().all(|(d, _)| d == c)
+                && [truss_exit::USAGE, truss_exit::INVALID_INPUT, truss_exit::IO].contains(c) =>
+        {
+            (
+                *c,
+                "fix the cause above, then run the same command again to resume",
+            )
+        }
+        _ => (
+            truss_exit::VERIFICATION,
+            "run the same command again to resume them",
+        ),
+    }
+}
+
+/// What `run-all` adds to a merge error: for failed samples, that it takes `--allow-failed`.
+fn merge_hint(e: &mc_merge::MergeError) -> &'static str {
+    if e.exit_code() == truss_exit::FAILED_SAMPLES {
+        " (run-all takes --allow-failed too: rerun the same command with it; the finished shards are kept)"
+    } else {
+        ""
+    }
+}
+
+/// Sample lines `run-all` audits before it merges, by default.
+pub const DEFAULT_AUDIT_SAMPLES: u64 = 32;
 
 /// Options of `run-all`.
 #[derive(Debug, Clone)]
@@ -63,6 +115,10 @@ pub struct RunAllOptions {
     pub quiet: bool,
     /// Skip the merge.
     pub no_merge: bool,
+    /// Lines to audit before the merge (0: none).
+    pub audit_samples: u64,
+    /// Merge with failed samples present (mc-merge's `--allow-failed`).
+    pub allow_failed: bool,
 }
 
 /// Runs every shard with child processes of the executable `exe`, then merges; writes the
@@ -151,16 +207,40 @@ async fn run_and_merge(
     if options.no_merge {
         return Ok(Vec::new());
     }
+    let mut table = Vec::new();
+    if options.audit_samples > 0 {
+        let audit_options = mc_shard::audit::AuditOptions {
+            samples: options.audit_samples,
+            seed: 0,
+            threads: options.workers.max(1),
+        };
+        let (job, out) = (job.clone(), options.out.clone());
+        let auditing = tokio::task::spawn_blocking(move || {
+            let report = mc_shard::audit::audit(&job, &[out], &audit_options)
+                .map_err(|e| RunAllError::Audit(e.into()))?;
+            let mut line = Vec::new();
+            mc_shard::cli::audit_result(&report, &mut line).map_err(RunAllError::Audit)?;
+            Ok::<_, RunAllError>(line)
+        });
+        tokio::select! {
+            done = auditing => match done {
+                Ok(result) => table.extend(result?),
+                Err(e) => return Err(RunError::Usage(format!("the audit panicked: {e}")).into()),
+            },
+            signal = signals.recv() => return Err(RunAllError::Interrupted { signal, kept: 0 }),
+        }
+    }
     let merge = mc_merge::Options {
         paths: vec![options.out.clone()],
         out: Some(options.out.join("report")),
         plots: true,
-        settings: mc_merge::Settings::default(),
+        settings: mc_merge::Settings {
+            allow_failed: options.allow_failed,
+            ..mc_merge::Settings::default()
+        },
     };
-    let merging = tokio::task::spawn_blocking(move || {
-        let mut table = Vec::new();
-        mc_merge::run(&merge, &mut table).map(|_| table)
-    });
+    let merging =
+        tokio::task::spawn_blocking(move || mc_merge::run(&merge, &mut table).map(|_| table));
     tokio::select! {
         done = merging => match done {
             Ok(result) => result.map_err(RunAllError::Merge),
@@ -174,14 +254,15 @@ async fn run_and_merge(
 pub const GRACE: Duration = Duration::from_secs(10);
 
 /// Runs the shard processes, at most `workers` at once, with one progress display; returns
-/// a description of each that failed, and the signal that interrupted the run if one did.
+/// the exit code and a description of each that failed, and the signal that interrupted the
+/// run if one did.
 async fn run_children(
     exe: &Path,
     job: &Job,
     ranges: &[ShardRange],
     options: &RunAllOptions,
     signals: &mut Signals,
-) -> Result<(Vec<String>, Option<Signal>), RunError> {
+) -> Result<(Vec<(u8, String)>, Option<Signal>), RunError> {
     let k = ranges.len();
     // Progress: the sample lines the shard files hold before any child starts (kept from
     // an interrupted run: not counted in the rate), then the lines they gain.
@@ -215,7 +296,9 @@ async fn run_children(
             }
             let child = match cmd.spawn() {
                 Ok(child) => child,
-                Err(e) => return Some(format!("shard {i}/{k}: cannot start: {e}")),
+                Err(e) => {
+                    return Some((truss_exit::IO, format!("shard {i}/{k}: cannot start: {e}")));
+                }
             };
             let pid = child.id();
             let output = child.wait_with_output();
@@ -233,11 +316,17 @@ async fn run_children(
             };
             match output {
                 Ok(o) if o.status.success() => None,
-                Ok(o) => Some(format!(
-                    "shard {i}/{k}: {}",
-                    String::from_utf8_lossy(&o.stderr).trim()
+                Ok(o) => Some((
+                    o.status
+                        .code()
+                        .and_then(|c| u8::try_from(c).ok())
+                        .unwrap_or(truss_exit::VERIFICATION),
+                    format!(
+                        "shard {i}/{k}: {}",
+                        String::from_utf8_lossy(&o.stderr).trim()
+                    ),
                 )),
-                Err(e) => Some(format!("shard {i}/{k}: cannot run: {e}")),
+                Err(e) => Some((truss_exit::IO, format!("shard {i}/{k}: cannot run: {e}"))),
             }
         });
     }
@@ -250,7 +339,7 @@ async fn run_children(
             done = tasks.join_next() => match done {
                 Some(Ok(Some(failure))) => failures.push(failure),
                 Some(Ok(None)) => {}
-                Some(Err(e)) => failures.push(format!("a task panicked: {e}")),
+                Some(Err(e)) => failures.push((truss_exit::INTERNAL, format!("a task panicked: {e}"))),
                 None => break,
             },
             signal = signals.recv(), if interrupted.is_none() => {
@@ -269,8 +358,8 @@ async fn run_children(
     Ok((failures, interrupted))
 }
 
-/// Counts the sample lines appended to `path` since `offset` (header and end lines not
-/// counted, at most `max` in all), advancing `offset`; returns how many are new.
+/// Counts the sample lines appended to `path` since `offset` (header, checkpoint and end
+/// lines not counted, at most `max` in all), advancing `offset`; returns how many are new.
 fn count_new_lines(path: &Path, offset: &mut u64, lines: &mut u64, max: u64) -> u64 {
     use std::io::{Read, Seek, SeekFrom};
     let Ok(mut f) = std::fs::File::open(path) else {
@@ -291,10 +380,12 @@ fn count_new_lines(path: &Path, offset: &mut u64, lines: &mut u64, max: u64) -> 
     }
     let end = buf.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
     *offset += end as u64;
-    let newlines = buf[..end].iter().filter(|&&b| b == b'\n').count() as u64;
-    // The first line is the header; the last, once complete, the end line.
-    let total = (*lines + newlines).saturating_sub(1).min(max);
-    let before = lines.saturating_sub(1).min(max);
-    *lines += newlines;
+    let samples = buf[..end]
+        .split(|&b| b == b'\n')
+        .filter(|l| l.starts_with(br#"{"record":"sample""#))
+        .count() as u64;
+    let total = (*lines + samples).min(max);
+    let before = (*lines).min(max);
+    *lines += samples;
     total - before
 }

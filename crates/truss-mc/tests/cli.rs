@@ -74,8 +74,9 @@ fn run_all_runs_every_shard_then_merges() {
 }
 
 /// Exit codes of `run-all`: an invalid job is refused with mc-shard's code 3 before anything
-/// starts, bad arguments with 2, and a shard process that fails (here: its file is in the
-/// way, a damaged file of no job) with 6, naming the shard, while the other shard completes.
+/// starts, bad arguments with 2 (`--shards 0` at once), and a shard process that fails
+/// because its file is in the way (a damaged file of no job, another job's shard) with 5,
+/// naming the shard and advising to move the file, while the other shard completes.
 #[test]
 fn run_all_exit_codes() {
     let dir = tempfile::tempdir().unwrap();
@@ -105,6 +106,12 @@ fn run_all_exit_codes() {
     );
     let job = write(dir.path(), "job.json", &small_job(10));
     assert_eq!(call(args(&job, &["--workers", "0"])).status.code(), Some(2));
+    let started = std::time::Instant::now();
+    let r = call(args(&job, &["--shards", "0"]));
+    assert_eq!(r.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&r.stderr).contains("--shards must be 1 to"));
+    assert!(started.elapsed().as_secs_f64() < 5.0);
+    assert!(!out.exists(), "nothing started");
     std::fs::create_dir_all(&out).unwrap();
     std::fs::write(
         out.join("shard-0000000000-0000000010.jsonl"),
@@ -113,9 +120,122 @@ fn run_all_exit_codes() {
     .unwrap();
     let r = call(args(&job, &["--shards", "2", "--workers", "2"]));
     let stderr = String::from_utf8_lossy(&r.stderr);
-    assert_eq!(r.status.code(), Some(6), "{stderr}");
+    assert_eq!(r.status.code(), Some(5), "{stderr}");
     assert!(stderr.contains("shard 0/2"), "{stderr}");
+    assert!(stderr.contains("move it away"), "{stderr}");
+    assert!(
+        !stderr.contains("run the same command again to resume them"),
+        "{stderr}"
+    );
     assert_eq!(sample_lines(&out).len(), 10, "the other shard completed");
+
+    // Another job's shards in the directory: 5 and the same advice.
+    let other = dir.path().join("other");
+    let job2 = write(
+        dir.path(),
+        "job2.json",
+        &small_job(10).replace("\"seed\": 7", "\"seed\": 8"),
+    );
+    let r = truss_mc(
+        &[
+            "run",
+            "--job",
+            job2.to_str().unwrap(),
+            "-o",
+            other.to_str().unwrap(),
+            "--shard",
+            "0/2",
+            "-q",
+        ],
+        &[],
+    );
+    assert!(r.status.success());
+    let r = truss_mc(
+        &[
+            "run-all",
+            "--job",
+            job.to_str().unwrap(),
+            "-o",
+            other.to_str().unwrap(),
+            "--shards",
+            "2",
+            "-q",
+        ],
+        &[],
+    );
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(5), "{stderr}");
+    assert!(
+        stderr.contains("holds a shard of job") && stderr.contains("move it away"),
+        "{stderr}"
+    );
+}
+
+/// Failed samples: the merge's code 7 with advice `run-all` accepts (`--allow-failed`),
+/// which then merges. The failed samples are forged into a complete shard (fresh digests),
+/// so the audit before the merge, on by default, finds the forgery first (6).
+#[test]
+fn run_all_failed_samples_advice_and_audit() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "job.json", &small_job(20));
+    let out = dir.path().join("o");
+    let base = |extra: &[&str]| {
+        let mut a = vec![
+            "run-all",
+            "--job",
+            job.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--shards",
+            "1",
+            "-q",
+        ];
+        a.extend_from_slice(extra);
+        truss_mc(&a, &[])
+    };
+    let r = base(&["--no-merge"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    common::forge_shard(&common::only_shard(&out), |s| {
+        if s.index == 3 {
+            s.status = shard_record::Status::Failed;
+            s.theta_p = None;
+            s.tan_theta_x = None;
+            s.tan_theta_y = None;
+            s.residual = None;
+            s.slack_cables = None;
+            s.reason = Some("forged".into());
+        }
+    });
+    // The default audit re-solves 32 of the 40 lines: whether it meets index 3 depends on
+    // the seed, so all 40 are audited here.
+    let r = base(&["--audit-samples", "40"]);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(6), "{stderr}");
+    assert!(
+        stderr.contains("index 3 (case \"normal\", sample 3)"),
+        "{stderr}"
+    );
+    let r = base(&["--audit-samples", "0"]);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(7), "{stderr}");
+    assert!(stderr.contains("run-all takes --allow-failed"), "{stderr}");
+    let r = base(&["--audit-samples", "0", "--allow-failed"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(out.join("report/report.json").exists());
+}
+
+/// Completions and the man page of truss-mc name its own run-all.
+#[test]
+fn truss_mc_completions_and_man() {
+    let r = truss_mc(&["completions", "bash"], &[]);
+    assert!(r.status.success());
+    assert!(String::from_utf8_lossy(&r.stdout).contains("run-all"));
+    let r = truss_mc(&["man"], &[]);
+    let text = String::from_utf8_lossy(&r.stdout);
+    assert!(
+        text.contains(".TH truss-mc-run-all") && text.contains("audit"),
+        "{text}"
+    );
 }
 
 /// The pids whose parent is `pid` (from /proc).

@@ -341,7 +341,7 @@ fn exit_codes() {
         Some(2)
     );
     assert_eq!(run(&good, &out, &["--shard", "3/3"]).status.code(), Some(2));
-    let plan = mc_shard(&["plan", good.to_str().unwrap()], &[]);
+    let plan = mc_shard(&["plan", "--job", good.to_str().unwrap()], &[]);
     assert!(plan.status.success());
     let id = mc_shard_job_id(&good);
     assert!(String::from_utf8_lossy(&plan.stdout).contains(&id));
@@ -357,7 +357,7 @@ fn mc_shard_job_id(job: &Path) -> String {
 fn plan_advises_no_cluster_for_a_small_job() {
     let dir = tempfile::tempdir().unwrap();
     let job = write(dir.path(), "job.json", &small_job(20));
-    let plan = mc_shard(&["plan", job.to_str().unwrap()], &[]);
+    let plan = mc_shard(&["plan", "--job", job.to_str().unwrap()], &[]);
     assert!(plan.status.success());
     let text = String::from_utf8_lossy(&plan.stdout);
     let advice = text.lines().last().unwrap();
@@ -370,7 +370,7 @@ fn plan_advises_no_cluster_for_a_small_job() {
         !text.contains("1 shards") && !text.contains("cluster,"),
         "{text}"
     );
-    let json = mc_shard(&["plan", job.to_str().unwrap(), "--json"], &[]);
+    let json = mc_shard(&["plan", "--job", job.to_str().unwrap(), "--json"], &[]);
     let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
     assert_eq!(v["suggested"]["cluster_advised"], false);
 }

@@ -157,7 +157,13 @@ fn work_stops_on_sigterm_and_releases_its_claim() {
         "{stderr}"
     );
     assert!(String::from_utf8_lossy(&o.stdout).contains(r#""action":"interrupted""#));
-    let claims = std::fs::read_dir(out.join("claims")).unwrap().count();
+    let claims = std::fs::read_dir(out.join("claims"))
+        .unwrap()
+        .filter(|e| {
+            let name = e.as_ref().unwrap().file_name();
+            name.to_string_lossy().ends_with(".claim")
+        })
+        .count();
     assert_eq!(claims, 0, "the interrupted shard's claim is released");
     run_ok(&args);
     assert_eq!(sample_lines(&out).len(), 12_000);

@@ -7,5 +7,8 @@ mod common;
 mod determinism;
 mod interrupt;
 mod job;
+mod pool;
 mod sampling;
+mod schema;
+mod verify;
 mod work;

@@ -78,7 +78,8 @@ fn concurrent_workers_with_one_killed_finish_every_shard_exactly_once() {
 
     let shared = dir.path().join("shared");
     let mut workers: Vec<Child> = (0..4).map(|_| worker(&job, &shared)).collect();
-    // Find a worker in the middle of a shard: its claim exists and its shard file has lines.
+    // Find a worker in the middle of a shard: its claim exists and its shard file has lines
+    // up to a checkpoint.
     let claims = shared.join("claims");
     let deadline = Instant::now() + Duration::from_secs(120);
     let victim_pid = loop {
@@ -98,7 +99,9 @@ fn concurrent_workers_with_one_killed_finish_every_shard_exactly_once() {
                     .len();
                 let claim: serde_json::Value =
                     serde_json::from_str(&std::fs::read_to_string(e.path()).ok()?).ok()?;
-                (len > 2000).then(|| claim["pid"].as_u64().unwrap() as u32)
+                // Past the first checkpoint (100 lines of about 250 bytes), so that the
+                // killed worker leaves verified lines for the takeover to keep.
+                (len > 40_000).then(|| claim["pid"].as_u64().unwrap() as u32)
             })
         });
         if let Some(pid) = found {

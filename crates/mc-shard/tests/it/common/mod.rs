@@ -46,3 +46,34 @@ pub fn sample_lines(dir: &Path) -> Vec<String> {
         })
         .collect()
 }
+
+/// Rewrites the complete shard file `path` with `edit` applied to its samples and fresh,
+/// valid digests: a forged file that every digest check passes.
+pub fn forge_shard(path: &Path, edit: impl Fn(&mut shard_record::Sample)) {
+    use shard_record::{Record, ShardEncoder, Status, parse_record};
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let Ok(Record::Begin(begin)) = parse_record(lines.next().unwrap().as_bytes()) else {
+        panic!("no header")
+    };
+    let (mut encoder, mut out) = ShardEncoder::new(&begin);
+    for line in lines {
+        if let Ok(Record::Sample(mut s)) = parse_record(line.as_bytes()) {
+            edit(&mut s);
+            encoder.push(s.to_line().as_bytes(), s.status == Status::Failed, &mut out);
+        }
+    }
+    out.extend_from_slice(&encoder.end().1);
+    std::fs::write(path, out).unwrap();
+}
+
+/// The only `.jsonl` shard file in `dir`.
+pub fn only_shard(dir: &Path) -> PathBuf {
+    let files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "jsonl"))
+        .collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    files[0].clone()
+}
