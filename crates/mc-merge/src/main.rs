@@ -9,13 +9,8 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     // Usage errors exit with clap's code 2, which is ExitCodes::USAGE.
     let args = Args::parse();
-    let export = args.export.clone();
-    let out = &mut std::io::stdout().lock();
-    let result = args.validate().and_then(|options| match &export {
-        Some(to) => mc_merge::export::run(&options, to, out),
-        None => mc_merge::run(&options, out).map(|_| ()),
-    });
-    match result {
+    // A helper command, an export or a merge (see `Args::execute`).
+    match args.execute(&mut std::io::stdout().lock()) {
         Ok(()) => ExitCode::from(ExitCodes::OK),
         Err(e) => {
             eprintln!("mc-merge: error: {e}");
