@@ -7,11 +7,16 @@
 //! which member-length tolerance σ meets the pointing budget.
 //!
 //! ```text
-//! mc-merge DIR_OR_FILES... [--out REPORT_DIR] [--percentiles 50,90,95,99] [--confidence 0.95]
-//!          [--replicates 2000] [--bootstrap-seed 20210325] [--gof-replicates 1000]
-//!          [--gof-level 0.05] [--target-angle 9.69e-5] [--target-percentile 95]
-//!          [--threads N] [--allow-partial] [--allow-failed] [--no-plots]
+//! mc-merge DIR_OR_FILES... [-o|--out REPORT_DIR] [-q|--quiet] [--percentiles 50,90,95,99]
+//!          [--confidence 0.95] [--replicates 2000] [--bootstrap-seed 20210325]
+//!          [--gof-replicates 1000] [--gof-level 0.05] [--target-angle 9.69e-5]
+//!          [--target-percentile 95] [--threads N] [--allow-partial] [--allow-failed]
+//!          [--no-plots] [--export FILE.csv|FILE.jsonl]
+//! mc-merge completions bash|zsh|fish|elvish|powershell
+//! mc-merge man
 //! ```
+//!
+//! Every numeric flag has a documented limit, refused naming the flag ([`cli`]).
 //!
 //! The binary is a thin shell around [`run`]; the statistics are reusable functions:
 //! [`quantile`] (definition-1 percentiles, weighted percentiles, order-statistic interval),
@@ -64,8 +69,12 @@
 //!
 //! ## 4. Output
 //!
-//! With `--out REPORT_DIR`: `report.json` (schema in [`report`]; summary below) and SVG plots
-//! ([`plot`]). Always: a table on stdout (angles in rad and arcsec).
+//! With `--out REPORT_DIR`: `report.json` (schema in [`report`], summary below, and the
+//! standalone JSON Schema `docs/report.schema.json`), written atomically into a directory
+//! that holds no other job's report ([`report_dir`]), and SVG and PNG plots ([`plot`]).
+//! Unless `--quiet`: a table on stdout (angles in rad and arcsec). With `--export FILE`: every
+//! sample as a flat row ([`export`]; for pandas, `read_json(…, lines=True,
+//! precise_float=True)`).
 //!
 //! ### report.json
 //!
