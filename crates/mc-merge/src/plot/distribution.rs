@@ -158,7 +158,7 @@ pub fn theta(
         legend.add(
             Swatch::Text,
             format!(
-                "{beyond} of {} samples ({}) lie beyond the axis end at {} µrad, the largest at {} µrad: see the exceedance plot",
+                "{beyond} of {} samples ({}) lie beyond {} µrad (largest {} µrad): see the exceedance plot",
                 rep.n,
                 percent(beyond as f64 / thetas.len() as f64),
                 number(round_sig(hi, 4)),
@@ -490,10 +490,11 @@ pub fn exceedance(
     let mut marks: Vec<(f64, f64, RGBColor)> = vec![];
     for (k, p) in [pct / 100.0, 0.99, 0.999].into_iter().enumerate() {
         // A percentile is marked only where at least 10 samples lie above it.
-        if (1.0 - p) * nf >= 10.0 && !marks.iter().any(|m| m.0 == p) {
-            if let Some(q) = crate::quantile::quantile_sorted(&thetas, p) {
-                marks.push((p, q, palette(k + 3)));
-            }
+        if (1.0 - p) * nf >= 10.0
+            && !marks.iter().any(|m| m.0 == p)
+            && let Some(q) = crate::quantile::quantile_sorted(&thetas, p)
+        {
+            marks.push((p, q, palette(k + 3)));
         }
     }
     let mut legend = Legend::default();

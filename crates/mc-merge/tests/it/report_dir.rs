@@ -49,7 +49,7 @@ fn same_job_reuses_the_directory_and_clears_its_own_plots() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    assert!(listing(out.path()).contains(&"theta_p-a.png".to_string()));
+    assert!(listing(out.path()).contains(&"theta_p-a.svg".to_string()));
     // Again without plots: the earlier plots do not stay beside the new report.
     let o = merge(shards.path(), out.path(), &["--no-plots"]);
     assert_eq!(

@@ -64,20 +64,20 @@ fn validate(root: &Value, schema: &Value, value: &Value, at: &str, errors: &mut 
             return;
         }
     }
-    if let Some(c) = s.get("const") {
-        if value != c {
-            errors.push(format!("{at}: {value} is not {c}"));
-        }
+    if let Some(c) = s.get("const")
+        && value != c
+    {
+        errors.push(format!("{at}: {value} is not {c}"));
     }
-    if let Some(Value::Array(options)) = s.get("enum") {
-        if !options.contains(value) {
-            errors.push(format!("{at}: {value} is not one of {options:?}"));
-        }
+    if let Some(Value::Array(options)) = s.get("enum")
+        && !options.contains(value)
+    {
+        errors.push(format!("{at}: {value} is not one of {options:?}"));
     }
-    if let (Some(min), Some(v)) = (s.get("minimum").and_then(Value::as_f64), value.as_f64()) {
-        if v < min {
-            errors.push(format!("{at}: {v} is below {min}"));
-        }
+    if let (Some(min), Some(v)) = (s.get("minimum").and_then(Value::as_f64), value.as_f64())
+        && v < min
+    {
+        errors.push(format!("{at}: {v} is below {min}"));
     }
     if let Value::Object(map) = value {
         let props = s.get("properties").and_then(Value::as_object);
