@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # smoke-test.sh: the README's main command (truss-mc run-all) on a small job, checked end
-# to end: shards written, merged, report.json present, and every SVG plot renders to a PNG
-# (rsvg-convert parses and rasterises it; a malformed SVG fails).
+# to end: shards written, merged, report.json present, every SVG plot renders to a PNG
+# (rsvg-convert parses and rasterises it; a malformed SVG fails), and mc-merge wrote its own
+# PNG beside each SVG.
 #
 # Usage: scripts/smoke-test.sh     (needs target/release/truss-mc and rsvg-convert)
 set -euo pipefail
@@ -24,10 +25,15 @@ JOB
 grep -q "run-all: 4000 samples in 4 shards" "$WORK/out.txt" || { cat "$WORK/out.txt"; exit 1; }
 [[ -s "$WORK/run/report/report.json" ]] || { echo "smoke: no report.json" >&2; exit 1; }
 n=0
+mkdir "$WORK/check"
 for svg in "$WORK"/run/report/*.svg; do
-    rsvg-convert -o "${svg%.svg}.png" "$svg"
-    [[ -s "${svg%.svg}.png" ]] || { echo "smoke: $svg did not render" >&2; exit 1; }
+    name="$(basename "${svg%.svg}")"
+    rsvg-convert -o "$WORK/check/$name.png" "$svg"
+    [[ -s "$WORK/check/$name.png" ]] || { echo "smoke: $svg did not render" >&2; exit 1; }
+    # mc-merge's own PNG (resvg) beside it.
+    [[ "$(head -c 4 "${svg%.svg}.png" | tail -c 3)" == PNG ]] || { echo "smoke: no PNG for $svg" >&2; exit 1; }
     n=$((n + 1))
 done
-((n >= 5)) || { echo "smoke: expected at least 5 plots, found $n" >&2; exit 1; }
-echo "smoke: run-all, merge and $n plots rendered" >&2
+# 2 cases x 5 plots + the σ sweep.
+((n >= 11)) || { echo "smoke: expected at least 11 plots, found $n" >&2; exit 1; }
+echo "smoke: run-all, merge and $n plots rendered (SVG by rsvg-convert, PNG by mc-merge)" >&2

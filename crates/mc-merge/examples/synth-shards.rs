@@ -29,6 +29,10 @@ struct Args {
     /// Cases of the σ-sweep.
     #[arg(long, default_value_t = 1)]
     cases: u64,
+    /// The σ of the sweep's cases in mm, comma separated (instead of 0.0033·k for k = 1..=cases),
+    /// e.g. the paper's 0.0033,0.0067,0.017,0.033,0.067,0.0063.
+    #[arg(long, value_delimiter = ',')]
+    sigmas: Vec<f64>,
     /// Add a 1..=8 stages sweep at σ = 0.067 mm.
     #[arg(long)]
     stages: bool,
@@ -44,8 +48,12 @@ fn main() {
     let a = Args::parse();
     let per_mm = 3.96e-5 / 6.30e-3;
     let mut cases = vec![];
-    for k in 1..=a.cases {
-        let sigma = 0.0033 * k as f64;
+    let sigmas: Vec<f64> = if a.sigmas.is_empty() {
+        (1..=a.cases).map(|k| 0.0033 * k as f64).collect()
+    } else {
+        a.sigmas.clone()
+    };
+    for &sigma in &sigmas {
         cases.push(SynthCase::rayleigh(
             &format!("sigma-{sigma:.4}"),
             a.samples,

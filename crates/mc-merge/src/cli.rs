@@ -1,8 +1,20 @@
-//! The command line: raw flags ([`Args`], parsed by clap) validated into [`Options`].
+//! The command line: raw flags ([`Args`], parsed by clap) validated into [`Options`], and the
+//! two helper commands `completions SHELL` and `man`.
+//!
+//! `mc-merge` takes its shard directories positionally, so the helper commands are clap
+//! subcommands that conflict with every merge flag (`args_conflicts_with_subcommands`): a
+//! merge is `mc-merge DIRS… [FLAGS]`, and `mc-merge completions bash` or `mc-merge man` print
+//! to stdout and do nothing else. A shard directory literally named `man` or `completions` is
+//! given as `./man`.
+//!
+//! Every numeric flag has a documented range ([`MAX_REPLICATES`], [`MAX_GOF_REPLICATES`],
+//! [`MAX_PERCENTILES`], [`MAX_THREADS`], [`MAX_TARGET_ANGLE`]); a value outside it is refused
+//! before anything is read, naming the flag, instead of exhausting memory.
 
 use crate::errors::MergeError;
-use clap::Parser;
+use clap::{CommandFactory, Parser, Subcommand};
 use serde::Serialize;
+use std::io::Write;
 use std::path::PathBuf;
 
 /// The default seed of the bootstrap and of the goodness-of-fit null simulation.
@@ -14,12 +26,32 @@ pub const DEFAULT_TARGET_ANGLE: f64 = 9.69e-5;
 /// Radians to arcseconds: 648000/π.
 pub const ARCSEC_PER_RAD: f64 = 648_000.0 / std::f64::consts::PI;
 
+/// The most bootstrap replicates `--replicates` accepts. The replicate percentiles are kept
+/// (8 bytes × percentiles × B), and the time grows as B × n: 100,000 replicates of 50,000
+/// samples take about half a minute; B = 2000 already puts the Monte Carlo error of a 95 %
+/// interval's ends well below the interval's width.
+pub const MAX_REPLICATES: u32 = 100_000;
+
+/// The most null samples `--gof-replicates` accepts (each is a simulated sample of the
+/// case's size, up to the calibration's cap).
+pub const MAX_GOF_REPLICATES: u32 = 100_000;
+
+/// The most percentiles `--percentiles` accepts (each one is bootstrapped).
+pub const MAX_PERCENTILES: usize = 64;
+
+/// The most worker threads `--threads` accepts.
+pub const MAX_THREADS: usize = 1024;
+
+/// The largest target angle `--target-angle` accepts, in rad: a tilt below a right angle.
+pub const MAX_TARGET_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
+
 const AFTER_HELP: &str = "\
 Exit codes (the scheme every truss-mc binary shares):
   0  the shards verified and the report was written
   1  internal error (a bug)
   2  usage error (bad flag or value)
   4  I/O error reading shards or writing the report
+  5  a file in the way: the report directory holds another job's report.json
   6  verification failure: a torn, corrupt or incomplete shard, another job id, a wrong digest,
      a missing index range, or overlapping shards that disagree
   7  failed samples present (give --allow-failed to compute on the converged ones)
@@ -30,18 +62,34 @@ the shard files are given.";
 
 /// Merges Monte Carlo shard files of one job into percentiles of the distortion angle θ_P with
 /// bootstrap confidence intervals, the paper's Rayleigh law with goodness of fit, sweeps over
-/// σ and the number of stages with the allowable σ, and SVG plots.
+/// σ and the number of stages with the allowable σ, and SVG and PNG plots.
 #[derive(Debug, Clone, Parser)]
-#[command(name = "mc-merge", version, about, after_help = AFTER_HELP)]
+#[command(
+    name = "mc-merge",
+    version,
+    about,
+    after_help = AFTER_HELP,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 pub struct Args {
+    /// A helper command instead of a merge.
+    #[command(subcommand)]
+    pub command: Option<Helper>,
+
     /// Shard files, or directories whose *.jsonl files are read.
     #[arg(required = true, value_name = "DIR_OR_FILES")]
     pub paths: Vec<PathBuf>,
 
-    /// Directory for report.json and the SVG plots (created if needed). Without it only the
-    /// table is printed.
-    #[arg(long, value_name = "REPORT_DIR")]
+    /// Directory for report.json and the plots (created if needed). A directory holding
+    /// another job's report is refused; our own earlier files in it are replaced. Without it
+    /// only the table is printed.
+    #[arg(short = 'o', long, value_name = "REPORT_DIR")]
     pub out: Option<PathBuf>,
+
+    /// Print nothing on success (errors still go to stderr).
+    #[arg(short = 'q', long)]
+    pub quiet: bool,
 
     /// Percentiles of θ_P to estimate, in percent, comma separated, each strictly between 0 and 100.
     #[arg(long, value_delimiter = ',', default_value = "50,90,95,99")]
@@ -51,7 +99,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0.95)]
     pub confidence: f64,
 
-    /// Bootstrap replicates B.
+    /// Bootstrap replicates B, 10 to 100000.
     #[arg(long, default_value_t = 2000)]
     pub replicates: u32,
 
@@ -59,7 +107,7 @@ pub struct Args {
     #[arg(long, default_value_t = DEFAULT_SEED)]
     pub bootstrap_seed: u64,
 
-    /// Simulated null samples for the goodness-of-fit p-values.
+    /// Simulated null samples for the goodness-of-fit p-values, 19 to 100000.
     #[arg(long, default_value_t = 1000)]
     pub gof_replicates: u32,
 
@@ -75,7 +123,7 @@ pub struct Args {
     #[arg(long, default_value_t = 95.0)]
     pub target_percentile: f64,
 
-    /// Worker threads (results do not depend on it; default: all cores).
+    /// Worker threads, 1 to 1024 (results do not depend on it; default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
 
@@ -87,7 +135,7 @@ pub struct Args {
     #[arg(long)]
     pub allow_failed: bool,
 
-    /// Do not draw the SVG plots.
+    /// Do not draw the plots.
     #[arg(long)]
     pub no_plots: bool,
 
@@ -95,6 +143,56 @@ pub struct Args {
     /// numbers as the shards hold them. Without --out no statistics are computed.
     #[arg(long, value_name = "FILE")]
     pub export: Option<PathBuf>,
+}
+
+/// The helper commands: they print to stdout and merge nothing.
+#[derive(Debug, Clone, Subcommand)]
+pub enum Helper {
+    /// Print a shell completion script (bash, zsh, fish, elvish or powershell) to stdout.
+    Completions {
+        /// The shell.
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
+    },
+    /// Print the man page (roff) to stdout.
+    Man,
+}
+
+impl Helper {
+    /// Writes the completion script or the man page to `out`.
+    pub fn print(&self, out: &mut dyn Write) -> Result<(), MergeError> {
+        let mut command = Args::command();
+        let stdout = |source| MergeError::Io {
+            path: PathBuf::from("<stdout>"),
+            source,
+        };
+        match self {
+            Helper::Completions { shell } => {
+                clap_complete::generate(*shell, &mut command, "mc-merge", out);
+                Ok(())
+            }
+            Helper::Man => clap_mangen::Man::new(command).render(out).map_err(stdout),
+        }
+    }
+}
+
+impl Args {
+    /// Does what the command line asks, writing to `out`: a helper command, an export, or a
+    /// merge (the table and the files written, nothing with `--quiet`).
+    pub fn execute(self, out: &mut dyn Write) -> Result<(), MergeError> {
+        if let Some(helper) = &self.command {
+            return helper.print(out);
+        }
+        let export = self.export.clone();
+        let quiet = self.quiet;
+        let options = self.validate()?;
+        let mut sink = std::io::sink();
+        let out: &mut dyn Write = if quiet { &mut sink } else { out };
+        match &export {
+            Some(to) => crate::export::run(&options, to, out),
+            None => crate::run(&options, out).map(|_| ()),
+        }
+    }
 }
 
 /// The statistical settings of a merge, recorded in the report.
@@ -168,8 +266,12 @@ fn usage(message: String) -> MergeError {
 impl Args {
     /// Checks every value and builds the options.
     pub fn validate(self) -> Result<Options, MergeError> {
-        if self.threads == Some(0) {
-            return Err(usage("--threads 0: at least one thread".into()));
+        if let Some(t) = self.threads
+            && !(1..=MAX_THREADS).contains(&t)
+        {
+            return Err(usage(format!(
+                "--threads {t}: must be between 1 and {MAX_THREADS}"
+            )));
         }
         let settings = Settings {
             percentiles: self.percentiles.clone(),
@@ -222,21 +324,27 @@ impl Settings {
                 self.target_percentile
             )));
         }
-        if !(self.target_angle > 0.0 && self.target_angle.is_finite()) {
+        if self.percentiles.len() > MAX_PERCENTILES {
             return Err(usage(format!(
-                "--target-angle {}: must be a positive angle in rad",
+                "--percentiles: {} values given, at most {MAX_PERCENTILES}",
+                self.percentiles.len()
+            )));
+        }
+        if !(self.target_angle > 0.0 && self.target_angle < MAX_TARGET_ANGLE) {
+            return Err(usage(format!(
+                "--target-angle {}: must be a positive angle in rad below π/2 (e.g. 9.69e-5 for 20 arcsec)",
                 self.target_angle
             )));
         }
-        if self.replicates < 10 {
+        if !(10..=MAX_REPLICATES).contains(&self.replicates) {
             return Err(usage(format!(
-                "--replicates {}: at least 10 bootstrap replicates are needed (2000 recommended)",
+                "--replicates {}: must be between 10 and {MAX_REPLICATES} bootstrap replicates (2000 recommended)",
                 self.replicates
             )));
         }
-        if self.gof_replicates < 19 {
+        if !(19..=MAX_GOF_REPLICATES).contains(&self.gof_replicates) {
             return Err(usage(format!(
-                "--gof-replicates {}: at least 19 null samples are needed (1000 recommended)",
+                "--gof-replicates {}: must be between 19 and {MAX_GOF_REPLICATES} null samples (1000 recommended)",
                 self.gof_replicates
             )));
         }
@@ -288,5 +396,47 @@ mod tests {
                 "{bad:?}: {e}"
             );
         }
+    }
+
+    #[test]
+    fn absurd_numbers_are_refused_naming_the_flag() {
+        let many = vec!["50"; MAX_PERCENTILES + 1].join(",");
+        for (flag, bad) in [
+            ("--replicates", &["d", "--replicates", "4000000000"][..]),
+            ("--replicates", &["d", "--replicates", "100001"]),
+            ("--gof-replicates", &["d", "--gof-replicates", "4000000000"]),
+            ("--threads", &["d", "--threads", "100000"]),
+            ("--target-angle", &["d", "--target-angle", "1e300"]),
+            ("--target-angle", &["d", "--target-angle", "inf"]),
+            ("--percentiles", &["d", "--percentiles", &many]),
+        ] {
+            let e = parse(bad).unwrap_err();
+            assert_eq!(e.exit_code(), crate::errors::ExitCodes::USAGE, "{bad:?}");
+            assert!(e.to_string().contains(flag), "{bad:?}: {e}");
+        }
+        // The caps themselves are accepted.
+        let cap = MAX_REPLICATES.to_string();
+        assert_eq!(
+            parse(&["d", "--replicates", &cap])
+                .unwrap()
+                .settings
+                .replicates,
+            MAX_REPLICATES
+        );
+    }
+
+    #[test]
+    fn helper_commands_and_short_flags() {
+        let a = Args::try_parse_from(["mc-merge", "completions", "bash"]).unwrap();
+        assert!(matches!(a.command, Some(Helper::Completions { .. })));
+        let a = Args::try_parse_from(["mc-merge", "d", "-o", "r", "-q"]).unwrap();
+        assert_eq!(a.out, Some(PathBuf::from("r")));
+        assert!(a.quiet && a.command.is_none());
+        // A helper command takes no merge flags, and a merge needs its directories.
+        assert!(Args::try_parse_from(["mc-merge", "man", "--out", "r"]).is_err());
+        assert!(Args::try_parse_from(["mc-merge", "--out", "r"]).is_err());
+        // A directory called `man` is given as a path.
+        let a = Args::try_parse_from(["mc-merge", "./man"]).unwrap();
+        assert_eq!(a.paths, vec![PathBuf::from("./man")]);
     }
 }

@@ -21,6 +21,8 @@ impl ExitCodes {
     pub const USAGE: u8 = truss_exit::USAGE;
     /// A file or directory could not be read or written.
     pub const IO: u8 = truss_exit::IO;
+    /// The report directory holds another job's report (or a file that is not a report).
+    pub const IN_THE_WAY: u8 = truss_exit::IN_THE_WAY;
     /// The shards do not verify: torn, corrupt, incomplete, another job, a wrong digest,
     /// a missing range, or overlapping copies that disagree.
     pub const VERIFICATION: u8 = truss_exit::VERIFICATION;
@@ -175,10 +177,19 @@ pub enum MergeError {
         /// The operating system's error.
         source: std::io::Error,
     },
+    /// The report directory holds another job's report, or a `report.json` that mc-merge did
+    /// not write; nothing was changed in it.
+    #[error("{}: {message}", path.display())]
+    InTheWay {
+        /// The file in the way.
+        path: PathBuf,
+        /// What it is and what to do.
+        message: String,
+    },
     /// A plot could not be drawn.
     #[error("{}: cannot draw the plot: {message}", path.display())]
     Plot {
-        /// The SVG file.
+        /// The plot file (or the report directory, when no font is found for the PNGs).
         path: PathBuf,
         /// The plotting library's message.
         message: String,
@@ -230,6 +241,7 @@ impl MergeError {
             | MergeError::Missing { .. } => ExitCodes::VERIFICATION,
             MergeError::FailedSamples { .. } => ExitCodes::FAILED_SAMPLES,
             MergeError::Plot { .. } => ExitCodes::IO,
+            MergeError::InTheWay { .. } => ExitCodes::IN_THE_WAY,
             MergeError::Internal { .. } => ExitCodes::INTERNAL,
         }
     }

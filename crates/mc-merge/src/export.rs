@@ -18,6 +18,11 @@
 //! Numbers are the bytes of the shard lines, copied, not reformatted: the shortest
 //! round-trip form the runner wrote, so every value reads back to the same `f64`.
 //!
+//! pandas: read the `.jsonl` export with `pd.read_json(path, lines=True, precise_float=True)`.
+//! Without `precise_float=True` its JSON float parser changes the last digits of most values
+//! (294,611 of 300,000 θ_P values of a test export, pandas 3.1). `pd.read_csv(path)` is exact
+//! from pandas 3 on; older versions need `float_precision="round_trip"`.
+//!
 //! The file is written beside its final path and renamed into place when complete, so a
 //! failed export leaves no partial file.
 

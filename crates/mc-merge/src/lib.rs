@@ -7,11 +7,16 @@
 //! which member-length tolerance σ meets the pointing budget.
 //!
 //! ```text
-//! mc-merge DIR_OR_FILES... [--out REPORT_DIR] [--percentiles 50,90,95,99] [--confidence 0.95]
-//!          [--replicates 2000] [--bootstrap-seed 20210325] [--gof-replicates 1000]
-//!          [--gof-level 0.05] [--target-angle 9.69e-5] [--target-percentile 95]
-//!          [--threads N] [--allow-partial] [--allow-failed] [--no-plots]
+//! mc-merge DIR_OR_FILES... [-o|--out REPORT_DIR] [-q|--quiet] [--percentiles 50,90,95,99]
+//!          [--confidence 0.95] [--replicates 2000] [--bootstrap-seed 20210325]
+//!          [--gof-replicates 1000] [--gof-level 0.05] [--target-angle 9.69e-5]
+//!          [--target-percentile 95] [--threads N] [--allow-partial] [--allow-failed]
+//!          [--no-plots] [--export FILE.csv|FILE.jsonl]
+//! mc-merge completions bash|zsh|fish|elvish|powershell
+//! mc-merge man
 //! ```
+//!
+//! Every numeric flag has a documented limit, refused naming the flag ([`cli`]).
 //!
 //! The binary is a thin shell around [`run`]; the statistics are reusable functions:
 //! [`quantile`] (definition-1 percentiles, weighted percentiles, order-statistic interval),
@@ -64,8 +69,12 @@
 //!
 //! ## 4. Output
 //!
-//! With `--out REPORT_DIR`: `report.json` (schema in [`report`]; summary below) and SVG plots
-//! ([`plot`]). Always: a table on stdout (angles in rad and arcsec).
+//! With `--out REPORT_DIR`: `report.json` (schema in [`report`], summary below, and the
+//! standalone JSON Schema `docs/report.schema.json`), written atomically into a directory
+//! that holds no other job's report ([`report_dir`]), and SVG and PNG plots ([`plot`]).
+//! Unless `--quiet`: a table on stdout (angles in rad and arcsec). With `--export FILE`: every
+//! sample as a flat row ([`export`]; for pandas, `read_json(…, lines=True,
+//! precise_float=True)`).
 //!
 //! ### report.json
 //!
@@ -119,6 +128,7 @@
 //! | 1 | internal error (a bug) |
 //! | 2 | usage error |
 //! | 4 | I/O error |
+//! | 5 | a file in the way: the report directory holds another job's `report.json` |
 //! | 6 | verification failure: torn, corrupt or incomplete shard, other job id, wrong digest, missing range, disagreeing overlap |
 //! | 7 | failed samples present without `--allow-failed` |
 //!
@@ -143,6 +153,7 @@ pub mod load;
 pub mod plot;
 pub mod rayleigh;
 pub mod report;
+pub mod report_dir;
 pub mod sweep;
 pub mod table;
 
@@ -158,7 +169,7 @@ use analysis::{CaseAnalysis, analyse_case};
 use gof::CalibrationCache;
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The result of a merge.
 #[derive(Debug)]
@@ -234,26 +245,17 @@ pub fn report_json(report: &Report) -> Result<String, MergeError> {
     Ok(s)
 }
 
-fn write_file(path: &Path, text: &str) -> Result<(), MergeError> {
-    std::fs::write(path, text).map_err(|source| MergeError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
-}
-
 /// Runs a merge as the command line asks: verify, compute, print the table to `out`, and with
-/// a report directory write `report.json` and the plots.
+/// a report directory write `report.json` and the plots ([`report_dir`]: another job's report
+/// directory is refused, our own earlier files replaced, `report.json` written atomically).
 pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError> {
     let merge = merge(&options.paths, &options.settings)?;
     let json = report_json(&merge.report)?;
     let mut text = table::render(&merge.report, merge.dataset.files.len());
     if let Some(dir) = &options.out {
-        std::fs::create_dir_all(dir).map_err(|source| MergeError::Io {
-            path: dir.clone(),
-            source,
-        })?;
-        let path = dir.join("report.json");
-        write_file(&path, &json)?;
+        report_dir::prepare(dir, &merge.report.job_id)?;
+        let path = dir.join(report_dir::REPORT_FILE);
+        report_dir::write_atomically(&path, json.as_bytes())?;
         text.push_str(&format!("\nwrote {}\n", path.display()));
         if options.plots {
             for p in plot::draw_all(dir, &merge.dataset.cases, &merge.report)? {

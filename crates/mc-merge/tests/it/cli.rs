@@ -104,15 +104,7 @@ fn complete_job_reports_and_plots() {
             .unwrap()
             .contains("Hyndman")
     );
-    for f in [
-        "theta_p-s1.svg",
-        "tan-s2.svg",
-        "sigma-sweep.svg",
-        "stages-sweep.svg",
-    ] {
-        let svg = std::fs::read_to_string(out.path().join(f)).unwrap();
-        assert!(svg.starts_with("<svg") && svg.contains("</svg>"), "{f}");
-    }
+    crate::plots::check_every_plot(out.path(), &["s1", "s2", "s3"], true, true);
 }
 
 /// The report does not depend on how the job was split, on the order of the files, on the
@@ -445,9 +437,74 @@ fn help_documents_exit_codes() {
         "0  ",
         "2  usage",
         "4  I/O",
+        "5  a file in the way",
         "6  verification",
         "7  failed samples",
     ] {
         assert!(text.contains(code), "{code}: {text}");
     }
+}
+
+#[test]
+fn quiet_short_flags_and_absurd_numbers() {
+    let shards = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    job().write_split(shards.path(), 1);
+    let o = mc_merge(
+        &["-q", "--no-plots", "-o", out.path().to_str().unwrap()],
+        &[shards.path().to_path_buf()],
+    );
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert_eq!((o.stdout.as_str(), o.stderr.as_str()), ("", ""));
+    assert!(out.path().join("report.json").exists());
+    // 4e9 replicates aborted with an allocation failure; now a usage error naming the flag
+    // and its cap, before any shard is read.
+    let o = Command::new(BIN)
+        .args(["/nonexistent", "--replicates", "4000000000"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--replicates 4000000000") && stderr.contains("100000"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn completions_and_man_page() {
+    for shell in ["bash", "zsh", "fish"] {
+        let o = Command::new(BIN)
+            .args(["completions", shell])
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(0), "{shell}");
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(
+            text.contains("mc-merge") && text.contains("replicates"),
+            "{shell}"
+        );
+    }
+    let o = Command::new(BIN).arg("man").output().unwrap();
+    assert_eq!(o.status.code(), Some(0));
+    let roff = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        roff.starts_with(".ie") || roff.contains(".TH mc-merge"),
+        "{roff}"
+    );
+    assert!(roff.contains("\\-\\-replicates"), "{roff}");
+    // A helper command takes no merge flags.
+    let o = Command::new(BIN)
+        .args(["man", "--out", "x"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    // The help text has no markdown escapes and no internal names.
+    let o = Command::new(BIN).arg("--help").output().unwrap();
+    let help = String::from_utf8_lossy(&o.stdout);
+    assert!(!help.contains("\\["), "{help}");
+    assert!(
+        help.contains("-o, --out") && help.contains("-q, --quiet"),
+        "{help}"
+    );
 }

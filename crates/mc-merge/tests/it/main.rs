@@ -1,7 +1,11 @@
-//! mc-merge's integration tests, one binary: statistics, sweeps and the command line.
+//! mc-merge's integration tests, one binary: statistics, sweeps, the command line, plots and
+//! the report directory.
 
 mod cli;
 mod common;
 mod export;
+mod plots;
+mod report_dir;
+mod schema;
 mod statistics;
 mod sweep;

@@ -1,0 +1,207 @@
+//! Plots for a design review, after the paper's figures, as SVG and (cargo feature `png`, on
+//! by default) PNG at twice the size, for slides. Per case (`STEM` is [`file_stems`]' name):
+//!
+//! - `theta_p-STEM`: histogram of θ_P (as a density) with the fitted Rayleigh density, the
+//!   empirical and Rayleigh target percentiles and the target angle (Figs. 4, 7); samples
+//!   beyond the axis are counted in the legend;
+//! - `tan-STEM`: histograms of tan θ_x and tan θ_y with the N(0, σ_t²) density (Fig. 6);
+//! - `qq-STEM`: Rayleigh QQ plot with a pointwise band;
+//! - `exceedance-STEM`: 1 − F on a log scale with P99 and P99.9 marked;
+//! - `running-STEM`: the target percentile with its interval against the sample count;
+//!
+//! and over the job:
+//!
+//! - `sigma-sweep`: θ_P at the target percentile against σ (log–log), every σ-series with its
+//!   intervals, line through the origin, target and allowable σ, and the deviations from the
+//!   line (Figs. 3, 16);
+//! - `stages-sweep`: the normalised percentile against the number of stages (Fig. 9).
+//!
+//! Angles are drawn in µrad with an arcsec axis beside them; slopes tan θ as 10⁶ · tan θ. The
+//! legend sits below each chart, its swatches drawn like their series (dashed, dotted).
+
+mod distribution;
+#[cfg(feature = "png")]
+pub mod png;
+mod series;
+pub mod style;
+
+pub use distribution::{axis_end, bin_count, histogram};
+
+use crate::errors::MergeError;
+use crate::load::CaseData;
+use crate::report::Report;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The prefixes of the per-case plot files.
+pub const CASE_PLOTS: [&str; 5] = ["theta_p", "tan", "qq", "exceedance", "running"];
+
+/// The names of the plots over the job.
+pub const JOB_PLOTS: [&str; 2] = ["sigma-sweep", "stages-sweep"];
+
+/// The file extensions of plots.
+pub const EXTENSIONS: [&str; 2] = ["svg", "png"];
+
+/// Whether a file name is one mc-merge's plots could have (so it may be replaced).
+pub fn is_plot_file(name: &str) -> bool {
+    let Some((stem, ext)) = name.rsplit_once('.') else {
+        return false;
+    };
+    EXTENSIONS.contains(&ext)
+        && (JOB_PLOTS.contains(&stem)
+            || CASE_PLOTS.iter().any(|p| {
+                stem.strip_prefix(p)
+                    .and_then(|rest| rest.strip_prefix('-'))
+                    .is_some_and(|case| !case.is_empty())
+            }))
+}
+
+fn is_safe(c: char) -> bool {
+    c.is_ascii_alphanumeric() || c == '.' || c == '-' || c == '_'
+}
+
+/// File-name-safe, unique stems of the case names, in order. A name made only of ASCII
+/// letters, digits, `.`, `-` and `_` is its own stem. Any other character becomes `_`, and
+/// such a name, or one that equals another's ignoring letter case (file systems that ignore
+/// case), gets `~K` appended, K its position in the job from 1; `~` never occurs in a plain
+/// stem, so no two stems are equal: cases `σ` and `δ` give `_~1` and `_~2`; `a/b` and `a_b`
+/// give `a_b~1` and `a_b`.
+pub fn file_stems(names: &[&str]) -> Vec<String> {
+    let mut folded: HashMap<String, usize> = HashMap::new();
+    for n in names {
+        *folded.entry(n.to_ascii_lowercase()).or_default() += 1;
+    }
+    names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| {
+            let plain = !n.is_empty() && n.chars().all(is_safe) && n != &"." && n != &"..";
+            let stem: String = n
+                .chars()
+                .map(|c| if is_safe(c) { c } else { '_' })
+                .collect();
+            if plain && folded[&n.to_ascii_lowercase()] == 1 {
+                stem
+            } else {
+                format!("{stem}~{}", k + 1)
+            }
+        })
+        .collect()
+}
+
+type Drawn = Result<Option<String>, Box<dyn std::error::Error>>;
+
+/// Writes one plot: the SVG, and with the `png` feature its PNG beside it.
+struct Writer {
+    #[cfg(feature = "png")]
+    png: png::Rasteriser,
+    written: Vec<PathBuf>,
+}
+
+impl Writer {
+    /// Fails (with the `png` feature) when the system has no fonts.
+    fn new(dir: &Path) -> Result<Self, MergeError> {
+        #[cfg(not(feature = "png"))]
+        let _ = dir;
+        Ok(Self {
+            #[cfg(feature = "png")]
+            png: png::Rasteriser::new().map_err(|message| MergeError::Plot {
+                path: dir.to_path_buf(),
+                message,
+            })?,
+            written: vec![],
+        })
+    }
+
+    fn write(&mut self, path: PathBuf, drawn: Drawn) -> Result<(), MergeError> {
+        let plot_error = |path: &Path, message: String| MergeError::Plot {
+            path: path.to_path_buf(),
+            message,
+        };
+        let Some(svg) = drawn.map_err(|e| plot_error(&path, e.to_string()))? else {
+            return Ok(());
+        };
+        let svg = style::subscript_svg(&svg);
+        std::fs::write(&path, &svg).map_err(|source| MergeError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        self.written.push(path.clone());
+        #[cfg(feature = "png")]
+        {
+            let png = path.with_extension("png");
+            self.png
+                .write(&svg, &png)
+                .map_err(|message| plot_error(&png, message))?;
+            self.written.push(png);
+        }
+        Ok(())
+    }
+}
+
+/// Draws every plot into `dir`; returns the files written.
+pub fn draw_all(
+    dir: &Path,
+    cases: &[CaseData],
+    report: &Report,
+) -> Result<Vec<PathBuf>, MergeError> {
+    let mut w = Writer::new(dir)?;
+    let names: Vec<&str> = report.cases.iter().map(|c| c.name.as_str()).collect();
+    for ((case, rep), stem) in cases.iter().zip(&report.cases).zip(file_stems(&names)) {
+        let path = |prefix: &str| dir.join(format!("{prefix}-{stem}.svg"));
+        w.write(path("theta_p"), distribution::theta(case, rep, report))?;
+        w.write(path("tan"), distribution::tan(case, rep))?;
+        w.write(path("qq"), distribution::qq(case, rep, report))?;
+        w.write(
+            path("exceedance"),
+            distribution::exceedance(case, rep, report),
+        )?;
+        w.write(path("running"), distribution::running(case, rep, report))?;
+    }
+    w.write(dir.join("sigma-sweep.svg"), series::sigma(report))?;
+    w.write(dir.join("stages-sweep.svg"), series::stages(report))?;
+    Ok(w.written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stems_are_unique_after_sanitising() {
+        assert_eq!(file_stems(&["σ", "δ"]), ["_~1", "_~2"]);
+        assert_eq!(file_stems(&["a/b", "a_b"]), ["a_b~1", "a_b"]);
+        assert_eq!(file_stems(&["A", "a", "b"]), ["A~1", "a~2", "b"]);
+        assert_eq!(
+            file_stems(&["sigma-0.0063", ".."]),
+            ["sigma-0.0063", "..~2"]
+        );
+        let many = ["x y", "x_y", "x?y", "x_y~1"];
+        let stems = file_stems(&many);
+        let mut unique = stems.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), many.len(), "{stems:?}");
+    }
+
+    #[test]
+    fn plot_files_are_recognised() {
+        for ours in [
+            "theta_p-a.svg",
+            "tan-_~1.png",
+            "sigma-sweep.svg",
+            "running-x.png",
+        ] {
+            assert!(is_plot_file(ours), "{ours}");
+        }
+        for theirs in [
+            "report.json",
+            "notes.svg",
+            "theta_p-.svg",
+            "tan-a.pdf",
+            "qq.svg",
+        ] {
+            assert!(!is_plot_file(theirs), "{theirs}");
+        }
+    }
+}
