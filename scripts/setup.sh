@@ -5,13 +5,14 @@
 #
 # - Debian packages: munge, slurmctld, slurmd, slurm-client (the real single-node Slurm
 #   cluster of the end-to-end test, see scripts/slurm/README.md) and librsvg2-bin
-#   (rsvg-convert, which the tests use to render the SVG plots to PNG).
+#   (rsvg-convert, which the tests use to render the SVG plots to PNG), and fonts-dejavu-core
+#   (the font mc-merge's own PNG rendering and rsvg-convert draw text with).
 # - Nothing else: the Rust toolchain comes with the machine; crates come from crates.io
 #   when cargo builds (Cargo.lock pins them).
 # Idempotent: packages already installed are not fetched again.
 set -euo pipefail
 
-packages=(munge slurmctld slurmd slurm-client librsvg2-bin)
+packages=(munge slurmctld slurmd slurm-client librsvg2-bin fonts-dejavu-core)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -16,7 +16,7 @@ set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$REPO"
 
-command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null || scripts/setup.sh
+command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && [ -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || scripts/setup.sh
 
 echo "test: cargo test --workspace" >&2
 cargo test --workspace --quiet
