@@ -25,7 +25,8 @@ pub struct DiagnoseArgs {
     /// The instrument's standard deviation per coordinate \[mm\].
     #[arg(long, default_value_t = 0.0)]
     pub measurement_sigma: f64,
-    /// Simulated samples per evaluation (default max(2000, 20 × specimens), at most 10 000).
+    /// Simulated samples per evaluation, 100 to 10 000 (default max(2000, 20 × specimens),
+    /// at most 10 000).
     #[arg(long)]
     pub samples: Option<usize>,
     /// Output directory (diagnosis.json, diagnosis.md, updated-job.json, plots).
@@ -100,8 +101,18 @@ pub fn run_diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<(), CliE
     let s = truss_diagnose::run(&options)?;
     writeln!(
         out,
-        "named_effect: {}\nverdict: {:?}\nreason: {}\ndiscrepancy: {:.4} before, {:.4} after",
-        s.named_effect, s.verdict, s.reason, s.discrepancy.0, s.discrepancy.1
+        "named_effect: {}\nnamed_effects: {}\nverdict: {} ({})\nreason: {}\ndiscrepancy: {:.4} before, {:.4} after",
+        s.named_effect,
+        if s.named_effects.is_empty() {
+            "none".to_string()
+        } else {
+            s.named_effects.join(", ")
+        },
+        s.verdict.as_str(),
+        s.verdict.words(),
+        s.reason,
+        s.discrepancy.0,
+        s.discrepancy.1
     )?;
     for f in &s.files {
         writeln!(out, "wrote {}", f.display())?;
