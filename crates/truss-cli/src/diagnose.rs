@@ -32,6 +32,9 @@ pub struct DiagnoseArgs {
     /// Output directory (diagnosis.json, diagnosis.md, updated-job.json, plots).
     #[arg(long)]
     pub out: PathBuf,
+    /// Only these candidate effects, comma separated (default: every one that applies).
+    #[arg(long, value_delimiter = ',')]
+    pub candidates: Option<Vec<String>>,
     /// No SVG plots.
     #[arg(long)]
     pub no_plots: bool,
@@ -56,7 +59,8 @@ pub struct SynthArgs {
     #[arg(long)]
     pub seed: u64,
     /// The hidden effect: `none`, or `NAME:PARAM=VALUE,…` (unnamed parameters at their
-    /// baseline values), e.g. `thermal_gradient:gradient_x=0.002`.
+    /// baseline values), e.g. `thermal_gradient:gradient_x=0.002`; several separated by
+    /// `;`.
     #[arg(long)]
     pub effect: String,
     /// The instrument's standard deviation per coordinate \[mm\].
@@ -94,6 +98,7 @@ pub fn run_diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<(), CliE
             samples: args.samples,
             measurement_sigma: args.measurement_sigma,
             quiet: args.quiet,
+            candidates: args.candidates.clone(),
             ..Default::default()
         },
         plots: !args.no_plots,

@@ -23,7 +23,10 @@
 //! ```
 //!
 //! with `S_r = Σ r rᵀ/(N − q − 1)` the residual covariance (q the members regressed on, those
-//! whose simulated ê has a spread). This is exact when (x, ê) are jointly normal, and the
+//! whose simulated ê has a spread), scaled for specimen i by the regression's prediction
+//! factor `1 + 1/N + hᵢ`, `hᵢ = (êᵢ − ē)ᵀ(EᵀE)⁻¹(êᵢ − ē)` (E the centred simulated ê): the
+//! estimated coefficients' own error, about q/N, which the simulation inflation c = 1 + n/N
+//! does not cover. This is exact when (x, ê) are jointly normal, and the
 //! best linear predictor otherwise: the node positions are nearly linear in small length
 //! errors, while what is not linear in them (free play, slack cables, the candidates' own
 //! effects) stays in `x̄` and `S_r`. Members a specimen did not measure are drawn from the job
@@ -139,6 +142,10 @@ struct Regression {
     x_mean: DVector<f64>,
     /// `q × d` coefficients.
     b: DMatrix<f64>,
+    /// The centred regressors' Gram matrix EᵀE, factorised (for the leverage).
+    gram: Option<nalgebra::Cholesky<f64, nalgebra::Dyn>>,
+    /// Simulated samples N.
+    samples: usize,
     /// The predictive covariance, factorised.
     chol: nalgebra::Cholesky<f64, nalgebra::Dyn>,
     log_det: f64,
@@ -186,13 +193,13 @@ impl Regression {
         );
         let ec = DMatrix::from_fn(n, q, |r, j| cols[j].1[r] - e_mean[j]);
         let xc = DMatrix::from_fn(n, d, |r, j| sim.x[r * d + j] - x_mean[j]);
-        let b = if q == 0 {
-            DMatrix::zeros(0, d)
+        let (b, gram) = if q == 0 {
+            (DMatrix::zeros(0, d), None)
         } else {
             let gram = ec.transpose() * &ec;
             let chol = nalgebra::Cholesky::new(gram)
                 .ok_or_else(|| failed("the members' simulated errors are collinear".into()))?;
-            chol.solve(&(ec.transpose() * &xc))
+            (chol.solve(&(ec.transpose() * &xc)), Some(chol))
         };
         let r = &xc - &ec * &b;
         let mut cov = r.transpose() * &r / (n - q - 1) as f64;
@@ -200,7 +207,7 @@ impl Regression {
         for j in 0..d {
             cov[(j, j)] += extra;
         }
-        let chol = nalgebra::Cholesky::new(cov)
+        let chol = nalgebra::Cholesky::new(cov.clone())
             .ok_or_else(|| failed("the residual covariance is not positive definite".into()))?;
         let log_det = 2.0
             * chol
@@ -214,6 +221,8 @@ impl Regression {
             e_mean,
             x_mean,
             b,
+            gram,
+            samples: n,
             chol,
             log_det,
         })
@@ -230,6 +239,11 @@ impl Regression {
                 .zip(self.e_mean.iter())
                 .map(|(&j, m)| e[j] - m),
         );
+        // The prediction's own uncertainty: Σ_r·(1 + 1/N + h), h = (ê − ē)ᵀ(EᵀE)⁻¹(ê − ē)
+        // the leverage of the specimen's measured errors (a regression's prediction
+        // variance), so that N barely above q does not make the fit overconfident.
+        let h = self.gram.as_ref().map_or(0.0, |g| de.dot(&g.solve(&de)));
+        let scale = 1.0 + 1.0 / self.samples as f64 + h;
         let mu = &self.x_mean + self.b.transpose() * de;
         let diff = DVector::from_iterator(d, y.iter().zip(mu.iter()).map(|(a, b)| a - b));
         let z = self
@@ -237,7 +251,10 @@ impl Regression {
             .l_dirty()
             .solve_lower_triangular(&diff)
             .expect("L is regular");
-        -0.5 * (d as f64 * (2.0 * std::f64::consts::PI).ln() + self.log_det + z.norm_squared())
+        -0.5 * (d as f64 * (2.0 * std::f64::consts::PI).ln()
+            + self.log_det
+            + d as f64 * scale.ln()
+            + z.norm_squared() / scale)
     }
 }
 
@@ -267,9 +284,10 @@ mod tests {
         let draws = Draws { e, members: 1 };
         let r = Regression::fit(&sim, &draws, &[0], 0.0).unwrap();
         assert!((r.b[(0, 0)] - 2.0).abs() < 0.03, "{}", r.b);
-        let var = 0.25 + RESOLUTION * RESOLUTION;
-        let want = -0.5 * ((2.0 * std::f64::consts::PI * var).ln() + 0.09 / var);
         let at = 1.0;
+        // The prediction factor 1 + 1/N + (1 − ē)²/Σ(e − ē)² ≈ 1 + 2/N.
+        let var = (0.25 + RESOLUTION * RESOLUTION) * (1.0 + 2.0 / n as f64);
+        let want = -0.5 * ((2.0 * std::f64::consts::PI * var).ln() + 0.09 / var);
         let got = r.log_density(&[2.0 * (at - r.e_mean[0]) + r.x_mean[0] + 0.3], &[at]);
         assert!((got - want).abs() < 0.05, "{got} vs {want}");
     }

@@ -7,8 +7,10 @@
 //! those indistinguishable from it get profile-likelihood intervals, [`crate::profile`], and
 //! should a profile find a higher maximum the verdict is decided again on the new fits), and
 //! adds the named effect at its fitted values. The selection stops at the first step that
-//! names nothing (no candidate both significant at α/K and better by ΔBIC ≤ −2: an added
-//! effect that no longer improves the fit ends it), or when no candidate is left. The
+//! names nothing (no candidate both significant at α/K and better by ΔBIC ≤ −2), at a named
+//! effect that does not improve the fit where the likelihood does not look (the
+//! discrepancy, the energy distance of the displacement vectors, does not shrink with it:
+//! then it is not added), or when no candidate is left. The
 //! false discovery rate over the steps is controlled by [`forward_stop`] on the steps'
 //! Bonferroni-adjusted p-values: named effects beyond its k̂ are not kept.
 //!
@@ -52,6 +54,13 @@ pub struct Settings {
     pub alpha: f64,
     /// No progress on stderr.
     pub quiet: bool,
+    /// Only these candidates (by name); `None`: every applicable one.
+    pub candidates: Option<Vec<String>>,
+    /// With member measurements, condition each specimen's node term on its own measured
+    /// members ([`crate::conditional`]); `false`: the member measurements only enter as
+    /// draws from the case's distributions (the older, distribution-only use, kept for
+    /// comparison).
+    pub condition_on_members: bool,
 }
 
 impl Default for Settings {
@@ -61,6 +70,8 @@ impl Default for Settings {
             measurement_sigma: 0.0,
             alpha: 0.05,
             quiet: false,
+            candidates: None,
+            condition_on_members: true,
         }
     }
 }
@@ -255,8 +266,9 @@ pub fn decide(
                 .join(", ")
         };
         let mut reason = format!(
-            "{} improves the likelihood significantly (p = {:.2e} < α/K = {level:.4}) and is the best by BIC",
-            scores[i].name, scores[i].p_value,
+            "{} improves the likelihood significantly ({} < α/K = {level:.4}) and is the best by BIC",
+            scores[i].name,
+            crate::report::p_is(scores[i].p_value),
         );
         if by_bic.is_empty() && by_vuong.is_empty() {
             reason += &format!(
@@ -299,14 +311,14 @@ pub fn decide(
     } else if before.tolerance.within {
         (
             Verdict::None,
-            "no candidate improves the fit significantly, and the baseline agrees with the measurements within the stated tolerance".into(),
+            "no candidate improves the fit significantly, and the model agrees with the measurements within the stated tolerance".into(),
             None,
             Vec::new(),
         )
     } else if before_disagrees && n >= MIN_FOR_DISAGREEMENT {
         (
             Verdict::Unexplained,
-            "the measurements disagree with the baseline, but no candidate effect of the library explains it significantly".into(),
+            "the measurements disagree with the model, but no candidate effect of the library explains it significantly".into(),
             None,
             Vec::new(),
         )
@@ -314,7 +326,7 @@ pub fn decide(
         (
             Verdict::CannotTell,
             format!(
-                "no candidate improves the fit significantly, but with {n} specimens the data cannot show that the baseline agrees within tolerance either ({} outside){}: more specimens are needed",
+                "no candidate improves the fit significantly, but with {n} specimens the data cannot show that the model agrees within tolerance either ({} outside){}: more specimens are needed",
                 before.tolerance.outside.join(", "),
                 if before_disagrees {
                     ", and the few statistics that disagree are too uncertain with so few specimens"
@@ -391,7 +403,33 @@ pub fn diagnose(
         baseline.case_name
     ));
     let mut models = vec![compare_model(&ctx, baseline.derived_case())?];
-    let (mut remaining, skipped) = library(baseline);
+    let (mut remaining, mut skipped) = library(baseline);
+    if let Some(only) = &settings.candidates {
+        for name in only {
+            if !remaining.iter().any(|c| c.name() == name)
+                && !skipped.iter().any(|(n, _)| n == name)
+            {
+                return Err(DiagnoseError::Usage(format!(
+                    "--candidates: no candidate effect {name:?} (the library: backlash, gravity, thermal_gradient, length_bias, length_sigma, diagonal_pretension)"
+                )));
+            }
+        }
+        let (asked, left): (Vec<_>, Vec<_>) = remaining
+            .into_iter()
+            .partition(|c| only.iter().any(|n| n == c.name()));
+        skipped.extend(left.iter().map(|c| {
+            (
+                c.name().to_string(),
+                "not asked for (--candidates)".to_string(),
+            )
+        }));
+        remaining = asked;
+    }
+    if remaining.is_empty() {
+        return Err(DiagnoseError::Usage(
+            "no candidate effect applies to this case (see the skipped reasons with --candidates unset)".into(),
+        ));
+    }
     let mut steps: Vec<Step> = Vec::new();
     while steps.len() < MAX_STEPS && !remaining.is_empty() {
         let current = models.last().expect("the baseline is there");
@@ -406,9 +444,13 @@ pub fn diagnose(
             _ => break,
         }
     }
-    let adjusted: Vec<f64> = steps.iter().filter_map(|s| s.adjusted_p).collect();
+    let adjusted: Vec<f64> = steps
+        .iter()
+        .filter(|s| s.kept)
+        .filter_map(|s| s.adjusted_p)
+        .collect();
     let kept = forward_stop(&adjusted, settings.alpha);
-    for s in steps.iter_mut().filter(|s| s.named.is_some()).skip(kept) {
+    for s in steps.iter_mut().filter(|s| s.kept).skip(kept) {
         s.kept = false;
         s.verdict = Verdict::CannotTell;
         s.reason += &format!(
@@ -465,7 +507,7 @@ fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
     let end = if last.kept {
         "no candidate is left to try".to_string()
     } else {
-        format!("then, step {}: {}", last.number, last.reason)
+        format!("step {}: {}", last.number, last.reason)
     };
     (
         Verdict::Named,

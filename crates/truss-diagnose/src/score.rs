@@ -90,6 +90,8 @@ pub(crate) struct Evaluator<'a> {
     pub measured: &'a Measured,
     pub samples: usize,
     pub sigma_m: f64,
+    /// Condition the node terms on the specimens' measured members.
+    pub condition: bool,
     pub simulations: std::cell::Cell<usize>,
 }
 
@@ -110,7 +112,7 @@ impl Evaluator<'_> {
     /// With member measurements, each specimen's node term is conditioned on its own
     /// measured members ([`crate::conditional`]).
     pub fn score(&self, job: &truss_job::Job, sim: &Simulation) -> Result<Terms, DiagnoseError> {
-        let mut terms = if self.measured.members.is_some() {
+        let mut terms = if self.condition && self.measured.members.is_some() {
             crate::conditional::log_densities(
                 job,
                 self.baseline.model(),

@@ -46,6 +46,7 @@ impl Context<'_> {
             measured: self.measured,
             samples: self.samples,
             sigma_m: self.settings.measurement_sigma,
+            condition: self.settings.condition_on_members,
             simulations: Cell::new(0),
         }
     }
@@ -191,12 +192,29 @@ pub(crate) fn run_step(
         }
         None => None,
     };
+    // An added effect must improve the fit where the likelihood does not look: the
+    // discrepancy (energy distance of the displacement vectors) must shrink.
+    let improves = next
+        .as_ref()
+        .is_none_or(|m| m.comparison.energy < current.comparison.energy);
+    let (verdict, reason) = if improves {
+        (verdict, reason)
+    } else {
+        (
+            Verdict::CannotTell,
+            format!(
+                "{reason}; but it does not improve the fit: the discrepancy grows from {:.4} to {:.4} with it, so it is not added (the likelihood's preference rests on what the model's Gaussian approximation cannot represent)",
+                current.comparison.energy,
+                next.as_ref().map_or(f64::NAN, |m| m.comparison.energy)
+            ),
+        )
+    };
     let step = Step {
         number,
         verdict,
         reason,
         named,
-        kept: named.is_some(),
+        kept: named.is_some() && improves,
         indistinguishable: indistinguishable
             .iter()
             .map(|&j| scores[j].name.clone())
@@ -208,7 +226,7 @@ pub(crate) fn run_step(
         candidates: scores,
         seconds: clock.elapsed().as_secs_f64(),
     };
-    Ok((step, next))
+    Ok((step, next.filter(|_| improves)))
 }
 
 /// Stage 2: every candidate fitted and tested against the current model.
