@@ -7,8 +7,8 @@
 //!
 //! ```text
 //! truss diagnose --job BASELINE.json --case NAME --measured M.csv [--measured-members MM.csv]
-//!                [--measurement-sigma MM] [--samples N] --out DIR
-//! truss synth-measured --job J --case NAME --specimens N --seed S --effect NAME:P=V,…
+//!                [--measurement-sigma MM] [--samples N] [--candidates A,B] --out DIR
+//! truss synth-measured --job J --case NAME --specimens N --seed S --effect 'NAME:P=V,…[;…]'
 //!                [--measurement-sigma MM] [--all-nodes] [--members-out MM.csv] > M.csv
 //! ```
 //!
@@ -57,10 +57,16 @@
 //!    95 % region (threshold χ²_k(0.95)·c·λ̄) is projected on each parameter as well
 //!    (`joint_interval`). Every candidate also carries its Wald interval, c·A⁻¹BA⁻¹
 //!    ([`fit`]), reported beside the profile one.
-//! 3. **Add it**: `DIR/updated-job.json`, the baseline job with the named effect in the
-//!    case at its fitted values (same case name), which mc-shard and mc-merge run as usual.
-//! 4. **The gap shrinks**: step 1 again with the effect; every statistic before and after,
-//!    and the overall discrepancy (the energy distance) before and after.
+//! 3. **Add it, and look again**: the named effect is added at its fitted values and step 2
+//!    runs again against the updated model with the remaining candidates, and so on
+//!    ([`step`], [`diagnose`]): forward selection, until no candidate is significant and
+//!    clearly better, or a named effect does not shrink the discrepancy (it is then not
+//!    added), or none is left. The false discovery rate over the steps is held at α by
+//!    ForwardStop on the steps' Bonferroni-adjusted p-values ([`diagnose::forward_stop`]).
+//!    `DIR/updated-job.json` is the baseline job with every added effect in the case (same
+//!    case name), which mc-shard and mc-merge run as usual.
+//! 4. **The gap shrinks**: each step's discrepancy before and after, and the baseline's
+//!    against the final model's, statistic by statistic.
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
 //! plots of [`plot`]. Progress goes to stderr.
@@ -79,7 +85,12 @@
 //! ## Measured data
 //!
 //! See [`measured`]: CSV with a header, any column and row order, quoting and CRLF; bad rows
-//! are errors with their line; specimens missing a compared node are left out and counted.
+//! (and rows with extra fields) are errors with their line; specimens missing a compared
+//! node are left out and counted; outlier rows (a coordinate beyond 10 robust SD) are left
+//! out and listed by specimen and line; member rows of specimens the node file lacks, and
+//! member errors beyond 1 % of the member's length, are refused. With
+//! `--measured-members` each specimen's own measured members enter its likelihood
+//! ([`conditional`]).
 
 pub mod baseline;
 pub mod candidates;

@@ -1,16 +1,26 @@
 //! `diagnosis.json` and `diagnosis.md`.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 3)
+//! ## diagnosis.json (format `truss-diagnose`, version 4)
 //!
 //! ```text
 //! format, format_version, program_version
 //! job {path, id, case, seed}, samples (N per simulation), measurement_sigma [mm]
 //! data        {file, rows, specimens_in_file, specimens_used, left_out_count, left_out[],
+//!              outliers[] {specimen, line, node, axis, displacement [mm], robust_z},
 //!              nodes[], unknown_nodes[], rare_nodes[], supports[], member_rows, unknown_members[]}
 //! verdict     "named" | "none" | "cannot_tell" | "unexplained";  reason (words)
-//! named_effect "none" or the effect's name
+//!              ("named" when an effect was added, else step 1's verdict)
+//! named_effect "none" or the first added effect's name
+//! named_effects [names]   every effect added, in order; [] when none
+//! steps       [{number, verdict, reason, named_effect ("none" when nothing was named),
+//!               kept (added to the model: significant, better by BIC, shrinking the
+//!               discrepancy, and kept by the false discovery rate over the steps),
+//!               parameters[] (the named effect's, as below), indistinguishable[],
+//!               adjusted_p (min(1, K·p) of the named one), log_likelihood_before,
+//!               candidates[] (as below, against the model of the step's start),
+//!               discrepancy_before, discrepancy_after, seconds}]
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null}]
-//!              (the named effect's)
+//!              (the first added effect's)
 //!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
 //!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
 //!              indistinguishable from it, else "wald"; lower/upper null when not found;
@@ -18,24 +28,29 @@
 //!   joint_interval  where profiled: the joint 95 % region of all k parameters projected on
 //!              this one (same fields, threshold χ²_k(0.95)·c·λ̄): every parameter inside its
 //!              joint interval at once with 95 % confidence
-//! indistinguishable [names]   (explain the data as well: ΔBIC within 2, or significant and
+//! indistinguishable [names]   (the first added effect's step; explain the data as well: ΔBIC within 2, or significant and
 //!              not shown further from the data than the named one, Vuong z < 1.96; empty
 //!              when clear)
 //! baseline    {log_likelihood}
-//! candidates  [{name, mechanism, k, parameters[], log_likelihood, lr_statistic, adjustment,
+//! candidates  (step 1's) [{name, mechanism, k, parameters[], log_likelihood, lr_statistic, adjustment,
 //!               p_value, significant, delta_bic, evaluations, profile_evaluations, seconds,
 //!               vuong_z?, error?}]   (vuong_z: the named one's Vuong z against this one,
 //!               for significant candidates when one is named)
 //! skipped     [{name, reason}]
-//! statistics  {before: Comparison, after: Comparison | null}
+//! statistics  {before: Comparison (the baseline's), after: Comparison | null (the final
+//!              model's, with every added effect)}
 //!   Comparison {specimens, samples, energy, energy_p, tolerance {within, outside[], bands},
 //!               statistics[] {id, kind, unit, measured, simulated, comparison, estimate
 //!               {value, lower, upper}, p_value, p_holm, disagrees, words}}
-//! discrepancy_before, discrepancy_after   (energy distance; after = before when no effect is added)
-//! method      {likelihood, fit, intervals, selection, verdicts, statistics, discrepancy}
+//! discrepancy_before, discrepancy_after   (energy distance of the baseline and of the final
+//!              model; after = before when no effect is added)
+//! method      {likelihood, fit, intervals, selection, verdicts, steps, statistics, discrepancy}
 //!             (in words)
 //! timing      {simulations, solves, seconds}
 //! ```
+//!
+//! Version 4 (from 3): the forward selection: `named_effects`, `steps[]`, `data.outliers`,
+//! `method.steps`; `statistics.after` and `discrepancy_after` are the final model's.
 //!
 //! Version 3 (from 2): `candidates[].vuong_z`, and `indistinguishable` also lists
 //! significant candidates the named one does not fit significantly better than (Vuong).

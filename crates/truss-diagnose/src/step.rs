@@ -1,13 +1,13 @@
 //! One step of the forward selection, as one pass through its stages:
 //!
-//! 1. **compare** ([`compare_model`]): the current model (the baseline with the effects added
+//! 1. **compare** (`compare_model`): the current model (the baseline with the effects added
 //!    so far) is simulated with N samples and the instrument's noise, compared with the
 //!    measurements statistic by statistic ([`crate::compare`]), and its ℓ computed: the
 //!    null of this step's tests.
-//! 2. **fit each candidate** ([`fit_each`]): every remaining candidate applied to the
+//! 2. **fit each candidate** (`fit_each`): every remaining candidate applied to the
 //!    current model's typed case ([`CaseEdit`]), its ℓ maximised and tested against the
 //!    current model ([`crate::score`]).
-//! 3. **decide** ([`decide_and_profile`]): the verdict of [`decide`]; the candidate it names
+//! 3. **decide** (`decide_and_profile`): the verdict of [`decide`]; the candidate it names
 //!    and those indistinguishable from it get profile-likelihood intervals, and should a
 //!    profile find a higher maximum the verdict is decided again on the new fits.
 //! 4. **update**: the named candidate is added at its fitted values, and the new model is
