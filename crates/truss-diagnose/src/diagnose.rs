@@ -14,8 +14,9 @@
 //! false discovery rate over the steps is controlled by [`forward_stop`] on the steps'
 //! Bonferroni-adjusted p-values: named effects beyond its k̂ are not kept.
 //!
-//! Effects already added are not re-fitted in later steps: each stays at the value fitted
-//! in its own step (a joint re-fit of interacting effects is not done).
+//! When a step adds an effect, every effect added before is re-fitted in turn with the
+//! others held (one pass of backfitting, not a joint fit of all of them): a scatter fitted
+//! before a mean shift was found has absorbed part of it, and gives it back.
 
 use crate::baseline::{Baseline, CaseEdit};
 use crate::candidates::library;
@@ -24,7 +25,7 @@ use crate::errors::DiagnoseError;
 use crate::measured::Measured;
 pub use crate::score::{CandidateScore, FittedParameter, SCAN};
 use crate::simulate::{Noise, Simulation, top_indices};
-use crate::step::{Context, Step, compare_model, run_step};
+use crate::step::{Added, Context, ModelEffect, Step, compare_model, run_step};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -165,6 +166,8 @@ pub struct Diagnosis {
     pub after: Option<Comparison>,
     /// The final case: the baseline with every kept effect (the baseline's when none).
     pub updated: CaseEdit,
+    /// The final model's effects at their final values (after the re-fits).
+    pub effects: Vec<ModelEffect>,
     /// Simulated samples per evaluation N.
     pub samples: usize,
     /// The simulations behind `before` and `after` (for plots).
@@ -431,14 +434,23 @@ pub fn diagnose(
         ));
     }
     let mut steps: Vec<Step> = Vec::new();
+    let mut added: Vec<Added> = Vec::new();
     while steps.len() < MAX_STEPS && !remaining.is_empty() {
         let current = models.last().expect("the baseline is there");
-        let (step, next) = run_step(&ctx, steps.len() + 1, current, &remaining)?;
+        let (step, next) = run_step(&ctx, steps.len() + 1, current, &remaining, &added)?;
         let named = step.named;
+        let now = step.effects.clone();
         steps.push(step);
         match (named, next) {
             (Some(i), Some(model)) => {
-                remaining.remove(i);
+                let candidate = remaining.remove(i);
+                added.push(Added {
+                    candidate,
+                    values: Vec::new(),
+                });
+                for (a, e) in added.iter_mut().zip(now) {
+                    a.values = e.parameters.iter().map(|p| p.2).collect();
+                }
                 models.push(model);
             }
             _ => break,
@@ -464,6 +476,12 @@ pub fn diagnose(
         );
     }
     let (verdict, reason) = overall(&steps, kept);
+    let effects = steps
+        .iter()
+        .filter(|s| s.kept)
+        .nth(kept.max(1) - 1)
+        .filter(|_| kept > 0)
+        .map_or_else(Vec::new, |s| s.effects.clone());
     progress.note(&format!("{}: {reason}", verdict.words()));
     let sims = ctx.simulations.get();
     let mut models = models.into_iter();
@@ -477,6 +495,7 @@ pub fn diagnose(
         baseline_log_likelihood: base.log_likelihood,
         before: base.comparison,
         updated: last.as_ref().map_or(base.edit, |m| m.edit.clone()),
+        effects,
         after: last.as_ref().map(|m| m.comparison.clone()),
         simulations: (base.simulation, last.map(|m| m.simulation)),
         samples,
@@ -594,6 +613,29 @@ mod tests {
             "{}",
             clear.reason
         );
+    }
+
+    /// ForwardStop by hand: −ln(1 − p) for p = 0.01, 0.04, 0.2 is 0.01005, 0.04082, 0.22314;
+    /// running means 0.01005, 0.02544, 0.09134: at α = 0.05 the first two are kept; a first
+    /// step at p = 0.06 keeps none even though a later one is tiny (mean 0.0309 ≤ 0.05 at
+    /// k = 2 keeps both: ForwardStop is about the rate, not each step); none for no steps.
+    #[test]
+    fn forward_stop_keeps_the_longest_prefix_within_alpha() {
+        assert_eq!(forward_stop(&[0.01, 0.04, 0.2], 0.05), 2);
+        assert_eq!(forward_stop(&[0.06], 0.05), 0);
+        assert_eq!(forward_stop(&[0.06, 1e-9], 0.05), 2);
+        assert_eq!(forward_stop(&[1.0, 0.0], 0.05), 0);
+        assert_eq!(forward_stop(&[], 0.05), 0);
+    }
+
+    /// p-values for people: below what a double tells from 0, `< 1e-16`, never `0.00e0`.
+    #[test]
+    fn p_values_read_plainly() {
+        use crate::report::{p_is, p_text};
+        assert_eq!(p_text(0.0), "< 1e-16");
+        assert_eq!(p_is(1e-20), "p < 1e-16");
+        assert_eq!(p_is(0.034), "p = 0.03");
+        assert_eq!(p_text(2.5e-7), "2.5e-7");
     }
 
     /// Vuong's z by hand: units 0, 1, 2 with differences 1, 3, 2 (unit 2's split over two

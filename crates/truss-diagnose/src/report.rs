@@ -18,9 +18,13 @@
 //!               parameters[] (the named effect's, as below), indistinguishable[],
 //!               adjusted_p (min(1, K·p) of the named one), log_likelihood_before,
 //!               candidates[] (as below, against the model of the step's start),
+//!               refitted[] (the effects added before, re-fitted with this one added:
+//!               candidate scores with Wald intervals),
 //!               discrepancy_before, discrepancy_after, seconds}]
+//! effects     [{name, parameters [[name, unit, value]]}]   the final model's effects at
+//!              their final values (after the re-fits): what updated-job.json holds
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null}]
-//!              (the first added effect's)
+//!              (the first added effect's, as fitted in its step)
 //!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
 //!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
 //!              indistinguishable from it, else "wald"; lower/upper null when not found;
@@ -49,7 +53,8 @@
 //! timing      {simulations, solves, seconds}
 //! ```
 //!
-//! Version 4 (from 3): the forward selection: `named_effects`, `steps[]`, `data.outliers`,
+//! Version 4 (from 3): the forward selection: `named_effects`, `steps[]`, `effects`,
+//! `data.outliers`,
 //! `method.steps`; `statistics.after` and `discrepancy_after` are the final model's.
 //!
 //! Version 3 (from 2): `candidates[].vuong_z`, and `indistinguishable` also lists
@@ -66,7 +71,7 @@ use crate::baseline::Baseline;
 use crate::compare::{Comparison, Statistic};
 use crate::diagnose::{CandidateScore, Diagnosis, FittedParameter, Verdict};
 use crate::measured::{DataReport, Measured};
-use crate::step::Step;
+use crate::step::{ModelEffect, Step};
 use serde::Serialize;
 
 /// Format name.
@@ -149,6 +154,7 @@ struct Report<'a> {
     candidates: &'a [CandidateScore],
     skipped: Vec<Skipped<'a>>,
     steps: Vec<StepReport<'a>>,
+    effects: &'a [ModelEffect],
     statistics: Statistics<'a>,
     discrepancy_before: f64,
     discrepancy_after: f64,
@@ -168,6 +174,7 @@ struct StepReport<'a> {
     adjusted_p: Option<f64>,
     log_likelihood_before: f64,
     candidates: &'a [CandidateScore],
+    refitted: &'a [CandidateScore],
     discrepancy_before: f64,
     discrepancy_after: f64,
     seconds: f64,
@@ -186,6 +193,7 @@ impl<'a> StepReport<'a> {
             adjusted_p: s.adjusted_p,
             log_likelihood_before: s.log_likelihood_before,
             candidates: &s.candidates,
+            refitted: &s.refitted,
             discrepancy_before: s.before.energy,
             discrepancy_after: s.after.as_ref().map_or(s.before.energy, |a| a.energy),
             seconds: s.seconds,
@@ -235,6 +243,7 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
             .map(|(n, r)| Skipped { name: n, reason: r })
             .collect(),
         steps: d.steps.iter().map(StepReport::of).collect(),
+        effects: &d.effects,
         statistics: Statistics {
             before: &d.before,
             after: d.after.as_ref(),
@@ -508,14 +517,33 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
     let span = spans(baseline);
     for s in d.steps.iter().filter(|s| s.kept) {
         let c = s.named_score().expect("a kept step names an effect");
-        push(m, &format!("Fitted `{}`:\n", c.name));
+        push(m, &format!("Fitted `{}` (step {}):\n", c.name, s.number));
+        // The final value where a later step re-fitted it.
+        let last = d
+            .effects
+            .iter()
+            .find(|e| e.name == c.name)
+            .map(|e| &e.parameters);
         for p in &c.parameters {
+            let now = last
+                .and_then(|ps| ps.iter().find(|q| q.0 == p.name))
+                .map(|q| q.2)
+                .filter(|&v| v != p.value);
+            let reading = FittedParameter {
+                value: now.unwrap_or(p.value),
+                ..p.clone()
+            };
             push(
                 m,
                 &format!(
-                    "- {}: {}",
+                    "- {}{}: {}",
                     parameter_text(p),
-                    plain_reading(&c.name, p, span)
+                    now.map_or(String::new(), |v| format!(
+                        "; {} {} after the later steps' re-fit",
+                        g(v),
+                        p.unit
+                    )),
+                    plain_reading(&c.name, &reading, span)
                 ),
             );
         }
@@ -692,6 +720,28 @@ fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
                     "- {}: {}",
                     parameter_text(p),
                     plain_reading(&c.name, p, span)
+                ),
+            );
+        }
+        push(m, "");
+    }
+    if !s.refitted.is_empty() {
+        push(
+            m,
+            "Effects added before, re-fitted with it (the others held; 95 % Wald intervals):\n",
+        );
+        for c in &s.refitted {
+            push(
+                m,
+                &format!(
+                    "- `{}`: {}",
+                    c.name,
+                    c.error.clone().unwrap_or_else(|| c
+                        .parameters
+                        .iter()
+                        .map(parameter_text)
+                        .collect::<Vec<_>>()
+                        .join("; "))
                 ),
             );
         }

@@ -116,8 +116,100 @@ pub struct Step {
     pub before: Comparison,
     /// The comparison with the named effect added.
     pub after: Option<Comparison>,
+    /// The effects added in earlier steps, re-fitted with this step's effect added (the
+    /// others held at their values), in the order they were added.
+    pub refitted: Vec<CandidateScore>,
+    /// The model's effects after this step, with their values: each (name, parameter
+    /// names and units, values).
+    pub effects: Vec<ModelEffect>,
     /// Wall time of the step \[s\].
     pub seconds: f64,
+}
+
+/// An effect in a model, at its values.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ModelEffect {
+    /// The candidate's name.
+    pub name: String,
+    /// (parameter, unit, value).
+    pub parameters: Vec<(String, &'static str, f64)>,
+}
+
+/// An effect added in an earlier step and its current values.
+pub(crate) struct Added {
+    pub candidate: Box<dyn Candidate>,
+    pub values: Vec<f64>,
+}
+
+/// Stage 4, update: the named effect added to the model, and every effect added before
+/// re-fitted in turn with the others (the new one included) held, since effects interact (a
+/// scatter fitted before a mean shift was found has absorbed part of it). Returns the new
+/// model's case, the re-fits, and its effects at their values.
+fn update(
+    ctx: &Context,
+    added: &[Added],
+    (new, new_values): (&dyn Candidate, &[f64]),
+) -> Result<(CaseEdit, Vec<CandidateScore>, Vec<ModelEffect>), DiagnoseError> {
+    let mut values: Vec<Vec<f64>> = added.iter().map(|a| a.values.clone()).collect();
+    let model_with = |values: &[Vec<f64>], skip: Option<usize>| {
+        let mut edit = ctx.baseline.derived_case();
+        for (k, a) in added.iter().enumerate() {
+            if Some(k) != skip {
+                a.candidate.apply(&values[k], &mut edit)?;
+            }
+        }
+        new.apply(new_values, &mut edit)?;
+        Ok::<CaseEdit, DiagnoseError>(edit)
+    };
+    let n = ctx.measured.n();
+    let mut refits = Vec::new();
+    for (j, a) in added.iter().enumerate() {
+        let c = a.candidate.as_ref();
+        ctx.progress
+            .note(&format!("re-fitting {} with the others held…", c.name()));
+        let ev = ctx.evaluator(&model_with(&values, Some(j))?);
+        let nulls: Vec<f64> = c.parameters().iter().map(|p| p.null).collect();
+        let l0: f64 = ev.terms_at(c, &nulls)?.iter().sum();
+        let test = Test {
+            l0,
+            n,
+            inflation: 1.0 + n as f64 / ctx.samples as f64,
+            level: ctx.settings.alpha,
+        };
+        let f = fit_candidate(&ev, c, &test);
+        ctx.simulations
+            .set(ctx.simulations.get() + ev.simulations.get());
+        if f.score.error.is_none() {
+            values[j] = f.score.parameters.iter().map(|p| p.value).collect();
+        }
+        ctx.progress.note(&format!(
+            "  {}: {}",
+            c.name(),
+            f.score
+                .parameters
+                .iter()
+                .map(|p| format!("{} {:.4e}", p.name, p.value))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+        refits.push(f.score);
+    }
+    let effect = |c: &dyn Candidate, v: &[f64]| ModelEffect {
+        name: c.name().into(),
+        parameters: c
+            .parameters()
+            .iter()
+            .zip(v)
+            .map(|(p, &x)| (p.name.clone(), p.unit, x))
+            .collect(),
+    };
+    let mut effects: Vec<ModelEffect> = added
+        .iter()
+        .zip(&values)
+        .map(|(a, v)| effect(a.candidate.as_ref(), v))
+        .collect();
+    effects.push(effect(new, new_values));
+    Ok((model_with(&values, None)?, refits, effects))
 }
 
 impl Step {
@@ -139,6 +231,7 @@ pub(crate) fn run_step(
     number: usize,
     current: &ComparedModel,
     candidates: &[Box<dyn Candidate>],
+    added: &[Added],
 ) -> Result<(Step, Option<ComparedModel>), DiagnoseError> {
     let clock = Instant::now();
     let n = ctx.measured.n();
@@ -177,10 +270,15 @@ pub(crate) fn run_step(
     } = decision;
     ctx.progress
         .note(&format!("step {number}: {}: {reason}", verdict.words()));
+    let mut refitted = Vec::new();
+    let mut effects = Vec::new();
     let next = match named {
         Some(i) => {
             let values: Vec<f64> = scores[i].parameters.iter().map(|p| p.value).collect();
-            let model = compare_model(ctx, ev.edit(candidates[i].as_ref(), &values)?)?;
+            let (edit, refits, now) = update(ctx, added, (candidates[i].as_ref(), &values))?;
+            refitted = refits;
+            effects = now;
+            let model = compare_model(ctx, edit)?;
             ctx.progress.note(&format!(
                 "step {number}: with {}: energy distance {:.3} (p = {:.3}), was {:.3}",
                 scores[i].name,
@@ -224,6 +322,8 @@ pub(crate) fn run_step(
         before: current.comparison.clone(),
         after: next.as_ref().map(|m| m.comparison.clone()),
         candidates: scores,
+        refitted,
+        effects,
         seconds: clock.elapsed().as_secs_f64(),
     };
     Ok((step, next.filter(|_| improves)))
