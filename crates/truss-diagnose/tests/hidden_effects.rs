@@ -734,3 +734,56 @@ fn one_bad_row_is_an_outlier_not_an_effect() {
     assert_eq!(v["data"]["specimens_used"], 59);
     assert_eq!(v["named_effects"], serde_json::json!([]), "{}", v["reason"]);
 }
+
+/// Issue 15's refusals, each naming what is wrong: `--samples` above the documented 10 000,
+/// and `synth-measured` parameters outside their range or not finite (`clearance=-0.01`
+/// was silently taken as 0, `gradient_x=nan` gave an internal error).
+#[test]
+fn out_of_range_settings_and_effects_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = make(dir.path(), "few", "none", 6, 1);
+    let e = run(&DiagnoseOptions {
+        job: job(),
+        case: "as-built".into(),
+        measured: m,
+        measured_members: None,
+        out: dir.path().join("out"),
+        settings: Settings {
+            samples: Some(100_000_000),
+            quiet: true,
+            ..Settings::default()
+        },
+        plots: false,
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("--samples 100000000: must be from 100 to 10000"),
+        "{e}"
+    );
+    let synth_err = |effect: &str| {
+        let mut out = Vec::new();
+        synth(
+            &SynthOptions {
+                job: job(),
+                case: "as-built".into(),
+                specimens: 5,
+                seed: 1,
+                effect: effect.into(),
+                measurement_sigma: 0.001,
+                all_nodes: false,
+                members_out: None,
+            },
+            &mut out,
+        )
+        .unwrap_err()
+        .to_string()
+    };
+    let e = synth_err("backlash:clearance=-0.01");
+    assert!(
+        e.contains("clearance = -0.01 is outside its plausible range [0, 0.05] mm"),
+        "{e}"
+    );
+    let e = synth_err("thermal_gradient:gradient_x=nan");
+    assert!(e.contains("gradient_x = nan is outside"), "{e}");
+}
