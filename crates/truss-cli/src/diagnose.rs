@@ -25,12 +25,16 @@ pub struct DiagnoseArgs {
     /// The instrument's standard deviation per coordinate \[mm\].
     #[arg(long, default_value_t = 0.0)]
     pub measurement_sigma: f64,
-    /// Simulated samples per evaluation (default max(2000, 20 × specimens), at most 10 000).
+    /// Simulated samples per evaluation, 100 to 10 000 (default max(2000, 20 × specimens),
+    /// at most 10 000).
     #[arg(long)]
     pub samples: Option<usize>,
     /// Output directory (diagnosis.json, diagnosis.md, updated-job.json, plots).
     #[arg(long)]
     pub out: PathBuf,
+    /// Only these candidate effects, comma separated (default: every one that applies).
+    #[arg(long, value_delimiter = ',')]
+    pub candidates: Option<Vec<String>>,
     /// No SVG plots.
     #[arg(long)]
     pub no_plots: bool,
@@ -55,7 +59,8 @@ pub struct SynthArgs {
     #[arg(long)]
     pub seed: u64,
     /// The hidden effect: `none`, or `NAME:PARAM=VALUE,…` (unnamed parameters at their
-    /// baseline values), e.g. `thermal_gradient:gradient_x=0.002`.
+    /// baseline values), e.g. `thermal_gradient:gradient_x=0.002`; several separated by
+    /// `;`.
     #[arg(long)]
     pub effect: String,
     /// The instrument's standard deviation per coordinate \[mm\].
@@ -93,6 +98,7 @@ pub fn run_diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<(), CliE
             samples: args.samples,
             measurement_sigma: args.measurement_sigma,
             quiet: args.quiet,
+            candidates: args.candidates.clone(),
             ..Default::default()
         },
         plots: !args.no_plots,
@@ -100,8 +106,18 @@ pub fn run_diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<(), CliE
     let s = truss_diagnose::run(&options)?;
     writeln!(
         out,
-        "named_effect: {}\nverdict: {:?}\nreason: {}\ndiscrepancy: {:.4} before, {:.4} after",
-        s.named_effect, s.verdict, s.reason, s.discrepancy.0, s.discrepancy.1
+        "named_effect: {}\nnamed_effects: {}\nverdict: {} ({})\nreason: {}\ndiscrepancy: {:.4} before, {:.4} after",
+        s.named_effect,
+        if s.named_effects.is_empty() {
+            "none".to_string()
+        } else {
+            s.named_effects.join(", ")
+        },
+        s.verdict.as_str(),
+        s.verdict.words(),
+        s.reason,
+        s.discrepancy.0,
+        s.discrepancy.1
     )?;
     for f in &s.files {
         writeln!(out, "wrote {}", f.display())?;

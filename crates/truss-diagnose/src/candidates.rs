@@ -548,9 +548,17 @@ pub fn parse_effect(
                 )));
             }
         };
-        values[j] = value.parse().map_err(|_| {
+        let v: f64 = value.parse().map_err(|_| {
             DiagnoseError::Usage(format!("--effect {name}: {value:?} is not a number"))
         })?;
+        let p = &params[j];
+        if !(v.is_finite() && p.low <= v && v <= p.high) {
+            return Err(DiagnoseError::Usage(format!(
+                "--effect {name}: {} = {value} is outside its plausible range [{}, {}] {}",
+                p.name, p.low, p.high, p.unit
+            )));
+        }
+        values[j] = v;
     }
     Ok(Some((i, values)))
 }

@@ -1,20 +1,31 @@
-//! Steps 2 to 4: fit every candidate, choose, add the effect, compare again.
+//! The forward selection: find the strongest missing effect, add it, look again at what is
+//! left, and repeat until nothing significant remains ([`diagnose`]).
 //!
-//! Every candidate is fitted and tested ([`crate::score`]); the verdict follows from the
-//! tests and BIC ([`decide`]); the named candidate and those indistinguishable from it get
-//! profile-likelihood intervals ([`crate::profile`]). Should a profile find a higher maximum,
-//! that candidate is scored anew and the verdict decided again (profiling any candidate that
-//! newly enters it), so the verdict always rests on the final fits.
+//! Each step ([`crate::step`]) compares the current model (the baseline with the effects
+//! added so far) with the measurements, fits and tests every remaining candidate against it
+//! ([`crate::score`]), decides from the tests and BIC ([`decide`]; the named candidate and
+//! those indistinguishable from it get profile-likelihood intervals, [`crate::profile`], and
+//! should a profile find a higher maximum the verdict is decided again on the new fits), and
+//! adds the named effect at its fitted values. The selection stops at the first step that
+//! names nothing (no candidate both significant at α/K and better by ΔBIC ≤ −2), at a named
+//! effect that does not improve the fit where the likelihood does not look (the
+//! discrepancy, the energy distance of the displacement vectors, does not shrink with it:
+//! then it is not added), or when no candidate is left. The
+//! false discovery rate over the steps is controlled by [`forward_stop`] on the steps'
+//! Bonferroni-adjusted p-values: named effects beyond its k̂ are not kept.
+//!
+//! When a step adds an effect, every effect added before is re-fitted in turn with the
+//! others held (one pass of backfitting, not a joint fit of all of them): a scatter fitted
+//! before a mean shift was found has absorbed part of it, and gives it back.
 
 use crate::baseline::{Baseline, CaseEdit};
 use crate::candidates::library;
-use crate::compare::{Comparison, compare};
-use crate::derivatives::Terms;
+use crate::compare::Comparison;
 use crate::errors::DiagnoseError;
 use crate::measured::Measured;
 pub use crate::score::{CandidateScore, FittedParameter, SCAN};
-use crate::score::{Evaluator, Fitted, Test, fit_candidate, profile_candidate};
-use crate::simulate::{Noise, Simulation, simulate, top_indices};
+use crate::simulate::{Noise, Simulation, top_indices};
+use crate::step::{Added, Context, ModelEffect, Step, compare_model, run_step};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -44,6 +55,13 @@ pub struct Settings {
     pub alpha: f64,
     /// No progress on stderr.
     pub quiet: bool,
+    /// Only these candidates (by name); `None`: every applicable one.
+    pub candidates: Option<Vec<String>>,
+    /// With member measurements, condition each specimen's node term on its own measured
+    /// members ([`crate::conditional`]); `false`: the member measurements only enter as
+    /// draws from the case's distributions (the older, distribution-only use, kept for
+    /// comparison).
+    pub condition_on_members: bool,
 }
 
 impl Default for Settings {
@@ -53,6 +71,8 @@ impl Default for Settings {
             measurement_sigma: 0.0,
             alpha: 0.05,
             quiet: false,
+            candidates: None,
+            condition_on_members: true,
         }
     }
 }
@@ -104,28 +124,50 @@ pub enum Verdict {
     Unexplained,
 }
 
-/// A complete diagnosis.
+impl Verdict {
+    /// The verdict as `diagnosis.json` writes it (`named`, `none`, `cannot_tell`,
+    /// `unexplained`).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Named => "named",
+            Verdict::None => "none",
+            Verdict::CannotTell => "cannot_tell",
+            Verdict::Unexplained => "unexplained",
+        }
+    }
+
+    /// The verdict in words.
+    pub fn words(self) -> &'static str {
+        match self {
+            Verdict::Named => "a missing effect is named",
+            Verdict::None => "the model agrees; no effect is missing",
+            Verdict::CannotTell => "the data cannot tell",
+            Verdict::Unexplained => "the model disagrees, and no candidate explains it",
+        }
+    }
+}
+
+/// A complete diagnosis: the steps of the forward selection and the final model.
 pub struct Diagnosis {
-    /// The verdict.
+    /// The overall verdict: `named` when an effect was added, else step 1's.
     pub verdict: Verdict,
     /// Why, in a sentence or two.
     pub reason: String,
-    /// The named candidate's index in `candidates`.
-    pub named: Option<usize>,
-    /// Candidates that explain the data as well as the named one (ΔBIC within 2).
-    pub indistinguishable: Vec<String>,
-    /// Every candidate's score.
-    pub candidates: Vec<CandidateScore>,
+    /// The steps, in order; the last one named nothing, or its effect was not kept, or no
+    /// candidate was left.
+    pub steps: Vec<Step>,
     /// Candidates not applicable to this case, with why.
     pub skipped: Vec<(String, String)>,
     /// ℓ₀ of the baseline.
     pub baseline_log_likelihood: f64,
-    /// Step 1 (and step 4's "before").
+    /// The baseline's comparison.
     pub before: Comparison,
-    /// Step 4's "after", when an effect was added.
+    /// The final model's comparison, when an effect was added.
     pub after: Option<Comparison>,
-    /// The updated case (the baseline's when no effect was named).
+    /// The final case: the baseline with every kept effect (the baseline's when none).
     pub updated: CaseEdit,
+    /// The final model's effects at their final values (after the re-fits).
+    pub effects: Vec<ModelEffect>,
     /// Simulated samples per evaluation N.
     pub samples: usize,
     /// The simulations behind `before` and `after` (for plots).
@@ -134,6 +176,27 @@ pub struct Diagnosis {
     pub top: [[usize; 3]; 3],
     /// Total simulations run, solves, and seconds.
     pub work: (usize, usize, f64),
+}
+
+impl Diagnosis {
+    /// The effects added, in order.
+    pub fn named_effects(&self) -> Vec<&str> {
+        self.steps
+            .iter()
+            .filter(|s| s.kept)
+            .filter_map(|s| s.named_effect())
+            .collect()
+    }
+
+    /// The first added effect's name, or `none`.
+    pub fn named_effect(&self) -> &str {
+        self.named_effects().first().copied().unwrap_or("none")
+    }
+
+    /// The step that added the first effect (or step 1).
+    pub fn first_step(&self) -> &Step {
+        &self.steps[0]
+    }
 }
 
 /// The verdict, why, the named candidate and those indistinguishable from it (indices).
@@ -206,8 +269,9 @@ pub fn decide(
                 .join(", ")
         };
         let mut reason = format!(
-            "{} improves the likelihood significantly (p = {:.2e} < α/K = {level:.4}) and is the best by BIC",
-            scores[i].name, scores[i].p_value,
+            "{} improves the likelihood significantly ({} < α/K = {level:.4}) and is the best by BIC",
+            scores[i].name,
+            crate::report::p_is(scores[i].p_value),
         );
         if by_bic.is_empty() && by_vuong.is_empty() {
             reason += &format!(
@@ -250,14 +314,14 @@ pub fn decide(
     } else if before.tolerance.within {
         (
             Verdict::None,
-            "no candidate improves the fit significantly, and the baseline agrees with the measurements within the stated tolerance".into(),
+            "no candidate improves the fit significantly, and the model agrees with the measurements within the stated tolerance".into(),
             None,
             Vec::new(),
         )
     } else if before_disagrees && n >= MIN_FOR_DISAGREEMENT {
         (
             Verdict::Unexplained,
-            "the measurements disagree with the baseline, but no candidate effect of the library explains it significantly".into(),
+            "the measurements disagree with the model, but no candidate effect of the library explains it significantly".into(),
             None,
             Vec::new(),
         )
@@ -265,7 +329,7 @@ pub fn decide(
         (
             Verdict::CannotTell,
             format!(
-                "no candidate improves the fit significantly, but with {n} specimens the data cannot show that the baseline agrees within tolerance either ({} outside){}: more specimens are needed",
+                "no candidate improves the fit significantly, but with {n} specimens the data cannot show that the model agrees within tolerance either ({} outside){}: more specimens are needed",
                 before.tolerance.outside.join(", "),
                 if before_disagrees {
                     ", and the few statistics that disagree are too uncertain with so few specimens"
@@ -285,7 +349,33 @@ pub fn decide(
     }
 }
 
-/// Runs steps 1 to 4 on measured data against the baseline case.
+/// Most steps of the forward selection: one per candidate at most.
+pub const MAX_STEPS: usize = 6;
+
+/// The number of steps whose named effects are kept: ForwardStop (G'Sell, Wager,
+/// Chouldechova & Tibshirani 2016) at level α on the steps' adjusted p-values
+/// pₛ = min(1, Kₛ·p) (Bonferroni over the step's Kₛ candidates):
+/// k̂ = max{k : −(1/k)·Σ_{s ≤ k} ln(1 − pₛ) ≤ α}, 0 if none. It controls the false
+/// discovery rate over the steps at α when the p-values of the effects that are not there
+/// are uniform and come after those that are; the first step alone is the Bonferroni test
+/// (−ln(1 − p₁) ≤ α is p₁ ≤ 1 − e^(−α) ≈ α).
+pub fn forward_stop(adjusted: &[f64], alpha: f64) -> usize {
+    let mut sum = 0.0;
+    let mut kept = 0;
+    for (k, &p) in adjusted.iter().enumerate() {
+        sum += -(1.0 - p.min(1.0)).ln();
+        if sum / (k + 1) as f64 <= alpha {
+            kept = k + 1;
+        }
+    }
+    kept
+}
+
+/// The forward selection on measured data against the baseline case: step after step
+/// ([`crate::step`]), each adding the strongest missing effect to the model, until no
+/// candidate is significant and clearly better by BIC, or none is left; then the false
+/// discovery rate over the steps decides how many of the named effects are kept
+/// ([`forward_stop`]).
 pub fn diagnose(
     baseline: &Baseline,
     measured: &Measured,
@@ -294,200 +384,158 @@ pub fn diagnose(
 ) -> Result<Diagnosis, DiagnoseError> {
     let n = measured.n();
     let samples = settings.samples_for(n);
-    let sigma_m = settings.measurement_sigma;
     let model = baseline.model();
     let top_nodes = model.top_surface().expect("checked when reading").nodes;
     let top = top_indices(&measured.coords, top_nodes).expect("top nodes are measured");
-    let noise = Noise {
-        sigma: sigma_m,
-        seed: NOISE_SEED,
-    };
-    let ev = Evaluator {
+    let ctx = Context {
         baseline,
         measured,
+        settings,
         samples,
-        sigma_m,
+        noise: Noise {
+            sigma: settings.measurement_sigma,
+            seed: NOISE_SEED,
+        },
+        top,
+        progress,
         simulations: std::cell::Cell::new(0),
     };
-    // Step 1.
     progress.note(&format!(
         "{n} specimens, {} coordinates; simulating the baseline case {:?} ({samples} samples)",
         measured.d(),
         baseline.case_name
     ));
-    let base_edit = baseline.derived_case();
-    let base_job = ev.job(&base_edit)?;
-    let base_sim = simulate(&base_job, &measured.coords, samples, Some((noise, top)))?;
-    ev.simulations.set(1);
-    let l0: f64 = ev.score(&base_job, &base_sim)?.iter().sum();
-    let before = compare(measured, &base_sim, top, sigma_m);
-    progress.note(&format!(
-        "baseline: ℓ₀ = {l0:.1}; {} of {} statistics disagree; energy distance {:.3} (p = {:.3})",
-        before.statistics.iter().filter(|s| s.disagrees).count(),
-        before.statistics.len(),
-        before.energy,
-        before.energy_p
-    ));
-    // Step 2.
-    let (candidates, skipped) = library(baseline);
-    let inflation = 1.0 + n as f64 / samples as f64;
-    let kk = candidates.len().max(1) as f64;
-    let test = Test {
-        l0,
-        n,
-        inflation,
-        level: settings.alpha / kk,
-    };
-    let mut fitted: Vec<Fitted> = Vec::new();
-    for c in &candidates {
-        progress.note(&format!(
-            "fitting {} ({} parameters)…",
-            c.name(),
-            c.parameters().len()
-        ));
-        let f = fit_candidate(&ev, c.as_ref(), &test);
-        let s = &f.score;
-        progress.note(&format!(
-            "  {}: ΔBIC {:.1}, Λ {:.1}, p {:.2e}, {} evaluations in {:.1} s",
-            s.name, s.delta_bic, s.lr_statistic, s.p_value, s.evaluations, s.seconds
-        ));
-        fitted.push(f);
-    }
-    // Decision, and profiles of the candidates it rests on.
-    let note = |m: &str| progress.note(m);
-    let terms = std::cell::RefCell::new(vec![None; candidates.len()]);
-    let decision = loop {
-        let scores: Vec<&CandidateScore> = fitted.iter().map(|f| &f.score).collect();
-        let closeness = |i: usize, j: usize| {
-            closeness_of(&ev, &candidates, &fitted, &terms, test.inflation, (i, j))
-                .unwrap_or(f64::INFINITY)
-        };
-        let d = decide(&scores, &before, n, test.level, &closeness);
-        let wanted: Vec<usize> = d
-            .named
-            .into_iter()
-            .chain(d.indistinguishable.iter().copied())
-            .filter(|&i| !fitted[i].profiled)
-            .collect();
-        if wanted.is_empty() {
-            break d;
-        }
-        for i in wanted {
-            progress.note(&format!(
-                "profile-likelihood intervals of {}…",
-                candidates[i].name()
-            ));
-            profile_candidate(&ev, candidates[i].as_ref(), &mut fitted[i], &test, &note);
-            let s = &fitted[i].score;
-            progress.note(&format!(
-                "  {}: {} profile evaluations, {:.1} s for the fit and profiles; {}",
-                s.name,
-                s.profile_evaluations,
-                s.seconds,
-                s.parameters
-                    .iter()
-                    .map(|p| format!(
-                        "{} {:.4e} [{}, {}]",
-                        p.name,
-                        p.value,
-                        p.interval.lower.map_or("?".into(), |v| format!("{v:.4e}")),
-                        p.interval.upper.map_or("?".into(), |v| format!("{v:.4e}"))
-                    ))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
-        }
-    };
-    let mut scores: Vec<CandidateScore> = fitted.iter().map(|f| f.score.clone()).collect();
-    if let Some(i) = decision.named {
-        for (j, s) in scores.iter_mut().enumerate() {
-            if j != i && s.significant && s.error.is_none() {
-                s.vuong_z = closeness_of(&ev, &candidates, &fitted, &terms, test.inflation, (i, j));
+    let mut models = vec![compare_model(&ctx, baseline.derived_case())?];
+    let (mut remaining, mut skipped) = library(baseline);
+    if let Some(only) = &settings.candidates {
+        for name in only {
+            if !remaining.iter().any(|c| c.name() == name)
+                && !skipped.iter().any(|(n, _)| n == name)
+            {
+                return Err(DiagnoseError::Usage(format!(
+                    "--candidates: no candidate effect {name:?} (the library: backlash, gravity, thermal_gradient, length_bias, length_sigma, diagonal_pretension)"
+                )));
             }
         }
+        let (asked, left): (Vec<_>, Vec<_>) = remaining
+            .into_iter()
+            .partition(|c| only.iter().any(|n| n == c.name()));
+        skipped.extend(left.iter().map(|c| {
+            (
+                c.name().to_string(),
+                "not asked for (--candidates)".to_string(),
+            )
+        }));
+        remaining = asked;
     }
-    let Decision {
-        verdict,
-        reason,
-        named,
-        indistinguishable,
-    } = decision;
-    let indistinguishable: Vec<String> = indistinguishable
-        .iter()
-        .map(|&i| scores[i].name.clone())
-        .collect();
-    progress.note(&format!("verdict: {verdict:?}: {reason}"));
-    // Steps 3 and 4.
-    let (updated, after, after_sim) = match named {
-        Some(i) => {
-            let values: Vec<f64> = scores[i].parameters.iter().map(|p| p.value).collect();
-            let edit = ev.edit(candidates[i].as_ref(), &values)?;
-            let job = ev.job(&edit)?;
-            let sim = simulate(&job, &measured.coords, samples, Some((noise, top)))?;
-            ev.simulations.set(ev.simulations.get() + 1);
-            let after = compare(measured, &sim, top, sigma_m);
-            progress.note(&format!(
-                "with {}: energy distance {:.3} (p = {:.3}), was {:.3}",
-                scores[i].name, after.energy, after.energy_p, before.energy
-            ));
-            (edit, Some(after), Some(sim))
+    if remaining.is_empty() {
+        return Err(DiagnoseError::Usage(
+            "no candidate effect applies to this case (see the skipped reasons with --candidates unset)".into(),
+        ));
+    }
+    let mut steps: Vec<Step> = Vec::new();
+    let mut added: Vec<Added> = Vec::new();
+    while steps.len() < MAX_STEPS && !remaining.is_empty() {
+        let current = models.last().expect("the baseline is there");
+        let (step, next) = run_step(&ctx, steps.len() + 1, current, &remaining, &added)?;
+        let named = step.named;
+        let now = step.effects.clone();
+        steps.push(step);
+        match (named, next) {
+            (Some(i), Some(model)) => {
+                let candidate = remaining.remove(i);
+                added.push(Added {
+                    candidate,
+                    values: Vec::new(),
+                });
+                for (a, e) in added.iter_mut().zip(now) {
+                    a.values = e.parameters.iter().map(|p| p.2).collect();
+                }
+                models.push(model);
+            }
+            _ => break,
         }
-        None => (base_edit, None, None),
-    };
-    let sims = ev.simulations.get();
+    }
+    let adjusted: Vec<f64> = steps
+        .iter()
+        .filter(|s| s.kept)
+        .filter_map(|s| s.adjusted_p)
+        .collect();
+    let kept = forward_stop(&adjusted, settings.alpha);
+    for s in steps.iter_mut().filter(|s| s.kept).skip(kept) {
+        s.kept = false;
+        s.verdict = Verdict::CannotTell;
+        s.reason += &format!(
+            "; not kept: over the steps, the false discovery rate at α = {} keeps only the first {kept} named effects (ForwardStop on the steps' adjusted p-values {})",
+            settings.alpha,
+            adjusted
+                .iter()
+                .map(|p| crate::report::p_text(*p))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let (verdict, reason) = overall(&steps, kept);
+    let effects = steps
+        .iter()
+        .filter(|s| s.kept)
+        .nth(kept.max(1) - 1)
+        .filter(|_| kept > 0)
+        .map_or_else(Vec::new, |s| s.effects.clone());
+    progress.note(&format!("{}: {reason}", verdict.words()));
+    let sims = ctx.simulations.get();
+    let mut models = models.into_iter();
+    let base = models.next().expect("the baseline is there");
+    let last = models.nth(kept.max(1) - 1).filter(|_| kept > 0);
     Ok(Diagnosis {
         verdict,
         reason,
-        named,
-        indistinguishable,
-        candidates: scores,
+        steps,
         skipped,
-        baseline_log_likelihood: l0,
-        before,
-        after,
-        updated,
+        baseline_log_likelihood: base.log_likelihood,
+        before: base.comparison,
+        updated: last.as_ref().map_or(base.edit, |m| m.edit.clone()),
+        effects,
+        after: last.as_ref().map(|m| m.comparison.clone()),
+        simulations: (base.simulation, last.map(|m| m.simulation)),
         samples,
-        simulations: (base_sim, after_sim),
         top,
         work: (sims, sims * samples, progress.seconds()),
     })
 }
 
-/// Vuong's z of fitted candidate i against j ([`vuong`]), `inflation` = c = 1 + n/N;
-/// `None` if a simulation failed.
-fn closeness_of(
-    ev: &Evaluator,
-    candidates: &[Box<dyn crate::candidates::Candidate>],
-    fitted: &[Fitted],
-    cache: &TermsCache,
-    inflation: f64,
-    (i, j): (usize, usize),
-) -> Option<f64> {
-    let a = fitted_terms(ev, candidates[i].as_ref(), &fitted[i], cache, i)?;
-    let b = fitted_terms(ev, candidates[j].as_ref(), &fitted[j], cache, j)?;
-    Some(vuong(&a, &b, &ev.measured.clusters(), inflation))
-}
-
-/// Each candidate's fitted parameter values and ℓ's per-unit terms there.
-type TermsCache = std::cell::RefCell<Vec<Option<(Vec<f64>, Terms)>>>;
-
-/// ℓ's per-unit terms at a candidate's fit, computed once per fitted point (one simulation).
-fn fitted_terms(
-    ev: &Evaluator,
-    c: &dyn crate::candidates::Candidate,
-    fitted: &Fitted,
-    cache: &TermsCache,
-    i: usize,
-) -> Option<Terms> {
-    let values: Vec<f64> = fitted.score.parameters.iter().map(|p| p.value).collect();
-    if let Some((at, terms)) = &cache.borrow()[i]
-        && at == &values
-    {
-        return Some(terms.clone());
+/// The overall verdict and reason from the steps, `kept` of whose named effects are kept.
+fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
+    if kept == 0 {
+        let first = &steps[0];
+        return (first.verdict, first.reason.clone());
     }
-    let terms = ev.terms_at(c, &values).ok()?;
-    cache.borrow_mut()[i] = Some((values, terms.clone()));
-    Some(terms)
+    let added: Vec<String> = steps
+        .iter()
+        .filter(|s| s.kept)
+        .map(|s| {
+            format!(
+                "step {}: {} ({})",
+                s.number,
+                s.named_effect().unwrap_or("none"),
+                s.reason
+            )
+        })
+        .collect();
+    let last = steps.last().expect("at least one step");
+    let end = if last.kept {
+        "no candidate is left to try".to_string()
+    } else {
+        format!("step {}: {}", last.number, last.reason)
+    };
+    (
+        Verdict::Named,
+        format!(
+            "{kept} effect{} added in turn. {}. Finally, {end}",
+            if kept == 1 { "" } else { "s" },
+            added.join(". ")
+        ),
+    )
 }
 
 #[cfg(test)]
@@ -565,6 +613,29 @@ mod tests {
             "{}",
             clear.reason
         );
+    }
+
+    /// ForwardStop by hand: −ln(1 − p) for p = 0.01, 0.04, 0.2 is 0.01005, 0.04082, 0.22314;
+    /// running means 0.01005, 0.02544, 0.09134: at α = 0.05 the first two are kept; a first
+    /// step at p = 0.06 keeps none even though a later one is tiny (mean 0.0309 ≤ 0.05 at
+    /// k = 2 keeps both: ForwardStop is about the rate, not each step); none for no steps.
+    #[test]
+    fn forward_stop_keeps_the_longest_prefix_within_alpha() {
+        assert_eq!(forward_stop(&[0.01, 0.04, 0.2], 0.05), 2);
+        assert_eq!(forward_stop(&[0.06], 0.05), 0);
+        assert_eq!(forward_stop(&[0.06, 1e-9], 0.05), 2);
+        assert_eq!(forward_stop(&[1.0, 0.0], 0.05), 0);
+        assert_eq!(forward_stop(&[], 0.05), 0);
+    }
+
+    /// p-values for people: below what a double tells from 0, `< 1e-16`, never `0.00e0`.
+    #[test]
+    fn p_values_read_plainly() {
+        use crate::report::{p_is, p_text};
+        assert_eq!(p_text(0.0), "< 1e-16");
+        assert_eq!(p_is(1e-20), "p < 1e-16");
+        assert_eq!(p_is(0.034), "p = 0.03");
+        assert_eq!(p_text(2.5e-7), "2.5e-7");
     }
 
     /// Vuong's z by hand: units 0, 1, 2 with differences 1, 3, 2 (unit 2's split over two

@@ -7,8 +7,8 @@
 //!
 //! ```text
 //! truss diagnose --job BASELINE.json --case NAME --measured M.csv [--measured-members MM.csv]
-//!                [--measurement-sigma MM] [--samples N] --out DIR
-//! truss synth-measured --job J --case NAME --specimens N --seed S --effect NAME:P=V,…
+//!                [--measurement-sigma MM] [--samples N] [--candidates A,B] --out DIR
+//! truss synth-measured --job J --case NAME --specimens N --seed S --effect 'NAME:P=V,…[;…]'
 //!                [--measurement-sigma MM] [--all-nodes] [--members-out MM.csv] > M.csv
 //! ```
 //!
@@ -57,10 +57,16 @@
 //!    95 % region (threshold χ²_k(0.95)·c·λ̄) is projected on each parameter as well
 //!    (`joint_interval`). Every candidate also carries its Wald interval, c·A⁻¹BA⁻¹
 //!    ([`fit`]), reported beside the profile one.
-//! 3. **Add it**: `DIR/updated-job.json`, the baseline job with the named effect in the
-//!    case at its fitted values (same case name), which mc-shard and mc-merge run as usual.
-//! 4. **The gap shrinks**: step 1 again with the effect; every statistic before and after,
-//!    and the overall discrepancy (the energy distance) before and after.
+//! 3. **Add it, and look again**: the named effect is added at its fitted values and step 2
+//!    runs again against the updated model with the remaining candidates, and so on
+//!    ([`step`], [`diagnose`]): forward selection, until no candidate is significant and
+//!    clearly better, or a named effect does not shrink the discrepancy (it is then not
+//!    added), or none is left. The false discovery rate over the steps is held at α by
+//!    ForwardStop on the steps' Bonferroni-adjusted p-values ([`diagnose::forward_stop`]).
+//!    `DIR/updated-job.json` is the baseline job with every added effect in the case (same
+//!    case name), which mc-shard and mc-merge run as usual.
+//! 4. **The gap shrinks**: each step's discrepancy before and after, and the baseline's
+//!    against the final model's, statistic by statistic.
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
 //! plots of [`plot`]. Progress goes to stderr.
@@ -79,11 +85,17 @@
 //! ## Measured data
 //!
 //! See [`measured`]: CSV with a header, any column and row order, quoting and CRLF; bad rows
-//! are errors with their line; specimens missing a compared node are left out and counted.
+//! (and rows with extra fields) are errors with their line; specimens missing a compared
+//! node are left out and counted; outlier rows (a coordinate beyond 10 robust SD) are left
+//! out and listed by specimen and line; member rows of specimens the node file lacks, and
+//! member errors beyond 1 % of the member's length, are refused. With
+//! `--measured-members` each specimen's own measured members enter its likelihood
+//! ([`conditional`]).
 
 pub mod baseline;
 pub mod candidates;
 pub mod compare;
+pub mod conditional;
 pub mod derivatives;
 pub mod diagnose;
 mod errors;
@@ -95,6 +107,7 @@ pub mod profile;
 pub mod report;
 pub mod score;
 pub mod simulate;
+pub mod step;
 pub mod synth;
 
 pub use errors::DiagnoseError;
@@ -125,8 +138,10 @@ pub struct DiagnoseOptions {
 pub struct Summary {
     /// The verdict.
     pub verdict: diagnose::Verdict,
-    /// The named effect or `none`.
+    /// The first named effect or `none`.
     pub named_effect: String,
+    /// Every effect added, in order.
+    pub named_effects: Vec<String>,
     /// The reason.
     pub reason: String,
     /// Discrepancy before and after.
@@ -138,8 +153,12 @@ pub struct Summary {
 /// Fewest specimens accepted.
 pub const MIN_SPECIMENS: usize = 5;
 
+/// Most simulated samples per evaluation (`--samples`).
+pub const MAX_SAMPLES: usize = 10_000;
+
 /// Runs the diagnosis and writes `diagnosis.json`, `diagnosis.md`, `updated-job.json` and
-/// the plots into the output directory.
+/// the plots into the output directory. What was left out of the data (outliers, unknown
+/// nodes and members) is reported on stderr (even with `quiet`) and in `diagnosis.json`.
 pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     let s = &options.settings;
     if !(s.measurement_sigma >= 0.0 && s.measurement_sigma.is_finite()) {
@@ -147,10 +166,12 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
             "--measurement-sigma must be a non-negative number of mm".into(),
         ));
     }
-    if s.samples.is_some_and(|n| n < 100) {
-        return Err(DiagnoseError::Usage(
-            "--samples must be at least 100".into(),
-        ));
+    if let Some(n) = s.samples
+        && !(100..=MAX_SAMPLES).contains(&n)
+    {
+        return Err(DiagnoseError::Usage(format!(
+            "--samples {n}: must be from 100 to {MAX_SAMPLES}"
+        )));
     }
     let progress = diagnose::Progress::new(s.quiet);
     let base = baseline::Baseline::read(&options.job, &options.case)?;
@@ -160,12 +181,7 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
         options.measured_members.as_deref(),
         MIN_SPECIMENS,
     )?;
-    if data.report.left_out_count > 0 {
-        progress.note(&format!(
-            "{} specimens left out for a missing node",
-            data.report.left_out_count
-        ));
-    }
+    warn_left_out(&data.report);
     let d = diagnose::diagnose(&base, &data, s, &progress)?;
     let dir = &options.out;
     std::fs::create_dir_all(dir).map_err(|e| DiagnoseError::io(dir, e))?;
@@ -181,7 +197,7 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
             "the baseline",
         )?);
         if let Some(sim) = &d.simulations.1 {
-            let label = format!("with {}", report::named_effect(&d));
+            let label = format!("with {}", d.named_effects().join(" and "));
             plots.extend(plot::draw(dir, "after", &data, sim, d.top, &label)?);
         }
     }
@@ -210,7 +226,8 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     progress.note(&format!("wrote {}", dir.display()));
     Ok(Summary {
         verdict: d.verdict,
-        named_effect: report::named_effect(&d).to_string(),
+        named_effect: d.named_effect().to_string(),
+        named_effects: d.named_effects().iter().map(|s| s.to_string()).collect(),
         reason: d.reason.clone(),
         discrepancy: (
             d.before.energy,
@@ -218,4 +235,36 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
         ),
         files,
     })
+}
+
+/// What reading the data left out, on stderr.
+fn warn_left_out(r: &measured::DataReport) {
+    let warn = |m: String| eprintln!("truss diagnose: warning: {m}");
+    for o in &r.outliers {
+        warn(format!("outlier left out: {}", o.words()));
+    }
+    if r.left_out_count > 0 {
+        warn(format!(
+            "{} specimens left out for a missing node (first: {})",
+            r.left_out_count,
+            r.left_out
+                .iter()
+                .take(5)
+                .map(|(s, n)| format!("{s} lacks {}", n.join(" ")))
+                .collect::<Vec<_>>()
+                .join("; ")
+        ));
+    }
+    if !r.unknown_nodes.is_empty() {
+        warn(format!(
+            "node ids the model does not have, ignored: {}",
+            r.unknown_nodes.join(", ")
+        ));
+    }
+    if !r.unknown_members.is_empty() {
+        warn(format!(
+            "member ids the model does not have, ignored: {}",
+            r.unknown_members.join(", ")
+        ));
+    }
 }

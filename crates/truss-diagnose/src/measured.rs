@@ -7,8 +7,16 @@
 //! case, surrounding spaces ignored; other columns ignored), one row per measured node per
 //! specimen, positions in mm in the model's frame with the bottom surface at nominal. Quoted
 //! fields, CRLF line ends and a UTF-8 byte-order mark are accepted; node order does not
-//! matter. A row with a missing or non-numeric field, or a second row for the same specimen
-//! and node, is an error naming its line.
+//! matter. A row with a missing or non-numeric field, more fields than the header (a decimal
+//! comma shifts the columns), or a second row for the same specimen and node, is an error
+//! naming its line.
+//!
+//! **Outliers.** A specimen with a coordinate more than [`OUTLIER_Z`] robust standard
+//! deviations (1.4826 × the median absolute deviation over the specimens, at least
+//! [`OUTLIER_FLOOR`]) from the coordinates' median is left out and listed with its line, node
+//! and coordinate ([`Outlier`]): no candidate in the library moves one specimen that far
+//! from the others (the scatter candidates scale every specimen's scatter alike, which the
+//! robust deviation follows), while a typo (z × 10) or a shifted column does.
 //!
 //! Which coordinates enter the diagnosis: the nodes of the model that at least half of the
 //! specimens measured (the top-surface nodes must be among them); node ids the model does not
@@ -21,16 +29,58 @@
 //!
 //! CSV `specimen`, `member`, `length_error` (mm; natural length minus nominal, as in the
 //! job's distributions), member ids of the model; unknown member ids are ignored and
-//! reported. Specimen ids are matched to the node file's: a specimen's node positions and
-//! its own members' length errors come from the same truss, and the intervals treat them as
-//! one independent unit ([`Measured::clusters`]); members of a specimen without (usable)
-//! node data are one unit per specimen.
+//! reported. Specimen ids are those of the node file: a member row for a specimen the node
+//! file does not have is refused, naming the ids; a length error beyond
+//! [`MAX_MEMBER_ERROR_FRACTION`] of the member's nominal length is refused with its line.
+//! A specimen's node positions and its own members' length errors come from the same truss,
+//! and the intervals treat them as one independent unit ([`Measured::clusters`]); members of
+//! a specimen left out of the node data (a missing node, an outlier) are one unit per
+//! specimen.
 
 use crate::errors::DiagnoseError;
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
 use truss_core::Model;
 use truss_core::measure::distortion;
+
+/// Robust standard deviations beyond which a specimen is an outlier (module doc). For
+/// normal data a specimen passes with probability 1 − 2e-23 per coordinate.
+pub const OUTLIER_Z: f64 = 10.0;
+
+/// Floor of the robust standard deviation in the outlier screen \[mm\] (0.1 µm).
+pub const OUTLIER_FLOOR: f64 = 1e-4;
+
+/// Largest measured member length error accepted, as a fraction of the member's nominal
+/// length: 1 % (3.8 mm on a 380 mm member, a hundred times the loosest tolerance of the
+/// paper).
+pub const MAX_MEMBER_ERROR_FRACTION: f64 = 0.01;
+
+/// A specimen left out as an outlier.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Outlier {
+    /// The specimen.
+    pub specimen: String,
+    /// Line of the row furthest out.
+    pub line: u64,
+    /// Its node.
+    pub node: String,
+    /// Its coordinate (`x`, `y`, `z`).
+    pub axis: &'static str,
+    /// The measured displacement \[mm\].
+    pub displacement: f64,
+    /// Robust standard deviations from the median.
+    pub robust_z: f64,
+}
+
+impl Outlier {
+    /// In words, for the report and stderr.
+    pub fn words(&self) -> String {
+        format!(
+            "specimen {} (line {}: node {} {} displaced {:.4} mm, {:.0} robust SD from the median)",
+            self.specimen, self.line, self.node, self.axis, self.displacement, self.robust_z
+        )
+    }
+}
 
 /// One measured coordinate: a node of the model and an axis (0 = x, 1 = y, 2 = z).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -66,6 +116,8 @@ pub struct DataReport {
     pub left_out: Vec<(String, Vec<String>)>,
     /// How many specimens were left out.
     pub left_out_count: usize,
+    /// Specimens left out as outliers (module doc).
+    pub outliers: Vec<Outlier>,
     /// The nodes compared, model order.
     pub nodes: Vec<String>,
     /// Node ids in the file that the model does not have.
@@ -203,6 +255,16 @@ fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<(u64, Vec<String>)>, 
         if record.iter().all(str::is_empty) {
             continue;
         }
+        if record.len() > header.len() {
+            return Err(bad(
+                line,
+                format!(
+                    "{} fields where the header has {} (a decimal comma, or a stray separator?)",
+                    record.len(),
+                    header.len()
+                ),
+            ));
+        }
         let fields = index
             .iter()
             .zip(columns)
@@ -328,7 +390,19 @@ pub fn read(
     let (mut specimens, mut y) = (Vec::new(), Vec::new());
     let (mut tan_x, mut tan_y, mut theta_p) = (Vec::new(), Vec::new(), Vec::new());
     let nominal = |i: usize| model.nodes()[i].xyz;
+    let complete: Vec<&String> = order
+        .iter()
+        .filter(|s| chosen.iter().all(|i| by_specimen[*s].contains_key(i)))
+        .collect();
+    let disp_of =
+        |s: &String, c: &Coordinate| by_specimen[s][&c.node].0[c.axis] - nominal(c.node)[c.axis];
+    report.outliers = outliers(&complete, &coords, &disp_of, &|s, c| {
+        by_specimen[s][&c.node].1
+    });
     for s in &order {
+        if report.outliers.iter().any(|o| &o.specimen == s) {
+            continue;
+        }
         let nodes = &by_specimen[s];
         let missing: Vec<String> = chosen
             .iter()
@@ -361,14 +435,15 @@ pub fn read(
     report.specimens_used = specimens.len();
     if specimens.len() < min_specimens {
         return Err(measured_err(format!(
-            "{} usable specimens ({} left out for missing nodes); at least {min_specimens} are needed",
+            "{} usable specimens ({} left out for missing nodes, {} as outliers); at least {min_specimens} are needed",
             specimens.len(),
-            report.left_out_count
+            report.left_out_count,
+            report.outliers.len()
         )));
     }
     let members = match members_path {
         None => None,
-        Some(p) => Some(read_members(model, p, &specimens, &mut report)?),
+        Some(p) => Some(read_members(model, p, &specimens, &order, &mut report)?),
     };
     Ok(Measured {
         specimens,
@@ -386,6 +461,7 @@ fn read_members(
     model: &Model,
     path: &Path,
     specimens: &[String],
+    all_specimens: &[String],
     report: &mut DataReport,
 ) -> Result<MemberData, DiagnoseError> {
     let rows = read_table(path, &["specimen", "member", "length_error"])?;
@@ -397,12 +473,45 @@ fn read_members(
     let mut seen: HashMap<(String, usize), u64> = HashMap::new();
     let mut unknown: BTreeMap<String, ()> = BTreeMap::new();
     let mut data = MemberData::default();
+    let strangers: BTreeMap<&str, u64> = rows
+        .iter()
+        .filter(|(_, f)| !all_specimens.contains(&f[0]))
+        .map(|(line, f)| (f[0].as_str(), *line))
+        .rev()
+        .collect();
+    if !strangers.is_empty() {
+        return Err(DiagnoseError::Measured {
+            path: path.to_path_buf(),
+            message: format!(
+                "member rows for {} specimen(s) the node file does not have: {} (the specimen ids of the two files must match)",
+                strangers.len(),
+                strangers
+                    .iter()
+                    .take(20)
+                    .map(|(s, line)| format!("{s:?} (line {line})"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        });
+    }
     for (line, f) in &rows {
         let value = number(path, *line, "length_error", &f[2])?;
         let Some(m) = model.member_index(&f[1]) else {
             unknown.insert(f[1].clone(), ());
             continue;
         };
+        let length = model.nominal_length(m);
+        if value.abs() > MAX_MEMBER_ERROR_FRACTION * length {
+            return Err(DiagnoseError::BadRow {
+                path: path.to_path_buf(),
+                line: *line,
+                message: format!(
+                    "member {:?} length_error = {value} mm is beyond {} % of its {length:.1} mm length: not a manufacturing error (a unit or sign slip?)",
+                    f[1],
+                    MAX_MEMBER_ERROR_FRACTION * 100.0
+                ),
+            });
+        }
         if let Some(first) = seen.insert((f[0].clone(), m), *line) {
             return Err(DiagnoseError::BadRow {
                 path: PathBuf::from(path),
@@ -420,6 +529,59 @@ fn read_members(
     report.member_rows = Some(data.observations.len());
     report.unknown_members = unknown.into_keys().collect();
     Ok(data)
+}
+
+/// The specimens (among `complete`) with a coordinate beyond [`OUTLIER_Z`] robust standard
+/// deviations of the median; `disp` gives a specimen's displacement at a coordinate, `line`
+/// the line of its row.
+fn outliers(
+    complete: &[&String],
+    coords: &[Coordinate],
+    disp: &dyn Fn(&String, &Coordinate) -> f64,
+    line: &dyn Fn(&String, &Coordinate) -> u64,
+) -> Vec<Outlier> {
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        let n = v.len();
+        if n % 2 == 1 {
+            v[n / 2]
+        } else {
+            0.5 * (v[n / 2 - 1] + v[n / 2])
+        }
+    };
+    if complete.len() < 3 {
+        return Vec::new();
+    }
+    let centre: Vec<(f64, f64)> = coords
+        .iter()
+        .map(|c| {
+            let mut v: Vec<f64> = complete.iter().map(|s| disp(s, c)).collect();
+            let m = median(&mut v);
+            let mut dev: Vec<f64> = v.iter().map(|x| (x - m).abs()).collect();
+            (m, (1.4826 * median(&mut dev)).max(OUTLIER_FLOOR))
+        })
+        .collect();
+    let mut out = Vec::new();
+    for s in complete {
+        let worst = coords
+            .iter()
+            .zip(&centre)
+            .map(|(c, &(m, sd))| (c, disp(s, c), (disp(s, c) - m).abs() / sd))
+            .max_by(|a, b| a.2.total_cmp(&b.2));
+        if let Some((c, value, z)) = worst
+            && z > OUTLIER_Z
+        {
+            out.push(Outlier {
+                specimen: (*s).clone(),
+                line: line(s, c),
+                node: c.node_id.clone(),
+                axis: ["x", "y", "z"][c.axis],
+                displacement: value,
+                robust_z: z,
+            });
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -470,8 +632,7 @@ mod tests {
         // tan θ_x = (z₂ − z₁)/l (paper eq. 17) for s1.
         assert!((m.tan_x[0] - 0.001 / 380.0).abs() < 1e-12);
         // Members: s2's and s1's join their node terms (clusters 1 and 0); s3 (left out of
-        // the node data) and s4 (no node data) are one cluster each after them; an unknown
-        // member id is reported.
+        // the node data) is one cluster after them; an unknown member id is reported.
         let members = write(
             dir.path(),
             "mm.csv",
@@ -480,16 +641,38 @@ mod tests {
              s3,longeron.1.0,0.002\n\
              s1,longeron.1.1,-0.001\n\
              s3,longeron.1.1,0.0\n\
-             s4,batten.1.0,0.003\n\
              s1,strut.9,0.1\n",
         );
         let m = read(&model, &p, Some(&members), 1).unwrap();
         let data = m.members.as_ref().unwrap();
-        assert_eq!(data.observations.len(), 5);
-        assert_eq!(data.truss, vec![1, 2, 0, 2, 3]);
-        assert_eq!(m.clusters(), vec![0, 1, 1, 2, 0, 2, 3]);
-        assert_eq!(m.report.member_rows, Some(5));
+        assert_eq!(data.observations.len(), 4);
+        assert_eq!(data.truss, vec![1, 2, 0, 2]);
+        assert_eq!(m.clusters(), vec![0, 1, 1, 2, 0, 2]);
+        assert_eq!(m.report.member_rows, Some(4));
         assert_eq!(m.report.unknown_members, vec!["strut.9"]);
+        // Member rows for specimens the node file lacks are refused, naming them.
+        let strangers = write(
+            dir.path(),
+            "ms.csv",
+            "specimen,member,length_error\ns2,longeron.1.0,0.001\ns4,batten.1.0,0.003\ns9,batten.1.0,0\n",
+        );
+        let e = read(&model, &p, Some(&strangers), 1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(
+                "2 specimen(s) the node file does not have: \"s4\" (line 3), \"s9\" (line 4)"
+            ),
+            "{e}"
+        );
+        // −500 mm on a 380 mm member is refused with its line.
+        let absurd = write(
+            dir.path(),
+            "ma.csv",
+            "specimen,member,length_error\ns2,longeron.1.0,0.001\ns1,batten.1.0,-500\n",
+        );
+        let e = read(&model, &p, Some(&absurd), 1).unwrap_err().to_string();
+        assert!(e.contains("ma.csv:3: member \"batten.1.0\" length_error = -500 mm is beyond 1 % of its 380.0 mm length"), "{e}");
     }
 
     #[test]
@@ -522,5 +705,44 @@ mod tests {
         let p = write(dir.path(), "e.csv", "specimen,node,x,y,z\ns1,n1.0,0,,380\n");
         let e = read(&model, &p, None, 1).unwrap_err().to_string();
         assert!(e.contains("e.csv:2: the y field is empty"), "{e}");
+        // A decimal comma shifts the columns: an extra field, refused with its line.
+        let p = write(
+            dir.path(),
+            "c.csv",
+            "specimen,node,x,y,z\ns1,n1.0,0,0,380\ns1,n1.1,380,0,380,001\n",
+        );
+        let e = read(&model, &p, None, 1).unwrap_err().to_string();
+        assert!(
+            e.contains("c.csv:3: 6 fields where the header has 5"),
+            "{e}"
+        );
+    }
+
+    /// Twenty specimens scattered by a few µm, one of them with z typed ten times too large:
+    /// that one is left out and listed by specimen, line, node and coordinate; the others stay.
+    #[test]
+    fn a_typo_row_is_an_outlier_left_out() {
+        let model = PrismOptions::with_stages(1).model().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let h = 380.0 * 3f64.sqrt() / 2.0;
+        let mut text = String::from("specimen,node,x,y,z\n");
+        for s in 0..20 {
+            let dz = 0.001 * ((s * 7 % 5) as f64 - 2.0);
+            let z = if s == 13 { 3800.0 + dz } else { 380.0 + dz };
+            text += &format!(
+                "s{s},n1.0,0,0,{z}\ns{s},n1.1,380,0,{}\ns{s},n1.2,190,{h},380\n",
+                380.0 - dz
+            );
+        }
+        let p = write(dir.path(), "o.csv", &text);
+        let m = read(&model, &p, None, 1).unwrap();
+        assert_eq!(m.n(), 19);
+        assert!(!m.specimens.contains(&"s13".to_string()));
+        let o = &m.report.outliers;
+        assert_eq!(o.len(), 1, "{o:?}");
+        assert_eq!((o[0].specimen.as_str(), o[0].line), ("s13", 2 + 3 * 13));
+        assert_eq!((o[0].node.as_str(), o[0].axis), ("n1.0", "z"));
+        // s13: dz = 0.001·(91 mod 5 − 2) = −0.001 mm.
+        assert!((o[0].displacement - 3419.999).abs() < 1e-6);
     }
 }

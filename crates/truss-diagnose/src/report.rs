@@ -1,16 +1,30 @@
 //! `diagnosis.json` and `diagnosis.md`.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 3)
+//! ## diagnosis.json (format `truss-diagnose`, version 4)
 //!
 //! ```text
 //! format, format_version, program_version
 //! job {path, id, case, seed}, samples (N per simulation), measurement_sigma [mm]
 //! data        {file, rows, specimens_in_file, specimens_used, left_out_count, left_out[],
+//!              outliers[] {specimen, line, node, axis, displacement [mm], robust_z},
 //!              nodes[], unknown_nodes[], rare_nodes[], supports[], member_rows, unknown_members[]}
 //! verdict     "named" | "none" | "cannot_tell" | "unexplained";  reason (words)
-//! named_effect "none" or the effect's name
+//!              ("named" when an effect was added, else step 1's verdict)
+//! named_effect "none" or the first added effect's name
+//! named_effects [names]   every effect added, in order; [] when none
+//! steps       [{number, verdict, reason, named_effect ("none" when nothing was named),
+//!               kept (added to the model: significant, better by BIC, shrinking the
+//!               discrepancy, and kept by the false discovery rate over the steps),
+//!               parameters[] (the named effect's, as below), indistinguishable[],
+//!               adjusted_p (min(1, K·p) of the named one), log_likelihood_before,
+//!               candidates[] (as below, against the model of the step's start),
+//!               refitted[] (the effects added before, re-fitted with this one added:
+//!               candidate scores with Wald intervals),
+//!               discrepancy_before, discrepancy_after, seconds}]
+//! effects     [{name, parameters [[name, unit, value]]}]   the final model's effects at
+//!              their final values (after the re-fits): what updated-job.json holds
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null}]
-//!              (the named effect's)
+//!              (the first added effect's, as fitted in its step)
 //!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
 //!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
 //!              indistinguishable from it, else "wald"; lower/upper null when not found;
@@ -18,24 +32,30 @@
 //!   joint_interval  where profiled: the joint 95 % region of all k parameters projected on
 //!              this one (same fields, threshold χ²_k(0.95)·c·λ̄): every parameter inside its
 //!              joint interval at once with 95 % confidence
-//! indistinguishable [names]   (explain the data as well: ΔBIC within 2, or significant and
+//! indistinguishable [names]   (the first added effect's step; explain the data as well: ΔBIC within 2, or significant and
 //!              not shown further from the data than the named one, Vuong z < 1.96; empty
 //!              when clear)
 //! baseline    {log_likelihood}
-//! candidates  [{name, mechanism, k, parameters[], log_likelihood, lr_statistic, adjustment,
+//! candidates  (step 1's) [{name, mechanism, k, parameters[], log_likelihood, lr_statistic, adjustment,
 //!               p_value, significant, delta_bic, evaluations, profile_evaluations, seconds,
 //!               vuong_z?, error?}]   (vuong_z: the named one's Vuong z against this one,
 //!               for significant candidates when one is named)
 //! skipped     [{name, reason}]
-//! statistics  {before: Comparison, after: Comparison | null}
+//! statistics  {before: Comparison (the baseline's), after: Comparison | null (the final
+//!              model's, with every added effect)}
 //!   Comparison {specimens, samples, energy, energy_p, tolerance {within, outside[], bands},
 //!               statistics[] {id, kind, unit, measured, simulated, comparison, estimate
 //!               {value, lower, upper}, p_value, p_holm, disagrees, words}}
-//! discrepancy_before, discrepancy_after   (energy distance; after = before when no effect is added)
-//! method      {likelihood, fit, intervals, selection, verdicts, statistics, discrepancy}
+//! discrepancy_before, discrepancy_after   (energy distance of the baseline and of the final
+//!              model; after = before when no effect is added)
+//! method      {likelihood, fit, intervals, selection, verdicts, steps, statistics, discrepancy}
 //!             (in words)
 //! timing      {simulations, solves, seconds}
 //! ```
+//!
+//! Version 4 (from 3): the forward selection: `named_effects`, `steps[]`, `effects`,
+//! `data.outliers`,
+//! `method.steps`; `statistics.after` and `discrepancy_after` are the final model's.
 //!
 //! Version 3 (from 2): `candidates[].vuong_z`, and `indistinguishable` also lists
 //! significant candidates the named one does not fit significantly better than (Vuong).
@@ -51,12 +71,13 @@ use crate::baseline::Baseline;
 use crate::compare::{Comparison, Statistic};
 use crate::diagnose::{CandidateScore, Diagnosis, FittedParameter, Verdict};
 use crate::measured::{DataReport, Measured};
+use crate::step::{ModelEffect, Step};
 use serde::Serialize;
 
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -97,6 +118,7 @@ struct Method {
     intervals: &'static str,
     selection: &'static str,
     verdicts: &'static str,
+    steps: &'static str,
     statistics: &'static str,
     discrepancy: &'static str,
 }
@@ -109,6 +131,7 @@ const METHOD: Method = Method {
     selection: "likelihood-ratio statistic Λ = 2(ℓ − ℓ₀)/(c·λ̄) against the baseline, c = 1 + n/N, λ̄ = max(1, tr(A⁻¹B)/k); p = P(χ²_k ≥ Λ), significant when p < 0.05/K (Bonferroni over the K candidates); ΔBIC = k·λ̄·ln n − 2(ℓ − ℓ₀)/c = λ̄·(k ln n − Λ) (n specimens), the BIC of a misspecified likelihood whose penalty counts the effective number of parameters tr(A⁻¹B) = k·λ̄ (Gao & Song 2010), so that candidates' likelihoods are compared unscaled. Named: the candidate with the lowest ΔBIC if it is significant and ΔBIC ≤ −2; indistinguishable: other candidates with ΔBIC within 2 of it, and significant candidates the named one does not fit significantly closer than by Vuong's test for non-nested models, z = Σ_u d_u/√(c·n·var d) < 1.96 with d_u the difference of the two maximised ℓ's terms for specimen u (its member observations included) (Vuong 1989): BIC then prefers the named one, but by its penalty or by a difference in ℓ within the specimens' own scatter, not by a fit the data show to be closer. Significant means better than the baseline, not present: when the baseline misses some effect, any candidate that mimics part of it improves on the baseline, and BIC chooses between them.",
     verdicts: "named: as above. cannot_tell: some candidate improves the fit but not both significantly and by ΔBIC ≤ −2, or none improves it and the data cannot show the baseline agrees within tolerance. none: no candidate improves it and the baseline agrees within tolerance (every coordinate's mean within ±0.5 predicted SD, its SD and θ_P's median and 95th percentile within a factor 1.3, judged by their 95 % intervals). unexplained: no candidate improves it, yet the baseline disagrees (a Holm-significant statistic, with at least 30 specimens; with fewer, cannot_tell).",
     statistics: "per coordinate, piston (mean top z), tan θ_x, tan θ_y: mean difference (Welch interval), SD ratio (interval on ln with kurtosis-corrected variance), covariances (fourth-moment variance); θ_P percentiles 50/90/95/99 (Hyndman–Fan definition 1) as ratios with Poisson-bootstrap intervals (B = 1000); KS on θ_P; energy distance with a permutation test (R = 199). The simulation carries the instrument's noise. Disagrees: Holm-adjusted p < 0.05.",
+    steps: "forward selection: step 1 tests every candidate against the baseline; a named effect is added at its fitted values and step 2 tests the remaining candidates against that model, and so on, until a step names nothing (no candidate significant at α/K and better by ΔBIC ≤ −2), or names an effect that does not shrink the discrepancy (the energy distance; then it is not added), or no candidate is left. Effects already added keep their own step's fit. The false discovery rate over the steps is held at α by ForwardStop (G'Sell et al. 2016) on the steps' Bonferroni-adjusted p-values min(1, K·p): the named effects kept are the first k̂, k̂ = max{k : −(1/k)·Σ_{s≤k} ln(1 − p_s) ≤ α}.",
     discrepancy: "energy distance (unbiased U-statistic, Székely & Rizzo 2004) between the measured and simulated displacement vectors, each coordinate divided by its measured SD: 0 when the distributions agree.",
 };
 
@@ -124,11 +147,14 @@ struct Report<'a> {
     verdict: Verdict,
     reason: &'a str,
     named_effect: &'a str,
+    named_effects: Vec<&'a str>,
     parameters: &'a [FittedParameter],
     indistinguishable: &'a [String],
     baseline: Baseline0,
     candidates: &'a [CandidateScore],
     skipped: Vec<Skipped<'a>>,
+    steps: Vec<StepReport<'a>>,
+    effects: &'a [ModelEffect],
     statistics: Statistics<'a>,
     discrepancy_before: f64,
     discrepancy_after: f64,
@@ -136,13 +162,54 @@ struct Report<'a> {
     timing: Timing,
 }
 
-/// The named effect's name, or `none`.
+#[derive(Serialize)]
+struct StepReport<'a> {
+    number: usize,
+    verdict: Verdict,
+    reason: &'a str,
+    named_effect: &'a str,
+    kept: bool,
+    parameters: &'a [FittedParameter],
+    indistinguishable: &'a [String],
+    adjusted_p: Option<f64>,
+    log_likelihood_before: f64,
+    candidates: &'a [CandidateScore],
+    refitted: &'a [CandidateScore],
+    discrepancy_before: f64,
+    discrepancy_after: f64,
+    seconds: f64,
+}
+
+impl<'a> StepReport<'a> {
+    fn of(s: &'a Step) -> Self {
+        Self {
+            number: s.number,
+            verdict: s.verdict,
+            reason: &s.reason,
+            named_effect: s.named_effect().unwrap_or("none"),
+            kept: s.kept,
+            parameters: s.named_score().map_or(&[][..], |c| &c.parameters),
+            indistinguishable: &s.indistinguishable,
+            adjusted_p: s.adjusted_p,
+            log_likelihood_before: s.log_likelihood_before,
+            candidates: &s.candidates,
+            refitted: &s.refitted,
+            discrepancy_before: s.before.energy,
+            discrepancy_after: s.after.as_ref().map_or(s.before.energy, |a| a.energy),
+            seconds: s.seconds,
+        }
+    }
+}
+
+/// The first named effect's name, or `none`.
 pub fn named_effect(d: &Diagnosis) -> &str {
-    d.named.map_or("none", |i| d.candidates[i].name.as_str())
+    d.named_effect()
 }
 
 /// diagnosis.json.
 pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f64) -> String {
+    let first = d.first_step();
+    let first_named = d.steps.iter().find(|s| s.kept).unwrap_or(first);
     let report = Report {
         format: FORMAT,
         format_version: FORMAT_VERSION,
@@ -158,18 +225,25 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
         data: &measured.report,
         verdict: d.verdict,
         reason: &d.reason,
-        named_effect: named_effect(d),
-        parameters: d.named.map_or(&[][..], |i| &d.candidates[i].parameters),
-        indistinguishable: &d.indistinguishable,
+        named_effect: d.named_effect(),
+        named_effects: d.named_effects(),
+        parameters: if first_named.kept {
+            first_named.named_score().map_or(&[][..], |c| &c.parameters)
+        } else {
+            &[]
+        },
+        indistinguishable: &first_named.indistinguishable,
         baseline: Baseline0 {
             log_likelihood: d.baseline_log_likelihood,
         },
-        candidates: &d.candidates,
+        candidates: &first.candidates,
         skipped: d
             .skipped
             .iter()
             .map(|(n, r)| Skipped { name: n, reason: r })
             .collect(),
+        steps: d.steps.iter().map(StepReport::of).collect(),
+        effects: &d.effects,
         statistics: Statistics {
             before: &d.before,
             after: d.after.as_ref(),
@@ -188,6 +262,28 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
     s
 }
 
+/// A p-value for people: `p < 1e-16` below what a double can tell from 0 after
+/// `1 − CDF`, else two significant digits.
+pub fn p_text(p: f64) -> String {
+    if p < 1e-16 {
+        "< 1e-16".into()
+    } else if p >= 0.01 {
+        format!("{p:.2}")
+    } else {
+        format!("{p:.1e}")
+    }
+}
+
+/// `p = 0.03` or `p < 1e-16`.
+pub fn p_is(p: f64) -> String {
+    let t = p_text(p);
+    if t.starts_with('<') {
+        format!("p {t}")
+    } else {
+        format!("p = {t}")
+    }
+}
+
 fn g(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         format!("{v}")
@@ -201,6 +297,15 @@ fn g(v: f64) -> String {
     }
 }
 
+/// `[lo, hi]`, or `—` where the interval is degenerate or missing.
+fn interval_text(lower: f64, upper: f64) -> String {
+    if !(lower.is_finite() && upper.is_finite()) || lower == upper {
+        "—".into()
+    } else {
+        format!("[{}, {}]", g(lower), g(upper))
+    }
+}
+
 fn parameter_text(p: &FittedParameter) -> String {
     let i = &p.interval;
     let end = |v: Option<f64>| v.map_or("?".to_string(), g);
@@ -208,18 +313,24 @@ fn parameter_text(p: &FittedParameter) -> String {
     // (k > 1).
     let joint = match &p.joint_interval {
         Some(j) if *j != p.interval && (j.lower.is_some() || j.upper.is_some()) => {
-            format!("; all parameters jointly {}–{}", end(j.lower), end(j.upper))
+            format!(
+                "; all parameters jointly {}–{} {}",
+                end(j.lower),
+                end(j.upper),
+                p.unit
+            )
         }
         _ => String::new(),
     };
-    let iv = if i.lower.is_none() && i.upper.is_none() {
+    let iv = if i.lower.is_none() && i.upper.is_none() || i.lower == i.upper {
         format!(" (interval undetermined{joint})")
     } else {
         format!(
-            " (95 % {} CI {}–{}{}{joint})",
+            " (95 % {} CI {}–{} {}{}{joint})",
             i.method,
             end(i.lower),
             end(i.upper),
+            p.unit,
             match (i.lower_at_range_end, i.upper_at_range_end) {
                 (true, true) => ", both ends cut at the plausible range",
                 (true, false) => ", lower end cut at the plausible range",
@@ -231,22 +342,113 @@ fn parameter_text(p: &FittedParameter) -> String {
     format!("{} = {} {}{iv}", p.name, g(p.value), p.unit)
 }
 
-fn statistic_row(s: &Statistic) -> String {
+/// The size of the model along x, y, z \[mm\], for the plain reading of gradients.
+fn spans(baseline: &Baseline) -> [f64; 3] {
+    let nodes = baseline.model().nodes();
+    let mut out = [0.0; 3];
+    for (a, o) in out.iter_mut().enumerate() {
+        let lo = nodes.iter().map(|n| n.xyz[a]).fold(f64::INFINITY, f64::min);
+        let hi = nodes
+            .iter()
+            .map(|n| n.xyz[a])
+            .fold(f64::NEG_INFINITY, f64::max);
+        *o = hi - lo;
+    }
+    out
+}
+
+/// A fitted parameter in plain words (issue 18): what it means for the hardware.
+fn plain_reading(effect: &str, p: &FittedParameter, span: [f64; 3]) -> String {
+    let v = p.value;
+    let um = |mm: f64| format!("{:.1} µm", mm * 1e3);
+    let name = p.name.as_str();
+    match (effect, name) {
+        ("thermal_gradient", "offset") => format!(
+            "the whole truss about {:.2} K {} than the stated conditions",
+            v.abs(),
+            if v >= 0.0 { "warmer" } else { "cooler" }
+        ),
+        ("thermal_gradient", _) => {
+            let a = match name {
+                "gradient_x" => 0,
+                "gradient_y" => 1,
+                _ => 2,
+            };
+            format!(
+                "about {:.2} K of temperature difference across the {:.0} mm the truss spans along {}",
+                (v * span[a]).abs(),
+                span[a],
+                ["x", "y", "z"][a]
+            )
+        }
+        ("gravity", _) => format!(
+            "self-weight of {:.2} g along {}{} (a ground test's gravity direction)",
+            v.abs(),
+            if v >= 0.0 { "+" } else { "−" },
+            &name[2..]
+        ),
+        ("length_bias", _) => format!(
+            "the {} members are on average {} {} than nominal",
+            name.trim_start_matches("bias."),
+            um(v.abs()),
+            if v >= 0.0 { "longer" } else { "shorter" }
+        ),
+        ("length_sigma", _) => format!(
+            "the {} members' lengths scatter by {} (1 SD), {:.2} times the stated {}",
+            name.trim_start_matches("sigma."),
+            um(v),
+            v / p.null,
+            um(p.null)
+        ),
+        ("diagonal_pretension", _) => format!(
+            "the diagonals are on average {} shorter than nominal, pretensioning the frame",
+            um(v.abs())
+        ),
+        ("backlash", _) => format!(
+            "each pin joint has about {} of radial clearance (free play of its shaft in the hole)",
+            um(v)
+        ),
+        _ => String::new(),
+    }
+}
+
+/// A statistic's row: id, unit, measured, simulated, comparison with its interval, verdict.
+fn statistic_cells(s: &Statistic) -> String {
+    let (what, value, iv) = if s.kind == "energy" {
+        (
+            "energy distance (standardised)".to_string(),
+            g(s.estimate.value),
+            format!("permutation {}", p_is(s.p_value)),
+        )
+    } else {
+        (
+            s.comparison.to_string(),
+            g(s.estimate.value),
+            interval_text(s.estimate.lower, s.estimate.upper),
+        )
+    };
     format!(
-        "| {} | {} | {} | {} {} [{}, {}] | {} |",
-        s.id,
-        g(s.measured),
-        g(s.simulated),
-        s.comparison,
-        g(s.estimate.value),
-        g(s.estimate.lower),
-        g(s.estimate.upper),
+        "{} | {what} {value} {iv} | {}",
+        if s.kind == "energy" {
+            "—".into()
+        } else {
+            g(s.simulated)
+        },
         if s.disagrees {
             "**disagrees**"
         } else {
             "agrees"
         }
     )
+}
+
+/// The label of a statistic's row with its unit.
+fn statistic_label(s: &Statistic) -> String {
+    if s.kind == "energy" {
+        "energy distance of the displacement vectors".into()
+    } else {
+        format!("{} [{}]", s.id, s.unit)
+    }
 }
 
 /// diagnosis.md.
@@ -260,8 +462,18 @@ pub fn markdown(
     verdict_section(&mut m, baseline, d);
     data_section(&mut m, baseline, measured, d);
     disagreement_section(&mut m, d);
-    effect_section(&mut m, baseline, d);
+    for s in &d.steps {
+        step_section(&mut m, baseline, s);
+    }
+    for (n, why) in &d.skipped {
+        push(&mut m, &format!("- `{n}` not tried: {why}."));
+    }
+    if !d.skipped.is_empty() {
+        push(&mut m, "");
+    }
+    updated_job_section(&mut m, baseline, d);
     before_after_section(&mut m, d);
+    next_step_section(&mut m, measured, d);
     method_section(&mut m, d, plots);
     m
 }
@@ -281,33 +493,61 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
             baseline.case_name
         ),
     );
+    let named = d.named_effects();
     push(
         m,
         &format!(
-            "**Verdict: {}** — named effect: `{}`.\n",
-            match d.verdict {
-                Verdict::Named => "a missing effect is named",
-                Verdict::None => "the baseline agrees; no effect is missing",
-                Verdict::CannotTell => "the data cannot tell",
-                Verdict::Unexplained => "the baseline disagrees, and no candidate explains it",
-            },
-            named_effect(d)
+            "**Verdict: {}** — {}.\n",
+            d.verdict.words(),
+            if named.is_empty() {
+                "no effect added".to_string()
+            } else {
+                format!(
+                    "effects added, in order: {}",
+                    named
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", then ")
+                )
+            }
         ),
     );
-    push(m, &format!("{}.\n", d.reason));
-    if let Some(i) = d.named {
-        let c = &d.candidates[i];
-        push(
-            m,
-            &format!(
-                "Fitted: {}.\n",
-                c.parameters
-                    .iter()
-                    .map(parameter_text)
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            ),
-        );
+    push(m, &format!("{}.\n", d.reason.trim_end_matches('.')));
+    let span = spans(baseline);
+    for s in d.steps.iter().filter(|s| s.kept) {
+        let c = s.named_score().expect("a kept step names an effect");
+        push(m, &format!("Fitted `{}` (step {}):\n", c.name, s.number));
+        // The final value where a later step re-fitted it.
+        let last = d
+            .effects
+            .iter()
+            .find(|e| e.name == c.name)
+            .map(|e| &e.parameters);
+        for p in &c.parameters {
+            let now = last
+                .and_then(|ps| ps.iter().find(|q| q.0 == p.name))
+                .map(|q| q.2)
+                .filter(|&v| v != p.value);
+            let reading = FittedParameter {
+                value: now.unwrap_or(p.value),
+                ..p.clone()
+            };
+            push(
+                m,
+                &format!(
+                    "- {}{}: {}",
+                    parameter_text(p),
+                    now.map_or(String::new(), |v| format!(
+                        "; {} {} after the later steps' re-fit",
+                        g(v),
+                        p.unit
+                    )),
+                    plain_reading(&c.name, &reading, span)
+                ),
+            );
+        }
+        push(m, "");
     }
 }
 
@@ -344,6 +584,20 @@ fn data_section(m: &mut String, baseline: &Baseline, measured: &Measured, d: &Di
             d.samples
         ),
     );
+    if !r.outliers.is_empty() {
+        push(
+            m,
+            &format!(
+                "Outliers left out ({}): {}.\n",
+                r.outliers.len(),
+                r.outliers
+                    .iter()
+                    .map(|o| o.words())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        );
+    }
     if !r.unknown_nodes.is_empty() || !r.rare_nodes.is_empty() {
         push(
             m,
@@ -358,7 +612,7 @@ fn data_section(m: &mut String, baseline: &Baseline, measured: &Measured, d: &Di
         push(
             m,
             &format!(
-                "Member measurements: {rows} used{}.\n",
+                "Member measurements: {rows} used, each specimen's own in its likelihood{}.\n",
                 if r.unknown_members.is_empty() {
                     String::new()
                 } else {
@@ -372,9 +626,9 @@ fn data_section(m: &mut String, baseline: &Baseline, measured: &Measured, d: &Di
     }
 }
 
-/// `## 1.`: the statistics that disagree, before any effect is added.
+/// `## Where the baseline and the measurements disagree`.
 fn disagreement_section(m: &mut String, d: &Diagnosis) {
-    push(m, "## 1. Where simulation and measurement disagree\n");
+    push(m, "## Where the baseline and the measurements disagree\n");
     let mut flagged: Vec<&Statistic> = d.before.statistics.iter().filter(|s| s.disagrees).collect();
     flagged.sort_by(|a, b| a.p_value.total_cmp(&b.p_value));
     if flagged.is_empty() {
@@ -389,7 +643,7 @@ fn disagreement_section(m: &mut String, d: &Diagnosis) {
             ),
         );
         for s in flagged.iter().take(12) {
-            push(m, &format!("- {} (p = {:.1e})", s.words, s.p_value));
+            push(m, &format!("- {} ({})", s.words, p_is(s.p_value)));
         }
         push(m, "");
     }
@@ -407,33 +661,41 @@ fn disagreement_section(m: &mut String, d: &Diagnosis) {
     );
 }
 
-/// `## 2.` and `## 3.`: the candidates, their fits and tests, and what was added.
-fn effect_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
-    push(m, "## 2. Which effect\n");
+/// `## Step s`: the candidates against the current model, the decision, the fit, and the
+/// discrepancy before and after.
+fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
+    let title = match (s.named_effect(), s.kept) {
+        (Some(n), true) => format!("`{n}` added"),
+        (Some(n), false) => format!("`{n}` named but not kept"),
+        (None, _) => "nothing more to add".into(),
+    };
+    push(m, &format!("## Step {}: {title}\n", s.number));
+    push(
+        m,
+        &format!(
+            "Against the {} model (ℓ = {:.1}): {}.\n",
+            if s.number == 1 { "baseline" } else { "current" },
+            s.log_likelihood_before,
+            s.reason.trim_end_matches('.')
+        ),
+    );
     push(
         m,
         "| candidate | k | ℓ | Λ | p | ΔBIC | Vuong z | fitted |\n|---|---|---|---|---|---|---|---|",
     );
-    push(
-        m,
-        &format!(
-            "| baseline | 0 | {:.1} | | | 0 | | |",
-            d.baseline_log_likelihood
-        ),
-    );
-    let mut order: Vec<&CandidateScore> = d.candidates.iter().collect();
+    let mut order: Vec<&CandidateScore> = s.candidates.iter().collect();
     order.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
     for c in order {
         push(
             m,
             &format!(
-                "| {}{} | {} | {:.1} | {:.1} | {:.2e} | {:.1} | {} | {} |",
+                "| {}{} | {} | {:.1} | {:.1} | {} | {:.1} | {} | {} |",
                 c.name,
                 if c.significant { " *" } else { "" },
                 c.k,
                 c.log_likelihood,
                 c.lr_statistic,
-                c.p_value,
+                p_text(c.p_value),
                 c.delta_bic,
                 c.vuong_z.map_or(String::new(), |z| format!("{z:.2}")),
                 c.error.clone().unwrap_or_else(|| c
@@ -447,47 +709,109 @@ fn effect_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
     }
     push(
         m,
-        "\n\\* significant at 0.05/K (Bonferroni). Vuong z: how much closer the named effect fits than this one (below 1.96: not significantly).\n",
+        "\n\\* significant at 0.05/K (Bonferroni over this step's K candidates). ℓ, Λ and ΔBIC are dimensionless; ΔBIC against the model of this step's start (negative: better). Vuong z: how much closer the named effect fits than this one (below 1.96: not significantly).\n",
     );
-    for (n, why) in &d.skipped {
-        push(m, &format!("- `{n}` not tried: {why}."));
+    if let Some(c) = s.named_score() {
+        let span = spans(baseline);
+        for p in &c.parameters {
+            push(
+                m,
+                &format!(
+                    "- {}: {}",
+                    parameter_text(p),
+                    plain_reading(&c.name, p, span)
+                ),
+            );
+        }
+        push(m, "");
     }
-    push(m, "\n## 3. The updated job\n");
+    if !s.refitted.is_empty() {
+        push(
+            m,
+            "Effects added before, re-fitted with it (the others held; 95 % Wald intervals):\n",
+        );
+        for c in &s.refitted {
+            push(
+                m,
+                &format!(
+                    "- `{}`: {}",
+                    c.name,
+                    c.error.clone().unwrap_or_else(|| c
+                        .parameters
+                        .iter()
+                        .map(parameter_text)
+                        .collect::<Vec<_>>()
+                        .join("; "))
+                ),
+            );
+        }
+        push(m, "");
+    }
+    let after = s.after.as_ref().map_or(s.before.energy, |a| a.energy);
     push(
         m,
-        &match d.named {
-            Some(i) => format!(
-                "`updated-job.json` is the baseline job with `{}` added to case `{}` at its fitted values; run it with mc-shard and mc-merge like any other job.\n",
-                d.candidates[i].name, baseline.case_name
-            ),
-            None => "No effect was added: `updated-job.json` is the baseline job.\n".into(),
+        &format!(
+            "Discrepancy (energy distance, standardised): {:.4} before this step, {:.4} after{}.\n",
+            s.before.energy,
+            after,
+            if s.after.is_some() && s.before.energy > 0.0 {
+                format!(
+                    " ({:.0} % of it closed)",
+                    100.0 * (1.0 - after / s.before.energy)
+                )
+            } else {
+                String::new()
+            }
+        ),
+    );
+}
+
+/// `## The updated job`.
+fn updated_job_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
+    push(m, "## The updated job\n");
+    let named = d.named_effects();
+    push(
+        m,
+        &if named.is_empty() {
+            "No effect was added: `updated-job.json` is the baseline job.\n".into()
+        } else {
+            format!(
+                "`updated-job.json` is the baseline job with {} added to case `{}` at the fitted values; run it with mc-shard and mc-merge like any other job.\n",
+                named
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(" and "),
+                baseline.case_name
+            )
         },
     );
 }
 
-/// `## 4.`: the discrepancy before and after, statistic by statistic.
+/// `## Before and after`: the baseline against the final model, statistic by statistic, and
+/// what still disagrees.
 fn before_after_section(m: &mut String, d: &Diagnosis) {
-    push(m, "## 4. Before and after\n");
+    push(m, "## Before and after, all steps together\n");
     let after_e = d.after.as_ref().map_or(d.before.energy, |a| a.energy);
     push(
         m,
         &format!(
-            "Overall discrepancy (energy distance, standardised): before {:.4} (p = {:.3}), after {:.4}{}.\n",
+            "Overall discrepancy (energy distance, standardised; 0 when the distributions agree): baseline {:.4} (permutation {}), final model {:.4}{}.\n",
             d.before.energy,
-            d.before.energy_p,
+            p_is(d.before.energy_p),
             after_e,
             d.after
                 .as_ref()
                 .map_or(" (no effect added)".to_string(), |a| format!(
-                    " (p = {:.3}); {:.0} % of the gap closed",
-                    a.energy_p,
+                    " (permutation {}); {:.0} % of the gap closed",
+                    p_is(a.energy_p),
                     100.0 * (1.0 - a.energy / d.before.energy)
                 ))
         ),
     );
     push(
         m,
-        "| statistic | measured | before: simulated | before: comparison [95 % CI] | | after: simulated | after: comparison [95 % CI] | |\n|---|---|---|---|---|---|---|---|",
+        "| statistic [unit] | measured | baseline: simulated | baseline: comparison [95 % CI] | | final: simulated | final: comparison [95 % CI] | |\n|---|---|---|---|---|---|---|---|",
     );
     let key = |s: &Statistic| {
         s.disagrees
@@ -501,32 +825,124 @@ fn before_after_section(m: &mut String, d: &Diagnosis) {
         if !key(s) && d.after.as_ref().is_none_or(|a| !a.statistics[i].disagrees) {
             continue;
         }
-        let before = statistic_row(s);
-        let after = d.after.as_ref().map_or("| | | |".to_string(), |a| {
-            let t = &a.statistics[i];
-            format!(
-                "| {} | {} {} [{}, {}] | {} |",
-                g(t.simulated),
-                t.comparison,
-                g(t.estimate.value),
-                g(t.estimate.lower),
-                g(t.estimate.upper),
-                if t.disagrees {
-                    "**disagrees**"
-                } else {
-                    "agrees"
-                }
-            )
-        });
+        let measured = if s.kind == "energy" {
+            "—".into()
+        } else {
+            g(s.measured)
+        };
+        let after = d
+            .after
+            .as_ref()
+            .map_or(" | | ".to_string(), |a| statistic_cells(&a.statistics[i]));
         push(
             m,
-            &format!("{}{}", before.trim_end_matches('|').trim_end(), after),
+            &format!(
+                "| {} | {measured} | {} | {after} |",
+                statistic_label(s),
+                statistic_cells(s)
+            ),
         );
     }
     push(
         m,
         "\nEvery statistic, before and after, with its interval and p-value, is in `diagnosis.json`.\n",
     );
+    let last = d.after.as_ref().unwrap_or(&d.before);
+    let still: Vec<&Statistic> = last.statistics.iter().filter(|s| s.disagrees).collect();
+    if still.is_empty() {
+        push(
+            m,
+            "No statistic disagrees with the final model (Holm-adjusted p < 0.05).\n",
+        );
+    } else {
+        push(m, "**Still disagreeing with the final model:**\n");
+        for s in &still {
+            push(m, &format!("- {} ({})", s.words, p_is(s.p_value)));
+        }
+        push(m, "");
+    }
+    let over: Vec<&Statistic> = last
+        .statistics
+        .iter()
+        .filter(|s| s.kind == "percentile" && s.id != "p50 theta_p" && s.estimate.upper < 1.0)
+        .collect();
+    if !over.is_empty() {
+        push(
+            m,
+            &format!(
+                "**The final model over-predicts the tail of θ_P:** {} (measured against predicted, whole 95 % interval below 1): a budget from it is conservative there.\n",
+                over.iter()
+                    .map(|s| format!(
+                        "{} ratio {} {}",
+                        s.id,
+                        g(s.estimate.value),
+                        interval_text(s.estimate.lower, s.estimate.upper)
+                    ))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        );
+    }
+}
+
+/// `## Next step`: what to measure or do next.
+fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
+    push(m, "## Next step\n");
+    let mut advice = Vec::new();
+    let joint_like = ["length_bias", "diagonal_pretension"];
+    for s in &d.steps {
+        let Some(named) = s.named_effect() else {
+            continue;
+        };
+        let mixes_backlash = (named == "backlash"
+            && s.indistinguishable
+                .iter()
+                .any(|o| joint_like.contains(&o.as_str())))
+            || (joint_like.contains(&named) && s.indistinguishable.iter().any(|o| o == "backlash"));
+        if mixes_backlash && measured.members.is_none() {
+            advice.push(format!(
+                "Step {}: `{named}` and {} fit the node positions equally well: joint free play shortens the truss much as a member-length error does. Measure the member lengths one by one (longerons and diagonals, to a few µm) and run again with `--measured-members`: then they separate.",
+                s.number,
+                s.indistinguishable
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        } else if !s.indistinguishable.is_empty() {
+            advice.push(format!(
+                "Step {}: `{named}` cannot be told from {} with these data; a measurement that only one of them affects separates them (member lengths for length effects, temperatures for a thermal field, a test in another orientation for self-weight).",
+                s.number,
+                s.indistinguishable
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+    }
+    match d.verdict {
+        Verdict::Named => advice.push(
+            "Run `updated-job.json` with mc-shard and mc-merge for the precision budget with the effects added.".into(),
+        ),
+        Verdict::None => advice.push(
+            "None needed: the baseline job's prediction stands for these trusses.".into(),
+        ),
+        Verdict::CannotTell => advice.push(format!(
+            "Measure more specimens: with {} the data cannot decide; about four times as many halve the intervals.",
+            measured.n()
+        )),
+        Verdict::Unexplained => advice.push(
+            "Look for a mechanism outside the candidates (a support that moves, a member bent or damaged, the instrument's own error): measure the supports and the instrument against a reference.".into(),
+        ),
+    }
+    if !measured.report.outliers.is_empty() {
+        advice.push("Check the outlier rows listed under Data against the instrument's records; they were left out.".into());
+    }
+    for a in advice {
+        push(m, &format!("- {a}"));
+    }
+    push(m, "");
 }
 
 /// The plots and `## Method`: how every number was found.
@@ -544,6 +960,7 @@ fn method_section(m: &mut String, d: &Diagnosis, plots: &[String]) {
         ("Fit", METHOD.fit),
         ("Intervals", METHOD.intervals),
         ("Selection", METHOD.selection),
+        ("Steps", METHOD.steps),
         ("Verdicts", METHOD.verdicts),
         ("Statistics", METHOD.statistics),
         ("Discrepancy", METHOD.discrepancy),
@@ -553,8 +970,15 @@ fn method_section(m: &mut String, d: &Diagnosis, plots: &[String]) {
     push(
         m,
         &format!(
-            "\n{} simulations ({} solves) in {:.1} s.",
-            d.work.0, d.work.1, d.work.2
+            "\n{} simulations ({} solves) in {:.1} s; per step: {}.",
+            d.work.0,
+            d.work.1,
+            d.work.2,
+            d.steps
+                .iter()
+                .map(|s| format!("{} {:.1} s", s.number, s.seconds))
+                .collect::<Vec<_>>()
+                .join(", ")
         ),
     );
 }

@@ -82,12 +82,16 @@ pub struct CandidateScore {
     pub error: Option<String>,
 }
 
-/// ℓ of the measured data under an edited case.
+/// ℓ of the measured data under an edited case: the current model of a forward-selection
+/// step (`start`: the baseline with the effects added so far) with one candidate applied.
 pub(crate) struct Evaluator<'a> {
     pub baseline: &'a Baseline,
+    pub start: CaseEdit,
     pub measured: &'a Measured,
     pub samples: usize,
     pub sigma_m: f64,
+    /// Condition the node terms on the specimens' measured members.
+    pub condition: bool,
     pub simulations: std::cell::Cell<usize>,
 }
 
@@ -105,9 +109,20 @@ impl Evaluator<'_> {
     }
 
     /// The terms of ℓ: each specimen's, then each member observation's.
+    /// With member measurements, each specimen's node term is conditioned on its own
+    /// measured members ([`crate::conditional`]).
     pub fn score(&self, job: &truss_job::Job, sim: &Simulation) -> Result<Terms, DiagnoseError> {
-        let g = Gaussian::from_simulation(sim, self.sigma_m)?;
-        let mut terms = g.log_densities(&self.measured.y);
+        let mut terms = if self.condition && self.measured.members.is_some() {
+            crate::conditional::log_densities(
+                job,
+                self.baseline.model(),
+                sim,
+                self.measured,
+                self.sigma_m,
+            )?
+        } else {
+            Gaussian::from_simulation(sim, self.sigma_m)?.log_densities(&self.measured.y)
+        };
         if let Some(m) = &self.measured.members {
             terms.extend(member_log_likelihood(
                 &job.cases[0],
@@ -124,9 +139,9 @@ impl Evaluator<'_> {
         self.log_likelihood(&self.edit(c, values)?)
     }
 
-    /// The baseline case with the candidate applied at `values`.
+    /// The current model's case with the candidate applied at `values`.
     pub fn edit(&self, c: &dyn Candidate, values: &[f64]) -> Result<CaseEdit, DiagnoseError> {
-        let mut edit = self.baseline.derived_case();
+        let mut edit = self.start.clone();
         c.apply(values, &mut edit)?;
         Ok(edit)
     }

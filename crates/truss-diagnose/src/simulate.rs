@@ -35,6 +35,9 @@ pub struct Simulation {
     pub tan_y: Vec<f64>,
     /// θ_P of the noisy positions \[rad\].
     pub theta_p: Vec<f64>,
+    /// The sample index of each converged row (rows of `x`), for draws made again from
+    /// the same streams (the member length errors of [`crate::conditional`]).
+    pub indices: Vec<u64>,
     /// Samples whose solve failed (left out).
     pub failed: usize,
     /// The first failure's reason.
@@ -170,6 +173,7 @@ pub fn simulate(
             sim.x_noisy.extend(noisy);
         }
         sim.x.extend(row.x);
+        sim.indices.push(k as u64);
         sim.n += 1;
     }
     if sim.n < 2 || sim.failed * 20 > samples {

@@ -1,5 +1,8 @@
 //! `truss synth-measured`: measured data made from a model with an effect the baseline
 //! lacks (or none), for testing the diagnosis on data whose hidden effect it is not told.
+//! Several effects are hidden at once with `;` between them
+//! (`gravity:g_x=1;length_sigma:sigma.longeron=0.012`). A parameter value outside its
+//! candidate's plausible range, or not a finite number, is refused naming the parameter.
 //!
 //! The specimens are samples `0..N` of the baseline case with the effect applied, under the
 //! seed `S` given (not the job's: their member errors are independent of the diagnosis's
@@ -28,7 +31,7 @@ pub struct SynthOptions {
     pub specimens: usize,
     /// Seed of the specimens and their noise.
     pub seed: u64,
-    /// `none` or `NAME:P=V,…`.
+    /// `none` or `NAME:P=V,…`; several effects separated by `;`.
     pub effect: String,
     /// Instrument σ_m \[mm\].
     pub measurement_sigma: f64,
@@ -48,8 +51,10 @@ pub fn synth(options: &SynthOptions, out: &mut dyn Write) -> Result<usize, Diagn
     let baseline = Baseline::read(&options.job, &options.case)?;
     let (candidates, _) = library(&baseline);
     let mut edit = baseline.derived_case();
-    if let Some((i, values)) = parse_effect(&options.effect, &candidates)? {
-        candidates[i].apply(&values, &mut edit)?;
+    for effect in options.effect.split(';') {
+        if let Some((i, values)) = parse_effect(effect, &candidates)? {
+            candidates[i].apply(&values, &mut edit)?;
+        }
     }
     let job = baseline.job_of(&edit, options.specimens as u64, Some(options.seed))?;
     let model = job.cases[0].model.clone();
