@@ -50,8 +50,10 @@ pub struct Settings {
     pub samples: Option<usize>,
     /// The instrument's standard deviation σ_m \[mm\].
     pub measurement_sigma: f64,
-    /// Family-wise significance level of the likelihood-ratio tests (Bonferroni over the
-    /// candidates).
+    /// The false-positive rate of the whole verdict on data that miss nothing. Half of it,
+    /// [`Settings::candidate_level`], goes to the candidates' likelihood-ratio tests
+    /// (Bonferroni over the candidates within a step, ForwardStop over the steps); the other
+    /// half is the comparison's ([`crate::compare::LEVEL`], fixed at 0.025).
     pub alpha: f64,
     /// No progress on stderr.
     pub quiet: bool,
@@ -62,6 +64,13 @@ pub struct Settings {
     /// draws from the case's distributions (the older, distribution-only use, kept for
     /// comparison).
     pub condition_on_members: bool,
+}
+
+impl Settings {
+    /// The candidates' family-wise level: α/2 (see [`Settings::alpha`]).
+    pub fn candidate_level(&self) -> f64 {
+        self.alpha / 2.0
+    }
 }
 
 impl Default for Settings {
@@ -461,13 +470,13 @@ pub fn diagnose(
         .filter(|s| s.kept)
         .filter_map(|s| s.adjusted_p)
         .collect();
-    let kept = forward_stop(&adjusted, settings.alpha);
+    let kept = forward_stop(&adjusted, settings.candidate_level());
     for s in steps.iter_mut().filter(|s| s.kept).skip(kept) {
         s.kept = false;
         s.verdict = Verdict::CannotTell;
         s.reason += &format!(
             "; not kept: over the steps, the false discovery rate at α = {} keeps only the first {kept} named effects (ForwardStop on the steps' adjusted p-values {})",
-            settings.alpha,
+            settings.candidate_level(),
             adjusted
                 .iter()
                 .map(|p| crate::report::p_text(*p))

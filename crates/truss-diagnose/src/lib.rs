@@ -61,8 +61,10 @@
 //!    runs again against the updated model with the remaining candidates, and so on
 //!    ([`step`], [`diagnose`]): forward selection, until no candidate is significant and
 //!    clearly better, or a named effect does not shrink the discrepancy (it is then not
-//!    added), or none is left. The false discovery rate over the steps is held at α by
-//!    ForwardStop on the steps' Bonferroni-adjusted p-values ([`diagnose::forward_stop`]).
+//!    added), or none is left. The false discovery rate over the steps is held at α/2 by
+//!    ForwardStop on the steps' Bonferroni-adjusted p-values ([`diagnose::forward_stop`]);
+//!    the other half of α = 0.05 is the comparison's ([`compare::LEVEL`]), so that on data
+//!    missing nothing any verdict but agreement has a rate of at most α.
 //!    `DIR/updated-job.json` is the baseline job with every added effect in the case (same
 //!    case name), which mc-shard and mc-merge run as usual.
 //! 4. **The gap shrinks**: each step's discrepancy before and after, and the baseline's

@@ -174,7 +174,7 @@ fn update(
             l0,
             n,
             inflation: 1.0 + n as f64 / ctx.samples as f64,
-            level: ctx.settings.alpha,
+            level: ctx.settings.candidate_level(),
         };
         let f = fit_candidate(&ev, c, &test);
         ctx.simulations
@@ -240,7 +240,7 @@ pub(crate) fn run_step(
         l0: current.log_likelihood,
         n,
         inflation: 1.0 + n as f64 / ctx.samples as f64,
-        level: ctx.settings.alpha / candidates.len().max(1) as f64,
+        level: ctx.settings.candidate_level() / candidates.len().max(1) as f64,
     };
     ctx.progress.note(&format!(
         "step {number}: ℓ₀ = {:.1}; {} of {} statistics disagree; energy distance {:.3} (p = {:.3}); {} candidates",
