@@ -521,7 +521,7 @@ pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> (f64, f64) 
 }
 
 /// The comparison's family-wise level: a statistic disagrees when its Holm-adjusted p is
-/// below it. Half of the verdict's α = 0.05 ([`crate::Settings::alpha`]): a verdict other
+/// below it. Half of the verdict's α = 0.05 ([`crate::diagnose::Settings::alpha`]): a verdict other
 /// than "the model agrees" on data that miss nothing can come from either of two families
 /// of tests (the comparison here, which alone can say `unexplained`, and the candidates'
 /// likelihood-ratio tests, which name an effect), so each family gets α/2 and their union
