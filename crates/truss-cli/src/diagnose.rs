@@ -16,13 +16,13 @@ pub struct DiagnoseArgs {
     /// The case of the job the measurements are compared with.
     #[arg(long)]
     pub case: String,
-    /// Measured node positions: CSV `specimen,node,x,y,z` \[mm\].
+    /// Measured node positions: CSV `specimen,node,x,y,z` (mm).
     #[arg(long)]
     pub measured: PathBuf,
-    /// Measured member length errors: CSV `specimen,member,length_error` \[mm\].
+    /// Measured member length errors: CSV `specimen,member,length_error` (mm).
     #[arg(long)]
     pub measured_members: Option<PathBuf>,
-    /// The instrument's standard deviation per coordinate \[mm\].
+    /// The instrument's standard deviation per coordinate (mm).
     #[arg(long, default_value_t = 0.0)]
     pub measurement_sigma: f64,
     /// Simulated samples per evaluation, 100 to 10 000 (default max(2000, 20 × specimens),
@@ -63,7 +63,7 @@ pub struct SynthArgs {
     /// `;`.
     #[arg(long)]
     pub effect: String,
-    /// The instrument's standard deviation per coordinate \[mm\].
+    /// The instrument's standard deviation per coordinate (mm).
     #[arg(long, default_value_t = 0.0)]
     pub measurement_sigma: f64,
     /// Write every node, not only the top surface.

@@ -16,16 +16,16 @@ pub struct ToleranceArgs {
     /// The case whose groups' tolerances are allocated (its σ values are the starting point).
     #[arg(long)]
     pub case: String,
-    /// The budget: θ_P at the percentile must not exceed this angle \[arcsec\].
+    /// The budget: θ_P at the percentile must not exceed this angle (arcsec).
     #[arg(long)]
     pub target_arcsec: f64,
-    /// The percentile of θ_P the budget applies to \[%\].
+    /// The percentile of θ_P the budget applies to (%).
     #[arg(long, default_value_t = 95.0)]
     pub percentile: f64,
     /// A group's cost weight, `GROUP=WEIGHT` (default 1: cost = members / σ); repeatable.
     #[arg(long = "cost", value_name = "GROUP=WEIGHT")]
     pub costs: Vec<String>,
-    /// Pin a group at a supplier's tolerance, `GROUP=SIGMA` \[mm\]; repeatable.
+    /// Pin a group at a supplier's tolerance, `GROUP=SIGMA` (mm); repeatable.
     #[arg(long = "fix", value_name = "GROUP=SIGMA")]
     pub fixes: Vec<String>,
     /// Samples of each verification run.

@@ -217,6 +217,9 @@ fn help_has_no_escaped_brackets() {
         &["solve", "--help"],
         &["completions", "--help"],
         &["man", "--help"],
+        &["diagnose", "--help"],
+        &["synth-measured", "--help"],
+        &["tolerance", "--help"],
     ] {
         let out = truss(args);
         let help = String::from_utf8(out.stdout).unwrap();
