@@ -13,8 +13,8 @@
 # - single: each of the six candidate effects hidden alone, ≥ 5 seeds each: exactly that
 #   effect named, nothing after it.
 # - pairs: two effects hidden at once, each pair mixing a mean shift with a change of
-#   scatter (gravity + length_sigma; thermal_gradient + length_sigma): both named, in
-#   either order, nothing else.
+#   scatter (gravity + length_sigma; thermal_gradient + length_sigma; diagonal_pretension +
+#   length_sigma): both named, in either order, nothing else.
 # - backlash with members: the paper's clearances U[0.004, 0.017] mm (made by the job's
 #   own backlash case), members measured one by one: backlash named.
 # - backlash without members: node positions alone: backlash named, or listed as
@@ -151,6 +151,9 @@ if run_group pairs; then
   check "pair-thermal-sigma" thermal_gradient,length_sigma "$J" $B $B 0 \
     "thermal_gradient:gradient_x=0.002,offset=2;length_sigma:sigma.batten=0.015" 302 \
     gradient_x=0.002 gradient_y=0 gradient_z=0 offset=2 sigma.longeron=0.0063 sigma.batten=0.015
+  check "pair-pretension-sigma" diagonal_pretension,length_sigma "$J" $B $B 0 \
+    "diagonal_pretension:length_error=-0.05;length_sigma:sigma.batten=0.015" 303 \
+    length_error=-0.05 sigma.longeron=0.0063 sigma.batten=0.015
 fi
 if run_group backlash; then
   # The paper's clearances scatter among the joints (U[0.004, 0.017] mm); the candidate's
