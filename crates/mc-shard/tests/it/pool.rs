@@ -6,14 +6,7 @@
 
 use crate::common::*;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn mc_shard(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mc-shard"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::process::Output;
 
 fn work(job: &Path, out: &Path, shards: &str, extra: &[&str]) -> Output {
     let mut args = vec![
@@ -40,17 +33,7 @@ fn a_damaged_shard_is_quarantined_and_the_pool_goes_on() {
     // Shard 1 of 3 (20..40) holds a line no crash produces: a corrupt line mid-file.
     std::fs::create_dir_all(&out).unwrap();
     let damaged = out.join(shard_record::ShardRange::new(20, 40).file_name());
-    let o = mc_shard(&[
-        "run",
-        "--job",
-        job.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--shard",
-        "1/3",
-        "-q",
-    ]);
-    assert!(o.status.success());
+    run_shard(&job, &out, "1/3");
     let text = std::fs::read_to_string(&damaged).unwrap();
     let mut lines: Vec<&str> = text.split_inclusive('\n').collect();
     lines.truncate(8);
@@ -149,17 +132,7 @@ fn a_worker_refuses_a_directory_of_another_split_and_absurd_durations() {
     let dir = tempfile::tempdir().unwrap();
     let job = write(dir.path(), "job.json", &small_job(5));
     let out = dir.path().join("o");
-    let o = mc_shard(&[
-        "run",
-        "--job",
-        job.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--shard",
-        "0/2",
-        "-q",
-    ]);
-    assert!(o.status.success());
+    run_shard(&job, &out, "0/2");
     // No pool record yet, but a shard file of a 2-way split: a 3-way worker is refused.
     let o = work(&job, &out, "3", &[]);
     let stderr = String::from_utf8_lossy(&o.stderr);

@@ -5,14 +5,7 @@
 
 use crate::common::*;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn mc_shard(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mc-shard"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::process::Output;
 
 /// A 2-stage job of 300 samples in one case with sigma 0.5 (so a header edit to 0.05 is a
 /// real parameter change).
@@ -118,17 +111,7 @@ fn audit_replays_a_seeded_sample_and_names_a_forged_line() {
     let job = write(dir.path(), "job.json", &job_text());
     let out = dir.path().join("s");
     for shard in ["0/3", "1/3", "2/3"] {
-        let o = mc_shard(&[
-            "run",
-            "--job",
-            job.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-            "--shard",
-            shard,
-            "-q",
-        ]);
-        assert!(o.status.success());
+        run_shard(&job, &out, shard);
     }
     let audit = |samples: &str, seed: &str| {
         mc_shard(&[
