@@ -2,6 +2,7 @@
 //! command line, and concurrent cron workers.
 
 mod backlash;
+mod binary;
 mod cli;
 mod common;
 mod determinism;

@@ -4,6 +4,7 @@
 //! worker with another `--shards` count on the directory is refused. Also the bounds of
 //! `work`'s and `run`'s flags.
 
+use crate::binary::{mc_shard, run_shard};
 use crate::common::*;
 use std::path::Path;
 use std::process::Output;

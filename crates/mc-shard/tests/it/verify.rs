@@ -3,6 +3,7 @@
 //! changed number) are each found, by `run`, by the merge, or by `audit`, with the file and
 //! line named and the right exit code.
 
+use crate::binary::{mc_shard, run_shard};
 use crate::common::*;
 use std::path::Path;
 use std::process::Output;
