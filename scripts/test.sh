@@ -15,28 +15,31 @@
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$REPO"
+# Each phase says when it starts (seconds since this script began), so a slow CI run shows
+# where its time went.
+phase() { echo "test: $1 (at ${SECONDS} s)" >&2; }
 
 command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && [ -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || scripts/setup.sh
 
-echo "test: cargo test --workspace" >&2
+phase "cargo test --workspace"
 cargo test --workspace --quiet
 
-echo "test: the cross-check against faer (a large build the default tests do without)" >&2
+phase "the cross-check against faer (a large build the default tests do without)"
 cargo test --release --quiet -p truss-core --features cross-checks --lib -- block::tests::agrees_with_faer_dense
 
-echo "test: the slow statistical checks (#[ignore]d in the default run), in release" >&2
+phase "the slow statistical checks (#[ignore]d in the default run), in release"
 # Only the crates that have such tests: building every test target in release costs minutes.
 for crate in $(grep -rl '#\[ignore' crates/*/src crates/*/tests | cut -d/ -f2 | sort -u); do
     cargo test --release --quiet -p "$crate" -- --ignored
 done
 
-echo "test: release binaries" >&2
+phase "release binaries"
 cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-mc
 
-echo "test: Slurm end to end" >&2
+phase "Slurm end to end"
 scripts/slurm/e2e-test.sh
 
-echo "test: smoke test of the main command" >&2
+phase "smoke test of the main command"
 scripts/smoke-test.sh
 
-echo "test: all passed" >&2
+phase "all passed"
