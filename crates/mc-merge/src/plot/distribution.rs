@@ -10,6 +10,7 @@
 //!
 //! Angles in µrad with an arcsec axis beside them.
 
+use super::frame::*;
 use super::style::*;
 use crate::load::CaseData;
 use crate::report::{CaseReport, Report};
@@ -167,39 +168,17 @@ pub fn theta(
         );
     }
 
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (WIDTH, CHART_HEIGHT + legend.height()))
-            .into_drawing_area();
-        root.fill(&WHITE)?;
-        let (area, legend_area) = root.split_vertically(CHART_HEIGHT);
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                title(rep, &format!("distortion angle {}", theta_p())),
-                (FONT, 22),
-            )
-            .margin(16)
-            .x_label_area_size(50)
+    let svg = render(WIDTH, CHART_HEIGHT, &legend, |_, area| {
+        let mut chart = captioned(area, title(rep, &format!("distortion angle {}", theta_p())))
             .top_x_label_area_size(50)
-            .y_label_area_size(80)
             .build_cartesian_2d(0.0..hi, 0.0..top.max(1e-12))?
             .set_secondary_coord(0.0..hi * ARCSEC_PER_MICRORAD, 0.0..top.max(1e-12));
-        chart
-            .configure_mesh()
+        styled_mesh(&mut chart.configure_mesh())
             .x_desc(format!("{} [µrad]", theta_p()))
             .y_desc("probability density [1/µrad]")
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(LIGHT)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
-        chart
-            .configure_secondary_axes()
+        styled_secondary(&mut chart.configure_secondary_axes())
             .x_desc(format!("{} [arcsec]", theta_p()))
-            .x_label_formatter(&tick)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
         chart.draw_series(
             hist.iter()
@@ -226,9 +205,8 @@ pub fn theta(
             DOTTED,
             BLACK.stroke_width(2),
         ))?;
-        legend.draw(&legend_area)?;
-        root.present()?;
-    }
+        Ok(())
+    })?;
     Ok(Some(svg))
 }
 
@@ -260,12 +238,7 @@ pub fn tan(
             number(round_sig(sigma_t, 4))
         ),
     );
-    let mut svg = String::new();
-    {
-        let root =
-            SVGBackend::with_string(&mut svg, (1200, 560 + legend.height())).into_drawing_area();
-        root.fill(&WHITE)?;
-        let (area, legend_area) = root.split_vertically(560);
+    let svg = render(1200, 560, &legend, |_, area| {
         let (title_area, body) = area.split_vertically(40);
         title_area.titled(&title(rep, "slopes of the top surface"), (FONT, 20))?;
         let panels = body.split_evenly((1, 2));
@@ -319,9 +292,8 @@ pub fn tan(
                 RED.stroke_width(3),
             ))?;
         }
-        legend.draw(&legend_area)?;
-        root.present()?;
-    }
+        Ok(())
+    })?;
     Ok(Some(svg))
 }
 
@@ -406,43 +378,23 @@ pub fn qq(
             percent(conf)
         ),
     );
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (WIDTH, CHART_HEIGHT + legend.height()))
-            .into_drawing_area();
-        root.fill(&WHITE)?;
-        let (area, legend_area) = root.split_vertically(CHART_HEIGHT);
+    let svg = render(WIDTH, CHART_HEIGHT, &legend, |_, area| {
         let a = hi * ARCSEC_PER_MICRORAD;
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                title(rep, &format!("Rayleigh QQ plot of {}", theta_p())),
-                (FONT, 22),
-            )
-            .margin(16)
-            .x_label_area_size(50)
-            .top_x_label_area_size(50)
-            .y_label_area_size(80)
-            .right_y_label_area_size(70)
-            .build_cartesian_2d(0.0..hi, 0.0..hi)?
-            .set_secondary_coord(0.0..a, 0.0..a);
-        chart
-            .configure_mesh()
+        let mut chart = captioned(
+            area,
+            title(rep, &format!("Rayleigh QQ plot of {}", theta_p())),
+        )
+        .top_x_label_area_size(50)
+        .right_y_label_area_size(70)
+        .build_cartesian_2d(0.0..hi, 0.0..hi)?
+        .set_secondary_coord(0.0..a, 0.0..a);
+        styled_mesh(&mut chart.configure_mesh())
             .x_desc("Rayleigh quantile [µrad]")
             .y_desc(format!("sample quantile of {} [µrad]", theta_p()))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(LIGHT)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
-        chart
-            .configure_secondary_axes()
+        styled_secondary(&mut chart.configure_secondary_axes())
             .x_desc("Rayleigh quantile [arcsec]")
             .y_desc("sample quantile [arcsec]")
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
         let mut outline: Vec<(f64, f64)> = band.iter().map(|b| (b.0, b.1)).collect();
         outline.extend(band.iter().rev().map(|b| (b.0, b.2)));
@@ -459,9 +411,8 @@ pub fn qq(
                 .iter()
                 .map(|&p| Circle::new(p, 3, palette(2).filled())),
         )?;
-        legend.draw(&legend_area)?;
-        root.present()?;
-    }
+        Ok(())
+    })?;
     Ok(Some(svg))
 }
 
@@ -529,40 +480,18 @@ pub fn exceedance(
         Swatch::Line(BLACK, 2, Some(DOTTED)),
         format!("target {}", angle(target)),
     );
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (WIDTH, CHART_HEIGHT + legend.height()))
-            .into_drawing_area();
-        root.fill(&WHITE)?;
-        let (area, legend_area) = root.split_vertically(CHART_HEIGHT);
+    let svg = render(WIDTH, CHART_HEIGHT, &legend, |_, area| {
         let xmax = hi.max(target * 1.04);
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                title(rep, &format!("exceedance of {}", theta_p())),
-                (FONT, 22),
-            )
-            .margin(16)
-            .x_label_area_size(50)
+        let mut chart = captioned(area, title(rep, &format!("exceedance of {}", theta_p())))
             .top_x_label_area_size(50)
-            .y_label_area_size(80)
             .build_cartesian_2d(0.0..xmax, (floor..1.0).log_scale())?
             .set_secondary_coord(0.0..xmax * ARCSEC_PER_MICRORAD, (floor..1.0).log_scale());
-        chart
-            .configure_mesh()
+        styled_mesh(&mut chart.configure_mesh())
             .x_desc(format!("{} [µrad]", theta_p()))
             .y_desc("1 − F: probability of exceeding [-]")
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(LIGHT)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
-        chart
-            .configure_secondary_axes()
+        styled_secondary(&mut chart.configure_secondary_axes())
             .x_desc(format!("{} [arcsec]", theta_p()))
-            .x_label_formatter(&tick)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
         chart.draw_series(LineSeries::new(points, palette(2).stroke_width(2)))?;
         if let Some(s) = sigma {
@@ -584,9 +513,8 @@ pub fn exceedance(
             DOTTED,
             BLACK.stroke_width(2),
         ))?;
-        legend.draw(&legend_area)?;
-        root.present()?;
-    }
+        Ok(())
+    })?;
     Ok(Some(svg))
 }
 
@@ -653,43 +581,24 @@ pub fn running(
         Swatch::Line(BLACK, 2, Some(DOTTED)),
         format!("target {}", angle(target)),
     );
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (WIDTH, CHART_HEIGHT + legend.height()))
-            .into_drawing_area();
-        root.fill(&WHITE)?;
-        let (area, legend_area) = root.split_vertically(CHART_HEIGHT);
+    let svg = render(WIDTH, CHART_HEIGHT, &legend, |_, area| {
         let xr = (x0..n as f64 * 1.05).log_scale();
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                title(
-                    rep,
-                    &format!("running {} against the sample count", theta_pct(pct)),
-                ),
-                (FONT, 22),
-            )
-            .margin(16)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
-            .right_y_label_area_size(70)
-            .build_cartesian_2d(xr.clone(), ylo..yhi)?
-            .set_secondary_coord(xr, ylo * ARCSEC_PER_MICRORAD..yhi * ARCSEC_PER_MICRORAD);
-        chart
-            .configure_mesh()
+        let mut chart = captioned(
+            area,
+            title(
+                rep,
+                &format!("running {} against the sample count", theta_pct(pct)),
+            ),
+        )
+        .right_y_label_area_size(70)
+        .build_cartesian_2d(xr.clone(), ylo..yhi)?
+        .set_secondary_coord(xr, ylo * ARCSEC_PER_MICRORAD..yhi * ARCSEC_PER_MICRORAD);
+        styled_mesh(&mut chart.configure_mesh())
             .x_desc("samples n [-]")
             .y_desc(format!("{} [µrad]", theta_pct(pct)))
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(LIGHT)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
-        chart
-            .configure_secondary_axes()
+        styled_secondary(&mut chart.configure_secondary_axes())
             .y_desc(format!("{} [arcsec]", theta_pct(pct)))
-            .y_label_formatter(&tick)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
         let mut outline: Vec<(f64, f64)> = rows.iter().map(|r| (r.0, r.2)).collect();
         outline.extend(rows.iter().rev().map(|r| (r.0, r.3)));
@@ -706,8 +615,7 @@ pub fn running(
             DOTTED,
             BLACK.stroke_width(2),
         ))?;
-        legend.draw(&legend_area)?;
-        root.present()?;
-    }
+        Ok(())
+    })?;
     Ok(Some(svg))
 }

@@ -20,6 +20,7 @@
 //! legend sits below each chart, its swatches drawn like their series (dashed, dotted).
 
 mod distribution;
+mod frame;
 #[cfg(feature = "png")]
 pub mod png;
 mod series;

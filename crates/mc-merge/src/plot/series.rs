@@ -7,6 +7,7 @@
 //!   where the intervals are large enough to see;
 //! - [`stages`]: the normalised percentile against the number of stages (paper Fig. 9).
 
+use super::frame::*;
 use super::style::*;
 use crate::report::{Figure, Report};
 use plotters::prelude::*;
@@ -146,52 +147,32 @@ pub fn sigma(report: &Report) -> Drawn {
         format!("target {}", angle(target)),
     );
 
-    let mut svg = String::new();
-    {
-        let main_height = 560;
-        let dev_height = 240;
-        let root = SVGBackend::with_string(
-            &mut svg,
-            (WIDTH, main_height + dev_height + legend.height()),
-        )
-        .into_drawing_area();
-        root.fill(&WHITE)?;
-        let (upper, legend_area) = root.split_vertically(main_height + dev_height);
+    let (main_height, dev_height) = (560, 240);
+    let svg = render(WIDTH, main_height + dev_height, &legend, |root, upper| {
         let (main, lower) = upper.split_vertically(main_height);
         let xr = (xlo..xhi).log_scale();
-        let mut chart = ChartBuilder::on(&main)
-            .caption(
-                format!(
-                    "{} against the member length σ ({conf} intervals), target {}",
-                    theta_pct(pct),
-                    angle(target)
-                ),
-                (FONT, 22),
-            )
-            .margin(16)
-            .x_label_area_size(40)
-            .y_label_area_size(80)
-            .right_y_label_area_size(70)
-            .build_cartesian_2d(xr.clone(), (ylo..yhi).log_scale())?
-            .set_secondary_coord(
-                xr.clone(),
-                (ylo * ARCSEC_PER_MICRORAD..yhi * ARCSEC_PER_MICRORAD).log_scale(),
-            );
-        chart
-            .configure_mesh()
+        let mut chart = captioned(
+            &main,
+            format!(
+                "{} against the member length σ ({conf} intervals), target {}",
+                theta_pct(pct),
+                angle(target)
+            ),
+        )
+        .x_label_area_size(40)
+        .right_y_label_area_size(70)
+        .build_cartesian_2d(xr.clone(), (ylo..yhi).log_scale())?
+        .set_secondary_coord(
+            xr.clone(),
+            (ylo * ARCSEC_PER_MICRORAD..yhi * ARCSEC_PER_MICRORAD).log_scale(),
+        );
+        styled_mesh(&mut chart.configure_mesh())
             .y_desc(format!("{} [µrad]", theta_pct(pct)))
             .x_label_formatter(&|_| String::new())
             .y_label_formatter(&|_| String::new())
-            .light_line_style(LIGHT)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
-        chart
-            .configure_secondary_axes()
+        styled_secondary(&mut chart.configure_secondary_axes())
             .y_desc(format!("{} [arcsec]", theta_pct(pct)))
-            .y_label_formatter(&tick)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
         for t in log_ticks(ylo, yhi) {
             let (px, py) = chart.backend_coord(&(xlo, t));
@@ -288,9 +269,8 @@ pub fn sigma(report: &Report) -> Drawn {
                 )))?;
             }
         }
-        legend.draw(&legend_area)?;
-        root.present()?;
-    }
+        Ok(())
+    })?;
     Ok(Some(svg))
 }
 
@@ -350,37 +330,22 @@ pub fn stages(report: &Report) -> Drawn {
             ),
         );
     }
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (WIDTH, CHART_HEIGHT + legend.height()))
-            .into_drawing_area();
-        root.fill(&WHITE)?;
-        let (area, legend_area) = root.split_vertically(CHART_HEIGHT);
-        let mut chart = ChartBuilder::on(&area)
-            .caption(
-                format!(
-                    "normalised {} against the number of stages ({conf} intervals)",
-                    theta_pct(pct)
-                ),
-                (FONT, 22),
-            )
-            .margin(16)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
-            .build_cartesian_2d(0.0..xmax + 0.5, 0.0..ymax * 1.05)?;
-        chart
-            .configure_mesh()
+    let svg = render(WIDTH, CHART_HEIGHT, &legend, |_, area| {
+        let mut chart = captioned(
+            area,
+            format!(
+                "normalised {} against the number of stages ({conf} intervals)",
+                theta_pct(pct)
+            ),
+        )
+        .build_cartesian_2d(0.0..xmax + 0.5, 0.0..ymax * 1.05)?;
+        styled_mesh(&mut chart.configure_mesh())
             .x_desc("number of stages [-]")
             .y_desc(format!(
                 "{} / {} of the smallest stage count [-]",
                 theta_pct(pct),
                 theta_pct(pct)
             ))
-            .light_line_style(LIGHT)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .axis_desc_style((FONT, 18))
-            .label_style((FONT, 15))
             .draw()?;
         for (k, s) in series.iter().enumerate() {
             let color = palette(k + 1);
@@ -411,8 +376,7 @@ pub fn stages(report: &Report) -> Drawn {
                 chart.draw_series(std::iter::once(Circle::new(p, 4, color.stroke_width(2))))?;
             }
         }
-        legend.draw(&legend_area)?;
-        root.present()?;
-    }
+        Ok(())
+    })?;
     Ok(Some(svg))
 }
