@@ -24,9 +24,6 @@ command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && [ -e /u
 phase "cargo test --workspace"
 cargo test --workspace --quiet
 
-phase "the cross-check against faer (a large build the default tests do without)"
-cargo test --release --quiet -p truss-core --features cross-checks --lib -- block::tests::agrees_with_faer_dense
-
 phase "the slow statistical checks (#[ignore]d in the default run), in release"
 # Only the crates that have such tests: building every test target in release costs minutes.
 for crate in $(grep -rl '#\[ignore' crates/*/src crates/*/tests | cut -d/ -f2 | sort -u); do

@@ -415,7 +415,8 @@ mod tests {
     }
 
     /// Agrees with faer's dense Cholesky solve, an independent implementation (with
-    /// `--features cross-checks`, which scripts/test.sh runs).
+    /// `--features cross-checks`; CI runs the same check against nalgebra in
+    /// tests/it/dense_cholesky.rs).
     #[cfg(feature = "cross-checks")]
     #[test]
     fn agrees_with_faer_dense() {
