@@ -2,7 +2,8 @@
 # smoke-test.sh: the README's main command (truss-mc run-all) on a small job, checked end
 # to end: shards written, merged, report.json present, every SVG plot renders to a PNG
 # (rsvg-convert parses and rasterises it; a malformed SVG fails), and mc-merge wrote its own
-# PNG beside each SVG.
+# PNG beside each SVG, at twice its size. This is where CI checks those PNGs: its default
+# tests run without the png feature (see scripts/test.sh).
 #
 # Usage: scripts/smoke-test.sh     (needs target/release/truss-mc and rsvg-convert)
 set -euo pipefail
@@ -31,7 +32,13 @@ for svg in "$WORK"/run/report/*.svg; do
     rsvg-convert -o "$WORK/check/$name.png" "$svg"
     [[ -s "$WORK/check/$name.png" ]] || { echo "smoke: $svg did not render" >&2; exit 1; }
     # mc-merge's own PNG (resvg) beside it.
-    [[ "$(head -c 4 "${svg%.svg}.png" | tail -c 3)" == PNG ]] || { echo "smoke: no PNG for $svg" >&2; exit 1; }
+    png="${svg%.svg}.png"
+    [[ "$(head -c 4 "$png" | tail -c 3)" == PNG ]] || { echo "smoke: no PNG for $svg" >&2; exit 1; }
+    # At twice the SVG's size: the PNG's width and height (IHDR, bytes 16-23, big-endian)
+    # against the SVG's.
+    read -r pw ph < <(od -An -j16 -N8 -tu1 "$png" | awk '{print $1*16777216+$2*65536+$3*256+$4, $5*16777216+$6*65536+$7*256+$8}')
+    read -r sw sh < <(head -c 200 "$svg" | sed -n 's/^<svg width="\([0-9]*\)" height="\([0-9]*\)".*/\1 \2/p')
+    [[ "$pw $ph" == "$((2 * sw)) $((2 * sh))" ]] || { echo "smoke: $png is ${pw}x$ph, the SVG ${sw}x$sh" >&2; exit 1; }
     n=$((n + 1))
 done
 # 2 cases x 5 plots + the σ sweep.

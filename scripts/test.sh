@@ -3,14 +3,15 @@
 #
 # Usage: scripts/test.sh
 #
-# 1. cargo test --workspace: unit, verification, property and CLI tests of every crate and
-#    the cross-crate pipeline (tests/), then the slow statistical checks that the default run
-#    ignores (cargo test --release -- --ignored).
+# 1. cargo test --workspace (without mc-merge's png feature, checked in step 2): unit,
+#    verification, property and CLI tests of every crate and the cross-crate pipeline
+#    (tests/), then the slow statistical checks that the default run ignores
+#    (cargo test --release -- --ignored).
 # 2. The release binaries, then the end-to-end checks with real parts:
 #    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
 #      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted;
 #    - scripts/smoke-test.sh: the README's main command on a small job, and its SVG plots
-#      rendered to PNG with rsvg-convert.
+#      rendered to PNG with rsvg-convert, and mc-merge's own PNGs checked.
 # Needs what scripts/setup.sh installs (it is run first when something is missing).
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -21,8 +22,11 @@ phase() { echo "test: $1 (at ${SECONDS} s)" >&2; }
 
 command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && [ -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || scripts/setup.sh
 
-phase "cargo test --workspace"
-cargo test --workspace --quiet
+phase "cargo test --workspace (without the png feature)"
+# Without mc-merge's default feature png: resvg's build is about 90 s of CPU in the debug
+# profile, and the PNGs are checked on the release binaries by scripts/smoke-test.sh. (No
+# other crate of the workspace has a default feature.)
+cargo test --workspace --no-default-features --quiet
 
 phase "the slow statistical checks (#[ignore]d in the default run), in release"
 # Only the crates that have such tests: building every test target in release costs minutes.
