@@ -6,11 +6,13 @@
 //! - A directory is reused only for the same job. If it holds a `report.json` of another job,
 //!   or a `report.json` that is not an mc-merge report, the merge is refused (exit 5, a file in
 //!   the way) and nothing in it is touched: give another `--out`, or remove the old report.
-//! - Before the new files are written, our own earlier files are removed: plot files by their
+//! - Before the new files are written, our own earlier files are removed: beside the same
+//!   job's `report.json` (which is written before the plots), plot files by their
 //!   names ([`crate::plot::is_plot_file`]: `theta_p-*`, `tan-*`, `qq-*`, `exceedance-*`,
 //!   `running-*` and the two sweeps, `.svg` or `.png`) and stale temporary reports. So no plot
 //!   of an earlier run (a renamed case, a run with plots when this one has `--no-plots`) stays
-//!   beside a report it does not belong to. Other files are left alone.
+//!   beside a report it does not belong to. Other files are left alone, and so are files named
+//!   like plots in a directory without a report (a diagnosis's `theta_p-ecdf-before.svg`).
 
 use crate::errors::MergeError;
 use crate::report::REPORT_FORMAT;
@@ -35,21 +37,28 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> MergeError + '_ {
 pub fn prepare(dir: &Path, job_id: &str) -> Result<(), MergeError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let report = dir.join(REPORT_FILE);
-    match std::fs::read(&report) {
-        Ok(bytes) => check_owner(&report, &bytes, job_id)?,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+    let ours_before = match std::fs::read(&report) {
+        Ok(bytes) => {
+            check_owner(&report, &bytes, job_id)?;
+            true
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
         Err(source) => {
             return Err(MergeError::Io {
                 path: report,
                 source,
             });
         }
-    }
+    };
     for entry in std::fs::read_dir(dir).map_err(io(dir))? {
         let entry = entry.map_err(io(dir))?;
         let name = entry.file_name();
         let Some(name) = name.to_str() else { continue };
-        let ours = crate::plot::is_plot_file(name) || name.starts_with(TEMP_PREFIX);
+        // Plots are ours only beside our report (written before them): in a directory
+        // without one, a file named like a plot (`theta_p-ecdf-before.svg` of a diagnosis)
+        // is someone else's.
+        let ours =
+            (ours_before && crate::plot::is_plot_file(name)) || name.starts_with(TEMP_PREFIX);
         if ours && entry.file_type().map_err(io(dir))?.is_file() {
             let path = entry.path();
             std::fs::remove_file(&path).map_err(io(&path))?;

@@ -3,9 +3,9 @@
 //! and margins ([`captioned`]), and the styles of the primary mesh ([`styled_mesh`]) and of the
 //! secondary (arcsec) axes ([`styled_secondary`]).
 
-use super::style::{FONT, LIGHT, Legend, PlotResult, tick};
 #[cfg(doc)]
 use super::style::WIDTH;
+use super::style::{FONT, LIGHT, Legend, PlotResult, tick};
 use plotters::chart::{MeshStyle, SecondaryMeshStyle};
 use plotters::coord::Shift;
 use plotters::coord::ranged1d::ValueFormatter;

@@ -1,6 +1,7 @@
 //! The report directory (crate doc of `mc_merge::report_dir`): `report.json` is replaced
 //! atomically, a directory of another job is refused with exit 5 and left untouched, our own
-//! earlier plots are removed when the same job's report is written again, other files stay,
+//! earlier plots are removed when the same job's report is written again, other files stay
+//! (also files named like plots in a directory without a report),
 //! and plot names stay unique after sanitising the case names.
 
 use crate::common::{SynthCase, SynthJob};
@@ -59,6 +60,32 @@ fn same_job_reuses_the_directory_and_clears_its_own_plots() {
         String::from_utf8_lossy(&o.stderr)
     );
     assert_eq!(listing(out.path()), ["notes.txt", "report.json"]);
+}
+
+/// Files named like our plots in a directory without a report are not ours: a diagnosis's
+/// `theta_p-ecdf-before.svg` stays when a merge writes its first report there.
+#[test]
+fn plot_like_files_without_a_report_are_left_alone() {
+    let shards = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    job(4, &["a"]).write_split(shards.path(), 1);
+    for name in ["theta_p-ecdf-before.svg", "qq-mine.png"] {
+        std::fs::write(out.path().join(name), "not mc-merge's").unwrap();
+    }
+    let o = merge(shards.path(), out.path(), &[]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let files = listing(out.path());
+    for name in ["theta_p-ecdf-before.svg", "qq-mine.png", "theta_p-a.svg"] {
+        assert!(
+            files.contains(&name.to_string()),
+            "{name} missing: {files:?}"
+        );
+    }
 }
 
 #[test]
