@@ -34,10 +34,7 @@ fn spd(nb: usize, q: usize, seed: u64) -> BlockBandMatrix {
     }
     let n = 3 * nb;
     for r in 0..n {
-        let off: f64 = (0..n)
-            .filter(|&c| c != r)
-            .map(|c| m.get(r, c).abs())
-            .sum();
+        let off: f64 = (0..n).filter(|&c| c != r).map(|c| m.get(r, c).abs()).sum();
         m.block_mut(r / 3, r / 3)[r % 3][r % 3] = off + 1.0 + next().abs() * 2.0;
     }
     m
