@@ -52,7 +52,7 @@ const MAX_LINEARISED_PIECES: u32 = 50;
 
 /// The state of one solve's iteration that the parts of [`Solver::newton`] share.
 #[derive(Debug, Clone, Copy)]
-struct Progress {
+pub(super) struct Progress {
     /// Linear solves so far (the linearised problem counts as one).
     iterations: u32,
     /// Factorisations so far (the shared nominal one not counted).
@@ -150,7 +150,7 @@ impl Solver {
     }
 
     /// Step 1: the linearised problem (or zero, if it fails), evaluated.
-    fn start(&mut self) -> Progress {
+    pub(super) fn start(&mut self) -> Progress {
         let structure = Arc::clone(&self.structure);
         let mut factorisations = 0;
         let mut iterations = 0;
