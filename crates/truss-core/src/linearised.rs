@@ -153,6 +153,9 @@ pub(crate) struct ActiveSet {
     pub slack: Vec<usize>,
     /// Cholesky factor of `W⁻¹ − G_SS`.
     capacitance: Capacitance,
+    /// The slack positions of the capacitance factor's valid leading rows (the matrix
+    /// depends only on them: `W` and `G` are the model's).
+    factored: Vec<usize>,
     /// Scratch: a right-hand side over the slack set, solved in place.
     z: Vec<f64>,
     /// Scratch: linearised elongations of the cables without slack corrections.
@@ -177,17 +180,25 @@ impl ActiveSet {
         Self {
             slack: Vec::with_capacity(nc),
             capacitance: Capacitance::new(nc),
+            factored: Vec::with_capacity(nc),
             z: Vec::with_capacity(nc),
             e_lin: Vec::with_capacity(nc),
             e: Vec::with_capacity(nc),
         }
     }
 
-    /// Factorises `W⁻¹ − G_SS` for the current `slack`.
+    /// Factorises `W⁻¹ − G_SS` for the current `slack`, keeping the rows of the last factor
+    /// whose leading slack cables are the same (the factor is the same, bit for bit).
     pub fn factor(&mut self, basis: &CableBasis) -> Result<(), ActiveSetFailure> {
         let nc = basis.cables.len();
         let slack = &self.slack;
-        self.capacitance.set(slack.len(), |i, row| {
+        let valid = self.capacitance.valid_rows().min(self.factored.len());
+        let keep = slack
+            .iter()
+            .zip(&self.factored[..valid])
+            .take_while(|(a, b)| a == b)
+            .count();
+        self.capacitance.set_from(keep, slack.len(), |i, row| {
             let a = slack[i];
             let g = &basis.g[a * nc..(a + 1) * nc];
             for (x, &b) in row.iter_mut().zip(slack) {
@@ -195,11 +206,13 @@ impl ActiveSet {
             }
             row[i] += basis.w_inv[a];
         });
+        self.factored.clear();
+        self.factored.extend_from_slice(slack);
         if slack.is_empty() {
             return Ok(());
         }
         self.capacitance
-            .factor()
+            .factor_from(keep)
             .map_err(|_| ActiveSetFailure::NotPositiveDefinite)
     }
 
