@@ -9,7 +9,8 @@
 //! 1. **The linearised problem, exactly.** With linear kinematics the energy is convex and
 //!    piecewise quadratic in the set of slack cables; its minimiser is found by an
 //!    active-set iteration from the shared factorisation of the all-taut stiffness `K₀`
-//!    (see the `linearised` module). For the imperfections of interest (µm on 380 mm) this
+//!    (see the `linearised` module; models with many cables, and pieces whose slack set
+//!    is too large for the Woodbury update, factorise each piece's stiffness instead). For the imperfections of interest (µm on 380 mm) this
 //!    point is within about 1e-4 (relative) of the answer and has the right slack set.
 //! 2. **Chord steps** `d = −K_S⁻¹·r(u)` with the linearised stiffness `K_S` of the current
 //!    slack set (a Woodbury update of `K₀`, no factorisation of the full matrix), while they
