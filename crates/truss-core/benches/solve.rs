@@ -8,7 +8,7 @@
 //! (factorise, triangular solves, evaluate, assemble) with the share of the solve that
 //! counts × kernel time accounts for. For comparison, a dense Cholesky of the same 5-stage
 //! tangent with faer. For 300 stages and for backlash, the histograms of the iteration and
-//! factorisation counts. Run with
+//! factorisation counts; the ratio of the backlash model's median to the rigid one's. Run with
 //! `cargo bench -p truss-core`; `-- --quick` for fewer samples, `-- --only 5` (or `5b`, `30`,
 //! `300`) for one model alone (for a profiler), `-- --paths` for the probe of whether the
 //! converged state depends on the solver's path (see `path_independence`).
@@ -57,7 +57,8 @@ fn kernel_time(reps: usize, mut f: impl FnMut()) -> f64 {
     batches[3]
 }
 
-fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) {
+/// Runs and prints one model's benchmark; returns its median time per solve \[µs\].
+fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) -> f64 {
     let model = PrismOptions {
         backlash: backlash.then(BacklashOptions::default),
         ..PrismOptions::with_stages(stages)
@@ -185,6 +186,7 @@ fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) {
             );
         }
     }
+    median_time.0
 }
 
 /// A dense Cholesky (faer) of a 45 × 45 matrix the shape of the 5-stage tangent, for
@@ -352,10 +354,17 @@ fn main() {
         ("30", 30, n(2_000), false, false),
         ("300", 300, n(100).max(10), false, true),
     ];
+    let mut medians = std::collections::BTreeMap::new();
     for (name, stages, samples, backlash, histogram) in runs {
         if only.as_deref().is_none_or(|o| o == name) {
-            bench(stages, samples, backlash, histogram);
+            medians.insert(name, bench(stages, samples, backlash, histogram));
         }
+    }
+    if let (Some(rigid), Some(backlash)) = (medians.get("5"), medians.get("5b")) {
+        println!(
+            "5 stages with backlash / rigid: {:.2} (median per solve)",
+            backlash / rigid
+        );
     }
     if only.is_none() {
         dense_comparison();

@@ -12,6 +12,12 @@
 //! with inner products of four interleaved partial sums ([`dot`], in a fixed summation
 //! order), so the factor is the one of a banded Cholesky of full bandwidth, without its
 //! padding and without allocating when the slack set changes.
+//!
+//! Row `i` of `L` depends only on the leading `(i+1)×(i+1)` block of `C`. So when a new
+//! matrix shares its leading rows with the last one factorised (the active-set method's
+//! next slack set keeps its first cables), [`Capacitance::factor_from`] keeps those rows
+//! of the factor and computes only the others: the factor is the same, bit for bit, as a
+//! factorisation from the first row.
 
 use crate::block::PIVOT_TOLERANCE;
 
@@ -22,6 +28,10 @@ pub(crate) struct Capacitance {
     m: usize,
     a: Vec<f64>,
     inv_diag: Vec<f64>,
+    /// Each row's pivot relative to its diagonal entry.
+    pivot_ratio: Vec<f64>,
+    /// The number of leading rows that hold a valid factor.
+    valid: usize,
     min_pivot_ratio: f64,
 }
 
@@ -38,26 +48,48 @@ impl Capacitance {
             m: 0,
             a: vec![0.0; capacity * capacity],
             inv_diag: vec![0.0; capacity],
+            pivot_ratio: vec![0.0; capacity],
+            valid: 0,
             min_pivot_ratio: f64::INFINITY,
         }
     }
 
     /// Makes the matrix of order `m`, row `i`'s lower-triangle entries (columns `0 ..= i`)
-    /// written by `fill(i, row)`.
-    pub fn set(&mut self, m: usize, mut fill: impl FnMut(usize, &mut [f64])) {
+    /// written by `fill(i, row)`, except the first `keep` rows, which are those of the last
+    /// factorised one (at most [`Capacitance::valid_rows`]). Then [`Capacitance::factor_from`]`(keep)` factorises it.
+    pub fn set_from(&mut self, keep: usize, m: usize, mut fill: impl FnMut(usize, &mut [f64])) {
         assert!(m <= self.stride, "capacitance matrix beyond its capacity");
+        assert!(keep <= self.valid.min(m), "kept rows that hold no factor");
         self.m = m;
-        for (i, row) in self.a.chunks_exact_mut(self.stride).take(m).enumerate() {
+        self.valid = keep;
+        for (i, row) in self
+            .a
+            .chunks_exact_mut(self.stride)
+            .enumerate()
+            .take(m)
+            .skip(keep)
+        {
             fill(i, &mut row[..=i]);
         }
     }
 
-    /// Factorises in place, `C = L·Lᵀ`; fails at the first pivot not above
+    /// The number of leading rows that hold a valid factor: all after a successful
+    /// factorisation, those before the failed pivot after a failed one.
+    pub fn valid_rows(&self) -> usize {
+        self.valid
+    }
+
+    /// Factorises in place, `C = L·Lᵀ`, the first `keep` rows being already factorised
+    /// (see [`Capacitance::set_from`]); fails at the first pivot not above
     /// [`PIVOT_TOLERANCE`] times its diagonal entry.
-    pub fn factor(&mut self) -> Result<(), NotPositiveDefinite> {
+    pub fn factor_from(&mut self, keep: usize) -> Result<(), NotPositiveDefinite> {
         let (m, w) = (self.m, self.stride);
-        self.min_pivot_ratio = f64::INFINITY;
-        for i in 0..m {
+        assert!(keep <= self.valid, "kept rows that hold no factor");
+        self.valid = keep;
+        self.min_pivot_ratio = self.pivot_ratio[..keep]
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b));
+        for i in keep..m {
             let (done, rest) = self.a.split_at_mut(i * w);
             let row = &mut rest[..=i];
             for (j, (row_j, inv)) in done.chunks_exact(w).zip(&self.inv_diag).enumerate() {
@@ -69,10 +101,12 @@ impl Capacitance {
             if s.partial_cmp(&(PIVOT_TOLERANCE * diag)) != Some(std::cmp::Ordering::Greater) {
                 return Err(NotPositiveDefinite);
             }
+            self.pivot_ratio[i] = s / diag;
             self.min_pivot_ratio = self.min_pivot_ratio.min(s / diag);
             let d = s.sqrt();
             row[i] = d;
             self.inv_diag[i] = 1.0 / d;
+            self.valid = i + 1;
         }
         Ok(())
     }
@@ -133,4 +167,86 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
         s[0] += x * y;
     }
     (s[0] + s[1]) + (s[2] + s[3])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Row `i`, column `j ≤ i` of a symmetric positive-definite test matrix: `B·Bᵀ + n·I`
+    /// with `B` of pseudo-random entries in (−1, 1) drawn per `(i, j)` from `seed`.
+    fn entry(seed: u64, i: usize, j: usize, n: usize) -> f64 {
+        let b = |r: usize, k: usize| {
+            let mut x = seed ^ ((r as u64) << 32 | k as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            x = (x ^ (x >> 31)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+            x ^= x >> 29;
+            (x >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+        };
+        let dot: f64 = (0..n).map(|k| b(i, k) * b(j, k)).sum();
+        dot + if i == j { n as f64 } else { 0.0 }
+    }
+
+    /// A factor of order `m` whose first `keep` rows come from the matrix of `seed_a`
+    /// (which holds rows `0..keep` of the result) and the others from `seed_b`.
+    fn matrix(keep: usize, seed_a: u64, seed_b: u64) -> impl Fn(usize, &mut [f64]) {
+        move |i, row: &mut [f64]| {
+            for (j, x) in row.iter_mut().enumerate() {
+                *x = entry(if i < keep { seed_a } else { seed_b }, i, j, 12);
+            }
+        }
+    }
+
+    #[test]
+    fn a_kept_leading_block_gives_the_same_factor_bit_for_bit() {
+        let mut reused = Capacitance::new(12);
+        reused.set_from(0, 10, matrix(10, 1, 1));
+        reused.factor_from(0).unwrap();
+        // The next matrix shares its first 6 rows and differs after them.
+        let next = |i: usize, row: &mut [f64]| {
+            for (j, x) in row.iter_mut().enumerate() {
+                *x = entry(if i < 6 { 1 } else { 2 }, i, j, 12);
+            }
+        };
+        reused.set_from(6, 11, next);
+        reused.factor_from(6).unwrap();
+        let mut fresh = Capacitance::new(12);
+        fresh.set_from(0, 11, next);
+        fresh.factor_from(0).unwrap();
+        for i in 0..11 {
+            for j in 0..=i {
+                let (a, b) = (reused.a[i * 12 + j], fresh.a[i * 12 + j]);
+                assert_eq!(a.to_bits(), b.to_bits(), "L[{i}][{j}]: {a} vs {b}");
+            }
+        }
+        assert_eq!(
+            reused.min_pivot_ratio.to_bits(),
+            fresh.min_pivot_ratio.to_bits()
+        );
+        let mut x = (0..11).map(|i| i as f64 - 4.5).collect::<Vec<_>>();
+        let mut y = x.clone();
+        reused.solve_in_place(&mut x);
+        fresh.solve_in_place(&mut y);
+        assert_eq!(x, y);
+    }
+
+    #[test]
+    fn a_failed_pivot_leaves_the_rows_before_it_valid() {
+        let mut c = Capacitance::new(12);
+        // Row 4's diagonal is made too small: the factorisation stops there.
+        c.set_from(0, 8, |i, row: &mut [f64]| {
+            matrix(8, 3, 3)(i, row);
+            if i == 4 {
+                row[4] = 1e-3;
+            }
+        });
+        assert_eq!(c.factor_from(0), Err(NotPositiveDefinite));
+        assert_eq!(c.valid_rows(), 4);
+        c.set_from(4, 8, matrix(8, 3, 3));
+        c.factor_from(4).unwrap();
+        let mut fresh = Capacitance::new(12);
+        fresh.set_from(0, 8, matrix(8, 3, 3));
+        fresh.factor_from(0).unwrap();
+        assert_eq!(c.a[..8 * 12], fresh.a[..8 * 12]);
+        assert_eq!(c.valid_rows(), 8);
+    }
 }

@@ -22,6 +22,13 @@
 //! one Cholesky of the `|S|×|S|` capacitance matrix `W⁻¹ − G_SS`, which is positive definite
 //! exactly when `K_S` is; the same factor then applies `K_S⁻¹` to any vector at the cost of a
 //! banded solve, which is the chord operator of the Newton iterations that follow.
+//!
+//! The dense Cholesky of the capacitance matrix costs `|S|³/6` multiply–adds, the banded
+//! one of `K_S` about `n·b²/2` (`n` unknowns, `b` the band's width in rows); where a piece's
+//! slack set is larger than [`CableBasis::max_slack`], the size at which the two are equal
+//! (pin joints in free play, whose two one-sided halves are both slack), the method gives
+//! way to the same iteration with a banded factorisation of `K_S` per piece
+//! ([`ActiveSetFailure::LargeSlackSet`]).
 
 use crate::capacitance::Capacitance;
 use crate::structure::Structure;
@@ -42,6 +49,10 @@ pub(crate) struct CableBasis {
     /// `σ_c` per cable: +1 tension-only (slack when `e < 0`), −1 compression-only (slack
     /// when `e > 0`).
     pub sense: Vec<f64>,
+    /// The largest slack set solved by the capacitance matrix: `⌊∛(3·n·b²)⌋`, where its
+    /// Cholesky (`|S|³/6` multiply–adds) costs as much as the banded one of `K_S` (`n·b²/2`,
+    /// `n` unknowns, `b = 3·(q + 1)` rows of band for `q` block off-diagonals).
+    pub max_slack: usize,
 }
 
 /// A slack set whose capacitance matrix has a pivot below this fraction of its diagonal
@@ -86,6 +97,8 @@ impl CableBasis {
             }
         }
         let sense = cables.iter().map(|&m| s.members[m].sense).collect();
+        let band = 3.0 * (s.bandwidth() as f64 + 1.0);
+        let max_slack = (3.0 * n as f64 * band * band).cbrt().floor() as usize;
         Self {
             cables,
             z,
@@ -93,6 +106,7 @@ impl CableBasis {
             g_t,
             w_inv,
             sense,
+            max_slack,
         }
     }
 }
@@ -153,6 +167,9 @@ pub(crate) struct ActiveSet {
     pub slack: Vec<usize>,
     /// Cholesky factor of `W⁻¹ − G_SS`.
     capacitance: Capacitance,
+    /// The slack positions of the capacitance factor's valid leading rows (the matrix
+    /// depends only on them: `W` and `G` are the model's).
+    factored: Vec<usize>,
     /// Scratch: a right-hand side over the slack set, solved in place.
     z: Vec<f64>,
     /// Scratch: linearised elongations of the cables without slack corrections.
@@ -169,6 +186,9 @@ pub(crate) enum ActiveSetFailure {
     NotPositiveDefinite,
     /// The slack set cycled or did not settle within the iteration limit.
     NoFixedPoint,
+    /// A piece's slack set is larger than [`CableBasis::max_slack`]: factorise `K_S`
+    /// instead.
+    LargeSlackSet,
 }
 
 impl ActiveSet {
@@ -177,17 +197,25 @@ impl ActiveSet {
         Self {
             slack: Vec::with_capacity(nc),
             capacitance: Capacitance::new(nc),
+            factored: Vec::with_capacity(nc),
             z: Vec::with_capacity(nc),
             e_lin: Vec::with_capacity(nc),
             e: Vec::with_capacity(nc),
         }
     }
 
-    /// Factorises `W⁻¹ − G_SS` for the current `slack`.
+    /// Factorises `W⁻¹ − G_SS` for the current `slack`, keeping the rows of the last factor
+    /// whose leading slack cables are the same (the factor is the same, bit for bit).
     pub fn factor(&mut self, basis: &CableBasis) -> Result<(), ActiveSetFailure> {
         let nc = basis.cables.len();
         let slack = &self.slack;
-        self.capacitance.set(slack.len(), |i, row| {
+        let valid = self.capacitance.valid_rows().min(self.factored.len());
+        let keep = slack
+            .iter()
+            .zip(&self.factored[..valid])
+            .take_while(|(a, b)| a == b)
+            .count();
+        self.capacitance.set_from(keep, slack.len(), |i, row| {
             let a = slack[i];
             let g = &basis.g[a * nc..(a + 1) * nc];
             for (x, &b) in row.iter_mut().zip(slack) {
@@ -195,11 +223,13 @@ impl ActiveSet {
             }
             row[i] += basis.w_inv[a];
         });
+        self.factored.clear();
+        self.factored.extend_from_slice(slack);
         if slack.is_empty() {
             return Ok(());
         }
         self.capacitance
-            .factor()
+            .factor_from(keep)
             .map_err(|_| ActiveSetFailure::NotPositiveDefinite)
     }
 
@@ -243,7 +273,9 @@ impl ActiveSet {
 
     /// Solves the linearised problem (module doc) for a sample whose initial stretches are
     /// `stretch` (per member) and loads `loads`; writes `u` (length `free + 1`) and leaves
-    /// the final slack set factorised. Returns the number of pieces tried.
+    /// the final slack set factorised. Returns the number of pieces tried; gives way
+    /// ([`ActiveSetFailure::LargeSlackSet`]) at a piece with more than
+    /// [`CableBasis::max_slack`] slack cables, before factorising it.
     pub fn solve_linearised(
         &mut self,
         s: &Structure,
@@ -271,6 +303,9 @@ impl ActiveSet {
         let mut pieces = 0;
         loop {
             pieces += 1;
+            if self.slack.len() > basis.max_slack {
+                return Err(ActiveSetFailure::LargeSlackSet);
+            }
             self.factor(basis)?;
             self.z.clear();
             self.z.extend(self.slack.iter().map(|&c| self.e_lin[c]));

@@ -89,11 +89,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "c61ab54381e45c454c77624a61b3c7c9baded63ceeec2d6b663890e4c824aef4",
+        "357d23775bd1f895024c5ce94c8e67d6af8fe5cbd91a77c4f5f4d008c24d9c2b",
         "5a858bf8e734f176b91148bbb0875c2729d5b69585ac8a1d04aec50b2ce92086",
         "8f2cc84d87bcfc515f27b31fd30cf297a875add765bedfe4fa6d9654587a40af",
         "d10ed9436448feb99676e2a80222bbc3f50639eee30692fa9431b4c269832758",
-        "84f4bc895fb6d5515515a46b8dad7756f790b9b0d897cc9895d1d851e311fe50",
+        "c876507151321e3438c3ba5db5ccc991ad33db5977a9819b54a935d81a748449",
     ];
     for (what, (g, w)) in [
         "job id",

@@ -146,7 +146,7 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "baacafd9453f3dfe89f310339da175cc192b10335cdffbda8fec63c59694a4ab"
+        "2d5894eea68c782bf9303fe7539eff2b5ae0ba6d8a84f56642f2ce4aad6b0e13"
     );
     assert_eq!(
         digest,

@@ -9,8 +9,15 @@
 //! 1. **The linearised problem, exactly.** With linear kinematics the energy is convex and
 //!    piecewise quadratic in the set of slack cables; its minimiser is found by an
 //!    active-set iteration from the shared factorisation of the all-taut stiffness `K₀`
-//!    (see the `linearised` module). For the imperfections of interest (µm on 380 mm) this
-//!    point is within about 1e-4 (relative) of the answer and has the right slack set.
+//!    (see the `linearised` module; models with many cables, and pieces whose slack set
+//!    is too large for the Woodbury update, factorise each piece's stiffness instead).
+//!    Where every panel keeps a taut diagonal, this point is close to the answer (the
+//!    length errors are µm on 380 mm members) with its slack set. A panel whose bracing
+//!    is all slack is held only by the slack cables' compression stiffness and the
+//!    geometric stiffness of the member forces, which `K_S` lacks: there the linearised
+//!    point can be off by percents and its slack set wrong, and its capacitance matrix
+//!    says so (a soft pivot), so the solver goes straight to Newton steps (3). In the
+//!    paper's prism nearly every sample has such a panel.
 //! 2. **Chord steps** `d = −K_S⁻¹·r(u)` with the linearised stiffness `K_S` of the current
 //!    slack set (a Woodbury update of `K₀`, no factorisation of the full matrix), while they
 //!    contract by at least [`SolveOptions::reuse_contraction`] per step.

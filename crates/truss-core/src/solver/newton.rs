@@ -50,9 +50,15 @@ const CONVERGED_CONTRACTION: f64 = 0.5;
 /// cable basis) before it gives up and Newton starts from zero.
 const MAX_LINEARISED_PIECES: u32 = 50;
 
+/// In the banded active-set iteration of step 1, a cable whose linearised elongation is
+/// within this fraction of the sample's largest initial stretch of its kink keeps its
+/// state: near a mechanism (pin joints in free play) the rounding of `K_S⁻¹` is that large,
+/// and such a cable would otherwise flip at every piece.
+const KINK_NOISE: f64 = 1e-8;
+
 /// The state of one solve's iteration that the parts of [`Solver::newton`] share.
 #[derive(Debug, Clone, Copy)]
-struct Progress {
+pub(super) struct Progress {
     /// Linear solves so far (the linearised problem counts as one).
     iterations: u32,
     /// Factorisations so far (the shared nominal one not counted).
@@ -150,7 +156,7 @@ impl Solver {
     }
 
     /// Step 1: the linearised problem (or zero, if it fails), evaluated.
-    fn start(&mut self) -> Progress {
+    pub(super) fn start(&mut self) -> Progress {
         let structure = Arc::clone(&self.structure);
         let mut factorisations = 0;
         let mut iterations = 0;
@@ -408,7 +414,9 @@ impl Solver {
 
     /// Step 1: solves the linearised problem into `self.work.u`, and says how to go on: chord
     /// steps with the active set's Woodbury inverse when the model has a cable basis and
-    /// the final slack set leaves no soft direction, model steps otherwise.
+    /// the final slack set leaves no soft direction, model steps otherwise. A piece with a
+    /// slack set too large for the capacitance matrix (see the `linearised` module) hands
+    /// the iteration to [`Solver::linearised_banded`].
     fn linearised(
         &mut self,
         structure: &Structure,
@@ -419,18 +427,21 @@ impl Solver {
         }
         match &structure.basis {
             Some(basis) => {
-                self.factor.active.solve_linearised(
+                match self.factor.active.solve_linearised(
                     structure,
                     basis,
                     &self.work.stretch,
                     &self.sample.loads,
                     &mut self.work.u,
-                )?;
-                Ok(if self.factor.active.is_soft() {
-                    Mode::Tangent
-                } else {
-                    Mode::Chord
-                })
+                ) {
+                    Ok(_) if self.factor.active.is_soft() => Ok(Mode::Tangent),
+                    Ok(_) => Ok(Mode::Chord),
+                    Err(ActiveSetFailure::LargeSlackSet) => {
+                        self.linearised_banded(structure, factorisations)?;
+                        Ok(Mode::Tangent)
+                    }
+                    Err(e) => Err(e),
+                }
             }
             None => {
                 self.linearised_banded(structure, factorisations)?;
@@ -439,9 +450,10 @@ impl Solver {
         }
     }
 
-    /// Step 1 without a cable basis: the active-set iteration with a block-banded
-    /// factorisation of the linearised stiffness of each slack set tried.
-    fn linearised_banded(
+    /// Step 1 without a cable basis, or with a large slack set: the active-set iteration
+    /// with a block-banded factorisation of the linearised stiffness of each slack set
+    /// tried, from the all-taut solution's slack set.
+    pub(super) fn linearised_banded(
         &mut self,
         s: &Structure,
         factorisations: &mut u32,
@@ -486,10 +498,11 @@ impl Solver {
                 .map_err(|_| ActiveSetFailure::NotPositiveDefinite)?;
             self.factor.k.solve_in_place(&mut self.work.u[..n]);
             let mut settled = true;
+            let noise = KINK_NOISE * self.sample.scale;
             for (m, c) in s.members.iter().enumerate() {
-                let slack = c.is_cable
-                    && c.sense * (gather_b(s, m, &self.work.u) + self.work.stretch[m]) < 0.0;
-                if slack != self.factor.factor_slack[m] {
+                let e = c.sense * (gather_b(s, m, &self.work.u) + self.work.stretch[m]);
+                let slack = c.is_cable && e < 0.0;
+                if slack != self.factor.factor_slack[m] && e.abs() > noise {
                     settled = false;
                     self.factor.factor_slack[m] = slack;
                 }
