@@ -188,13 +188,24 @@ pub struct Diagnosis {
 }
 
 impl Diagnosis {
-    /// The effects added, in order.
+    /// The effects of the final model in the order they entered it: each kept step's named
+    /// effect, less those a kept step removed, a swapped one's replacement in its place.
     pub fn named_effects(&self) -> Vec<&str> {
-        self.steps
-            .iter()
-            .filter(|s| s.kept)
-            .filter_map(|s| s.named_effect())
-            .collect()
+        let mut names: Vec<&str> = Vec::new();
+        for s in self.steps.iter().filter(|s| s.kept) {
+            names.extend(s.named_effect());
+            for r in &s.removed {
+                match &r.replaced_by {
+                    Some(by) => {
+                        for n in names.iter_mut().filter(|n| **n == r.name) {
+                            *n = by.as_str();
+                        }
+                    }
+                    None => names.retain(|n| *n != r.name),
+                }
+            }
+        }
+        names
     }
 
     /// The first added effect's name, or `none`.
@@ -452,13 +463,67 @@ pub fn diagnose(
         steps.push(step);
         match (named, next) {
             (Some(i), Some(model)) => {
+                let step = steps.last_mut().expect("just pushed");
+                let named = &step.candidates[i];
+                let rivals = step
+                    .candidates
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, c)| {
+                        j != i
+                            && c.significant
+                            && c.error.is_none()
+                            && c.delta_bic <= 0.5 * named.delta_bic
+                    })
+                    .map(|(_, c)| (c.name.clone(), c.parameters.iter().map(|p| p.value).collect()))
+                    .collect();
                 let candidate = remaining.remove(i);
                 added.push(Added {
                     candidate,
                     values: Vec::new(),
+                    step: step.number,
+                    rivals,
+                });
+                for r in &step.removed {
+                    let Some(by) = &r.replaced_by else { continue };
+                    let e = added
+                        .iter()
+                        .position(|a| a.candidate.name() == r.name)
+                        .expect("a swapped effect is in the model");
+                    let j = remaining
+                        .iter()
+                        .position(|c| c.name() == by)
+                        .expect("a swapped-in candidate was remaining");
+                    added[e] = Added {
+                        candidate: remaining.remove(j),
+                        values: Vec::new(),
+                        step: step.number,
+                        rivals: Vec::new(),
+                    };
+                }
+                added.retain(|a| {
+                    !step
+                        .removed
+                        .iter()
+                        .any(|r| r.replaced_by.is_none() && r.name == a.candidate.name())
                 });
                 for (a, e) in added.iter_mut().zip(now) {
+                    debug_assert_eq!(a.candidate.name(), e.name);
                     a.values = e.parameters.iter().map(|p| p.2).collect();
+                }
+                let taken_over: Vec<(String, String)> = step
+                    .removed
+                    .iter()
+                    .filter_map(|r| r.explained_by.clone().map(|x| (x, r.name.clone())))
+                    .collect();
+                for (by, name) in taken_over {
+                    if let Some(s) = steps
+                        .iter_mut()
+                        .find(|s| s.kept && s.named_effect() == Some(by.as_str()))
+                        && !s.indistinguishable.contains(&name)
+                    {
+                        s.indistinguishable.push(name);
+                    }
                 }
                 models.push(model);
             }
@@ -579,6 +644,7 @@ mod tests {
             statistics: Vec::new(),
             energy: 0.0,
             energy_p: 1.0,
+            energy_noise: 0.0,
             tolerance: Tolerance {
                 within: true,
                 outside: Vec::new(),

@@ -110,6 +110,7 @@ pub mod report;
 pub mod score;
 pub mod simulate;
 pub mod step;
+pub mod stepwise;
 pub mod synth;
 
 pub use errors::DiagnoseError;
