@@ -212,6 +212,34 @@ if run_group backlash; then
   check "paper-backlash" "backlash|indistinguishable" "$P" rigid-sigma-0.033 backlash-sigma-0.033 0 none 401 \
     clearance=0.0105
 fi
+if run_group null-fpr; then
+  # The slow test null_data_false_positive_rate_is_at_most_alpha at 30 specimens: 20 seeds,
+  # N = 400, every candidate but backlash; a false positive is a named effect or the verdict
+  # `unexplained`; at most 3 of 20 (P(≥ 4 of 20) = 0.016 at a rate of exactly α = 0.05).
+  fp=()
+  for s in $(seq 501 520); do
+    name="null-fpr-30-$s"
+    "$T" synth-measured --job "$J" --case $B --specimens 30 --seed "$s" --effect none \
+      --measurement-sigma 0.001 > "$WORK/$name.csv" || exit 1
+    "$T" diagnose --job "$J" --case $B --measured "$WORK/$name.csv" --measurement-sigma 0.001 \
+      --samples 400 --candidates gravity,thermal_gradient,length_bias,length_sigma,diagonal_pretension \
+      --out "$WORK/$name" --quiet --no-plots > /dev/null 2> "$WORK/$name.stderr" || exit 1
+    if ! python3 -c 'import json, sys
+d = json.load(open(sys.argv[1]))
+sys.exit(1 if d["named_effects"] or d["verdict"] == "unexplained" else 0)' "$WORK/$name/diagnosis.json"; then
+      fp+=("$s")
+    fi
+  done
+  echo "null-fpr-30            20 seeds at 30 specimens: ${#fp[@]} false positives${fp[*]:+ (seeds ${fp[*]})}"
+  if (( ${#fp[@]} <= 3 )); then
+    echo "    PASSED"
+    passed=$((passed + 1))
+  else
+    echo "    FAILED"
+    failed=$((failed + 1))
+    failures+=("null-fpr-30")
+  fi
+fi
 echo
 echo "$passed passed, $failed failed${failures[*]:+: ${failures[*]}}; outputs in $WORK"
 [[ $failed == 0 ]]

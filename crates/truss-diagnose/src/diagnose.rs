@@ -1,4 +1,4 @@
-//! The forward selection: find the strongest missing effect, add it, look again at what is
+//! The stepwise selection: find the strongest missing effect, add it, look again at what is
 //! left, and repeat until nothing significant remains ([`diagnose`]).
 //!
 //! Each step ([`crate::step`]) compares the current model (the baseline with the effects
@@ -6,17 +6,16 @@
 //! ([`crate::score`]), decides from the tests and BIC ([`decide`]; the named candidate and
 //! those indistinguishable from it get profile-likelihood intervals, [`crate::profile`], and
 //! should a profile find a higher maximum the verdict is decided again on the new fits), and
-//! adds the named effect at its fitted values. The selection stops at the first step that
+//! adds the named effect at its fitted values; then every effect of the model is re-fitted
+//! jointly, the effects added earlier are tested for removal given the others and tried
+//! swapped for a rival ([`crate::stepwise`]). The selection stops at the first step that
 //! names nothing (no candidate both significant at α/K and better by ΔBIC ≤ −2), at a named
-//! effect that does not improve the fit where the likelihood does not look (the
-//! discrepancy, the energy distance of the displacement vectors, does not shrink with it:
-//! then it is not added), or when no candidate is left. The
-//! false discovery rate over the steps is controlled by [`forward_stop`] on the steps'
-//! Bonferroni-adjusted p-values: named effects beyond its k̂ are not kept.
-//!
-//! When a step adds an effect, every effect added before is re-fitted in turn with the
-//! others held (one pass of backfitting, not a joint fit of all of them): a scatter fitted
-//! before a mean shift was found has absorbed part of it, and gives it back.
+//! effect that makes the fit worse where the likelihood does not look (the discrepancy, the
+//! energy distance of the displacement vectors, grows beyond its noise: then it is not
+//! added; [`crate::step`]), or when no candidate is left. The false discovery rate over the
+//! steps is controlled by [`forward_stop`] on the steps' Bonferroni-adjusted p-values: named
+//! effects beyond its k̂ are not kept, and the final model is the one after the k̂-th kept
+//! step, with the removals and swaps of the steps up to it.
 
 use crate::baseline::{Baseline, CaseEdit};
 use crate::candidates::library;
@@ -475,7 +474,12 @@ pub fn diagnose(
                             && c.error.is_none()
                             && c.delta_bic <= 0.5 * named.delta_bic
                     })
-                    .map(|(_, c)| (c.name.clone(), c.parameters.iter().map(|p| p.value).collect()))
+                    .map(|(_, c)| {
+                        (
+                            c.name.clone(),
+                            c.parameters.iter().map(|p| p.value).collect(),
+                        )
+                    })
                     .collect();
                 let candidate = remaining.remove(i);
                 added.push(Added {

@@ -143,8 +143,8 @@ const METHOD: Method = Method {
     selection: "likelihood-ratio statistic Λ = 2(ℓ − ℓ₀)/(c·λ̄) against the baseline, c = 1 + n/N, λ̄ = max(1, tr(A⁻¹B)/k); p = P(χ²_k ≥ Λ), significant when p < 0.025/K (Bonferroni over the K candidates at α/2: the other half of α = 0.05 is the comparison's, so that data missing nothing get a verdict other than agreement at most 5 % of the time); ΔBIC = k·λ̄·ln n − 2(ℓ − ℓ₀)/c = λ̄·(k ln n − Λ) (n specimens), the BIC of a misspecified likelihood whose penalty counts the effective number of parameters tr(A⁻¹B) = k·λ̄ (Gao & Song 2010), so that candidates' likelihoods are compared unscaled. Named: the candidate with the lowest ΔBIC if it is significant and ΔBIC ≤ −2; indistinguishable: other candidates with ΔBIC within 2 of it, and significant candidates the named one does not fit significantly closer than by Vuong's test for non-nested models, z = Σ_u d_u/√(c·n·var d) < 1.96 with d_u the difference of the two maximised ℓ's terms for specimen u (its member observations included) (Vuong 1989): BIC then prefers the named one, but by its penalty or by a difference in ℓ within the specimens' own scatter, not by a fit the data show to be closer. Significant means better than the baseline, not present: when the baseline misses some effect, any candidate that mimics part of it improves on the baseline, and BIC chooses between them.",
     verdicts: "named: as above. cannot_tell: some candidate improves the fit but not both significantly and by ΔBIC ≤ −2, or none improves it and the data cannot show the baseline agrees within tolerance. none: no candidate improves it and the baseline agrees within tolerance (every coordinate's mean within ±0.5 predicted SD, its SD and θ_P's median and 95th percentile within a factor 1.3, judged by their 95 % intervals). unexplained: no candidate improves it, yet the baseline disagrees (a Holm-significant statistic, with at least 30 specimens; with fewer, cannot_tell).",
     statistics: "per coordinate, piston (mean top z), tan θ_x, tan θ_y: mean difference (Welch interval), SD ratio (interval on ln with kurtosis-corrected variance), covariances (fourth-moment variance); θ_P percentiles 50/90/95/99 (Hyndman–Fan definition 1) as ratios with Poisson-bootstrap intervals (B = 1000); KS on θ_P; energy distance with a permutation test (R = 199). The simulation carries the instrument's noise. Disagrees: Holm-adjusted p < 0.025 (half of α = 0.05; the candidates' tests have the other half). p-values under \"no difference\" use the simulated moments for both parts (the measured specimens are draws from the simulation under that hypothesis); the 95 % intervals are Welch's with Student's t.",
-    steps: "forward selection: step 1 tests every candidate against the baseline; a named effect is added at its fitted values and step 2 tests the remaining candidates against that model, and so on, until a step names nothing (no candidate significant at α/K and better by ΔBIC ≤ −2), or names an effect that does not shrink the discrepancy (the energy distance; then it is not added), or no candidate is left. Effects already added keep their own step's fit. The false discovery rate over the steps is held at α by ForwardStop (G'Sell et al. 2016) on the steps' Bonferroni-adjusted p-values min(1, K·p): the named effects kept are the first k̂, k̂ = max{k : −(1/k)·Σ_{s≤k} ln(1 − p_s) ≤ α}.",
-    discrepancy: "energy distance (unbiased U-statistic, Székely & Rizzo 2004) between the measured and simulated displacement vectors, each coordinate divided by its measured SD: 0 when the distributions agree.",
+    steps: "stepwise selection: step 1 tests every candidate against the baseline; a named effect is added at its fitted values, every effect of the model is re-fitted jointly (one trust-region Newton fit of all their parameters), each effect added in an earlier step is tested for removal given the others (Λ = 2(ℓ̂ − ℓ̂ without it)/(c·λ), removed, the least needed first, unless p < α/2 and ΔBIC ≤ −2), then tried swapped for a rival candidate of its own step (significant then and at least half its ΔBIC), the swap made when the swapped model's BIC is lower by 2 or more; then step 2 tests the remaining candidates against that model, and so on, until a step names nothing (no candidate significant at α/K and better by ΔBIC ≤ −2), or names an effect that makes the discrepancy grow beyond its noise (E_after − E_before > 1.96·√(s_before² + s_after²), s the energy distance's permutation RMS, or the energy test turning significant at 0.025: then it is not added), or no candidate is left. A removed effect is listed as indistinguishable from the effect whose parameters moved furthest when it was removed. The false discovery rate over the steps is held at α by ForwardStop (G'Sell et al. 2016) on the steps' Bonferroni-adjusted p-values min(1, K·p): the named effects kept are the first k̂, k̂ = max{k : −(1/k)·Σ_{s≤k} ln(1 − p_s) ≤ α}, and removals only take effects out of the model.",
+    discrepancy: "energy distance (unbiased U-statistic, Székely & Rizzo 2004) between the measured and simulated displacement vectors, each coordinate divided by its measured SD: 0 when the distributions agree; its noise is the root mean square of the statistic over the R = 199 permutations.",
 };
 
 #[derive(Serialize)]
@@ -564,11 +564,18 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
                 .filter(|s| s.kept)
                 .flat_map(|s| &s.refitted)
                 .rfind(|r| r.name == e.name);
-            push(m, &format!("Fitted `{}` (swapped in; the last joint re-fit):\n", e.name));
+            push(
+                m,
+                &format!("Fitted `{}` (swapped in; the last joint re-fit):\n", e.name),
+            );
             for p in fit.map_or(&[][..], |f| &f.parameters) {
                 push(
                     m,
-                    &format!("- {}: {}", parameter_text(p), plain_reading(&e.name, p, span)),
+                    &format!(
+                        "- {}: {}",
+                        parameter_text(p),
+                        plain_reading(&e.name, p, span)
+                    ),
                 );
             }
             push(m, "");

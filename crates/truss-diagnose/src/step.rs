@@ -41,7 +41,7 @@ use crate::diagnose::{DELTA_BIC, Decision, Progress, Settings, Verdict, decide, 
 use crate::errors::DiagnoseError;
 use crate::measured::Measured;
 use crate::score::{
-    CandidateScore, Evaluator, FittedParameter, Fitted, Test, fit_candidate, profile_candidate,
+    CandidateScore, Evaluator, Fitted, FittedParameter, Test, fit_candidate, profile_candidate,
 };
 use crate::simulate::{Noise, Simulation, simulate};
 use crate::stepwise::{
@@ -295,9 +295,9 @@ fn update(
         note(&format!(
             "  {} removed: given the others it no longer improves the fit{}",
             gone.0.name(),
-            explained_by
-                .as_ref()
-                .map_or(String::new(), |x| format!(" ({x} takes over what it explained)"))
+            explained_by.as_ref().map_or(String::new(), |x| format!(
+                " ({x} takes over what it explained)"
+            ))
         ));
         removed.push(Removal {
             name: gone.0.name().into(),
@@ -306,10 +306,11 @@ fn update(
             lr_statistic: lr,
             p_value: Some(p),
             delta_bic,
-            separate_by: explained_by.as_ref().map_or(
-                "a measurement that only it affects".into(),
-                |x| separating_measurement(gone.0.name(), x).into(),
-            ),
+            separate_by: explained_by
+                .as_ref()
+                .map_or("a measurement that only it affects".into(), |x| {
+                    separating_measurement(gone.0.name(), x).into()
+                }),
             explained_by,
         });
         joint = Some(reduced);
@@ -404,8 +405,11 @@ fn best_swap<'a>(
             let mut swapped: Vec<(&dyn Candidate, &[f64])> =
                 members.iter().map(|m| (m.0, m.1.as_slice())).collect();
             swapped[e] = (r, start);
-            ctx.progress
-                .note(&format!("  trying {} in place of {}…", r.name(), m.0.name()));
+            ctx.progress.note(&format!(
+                "  trying {} in place of {}…",
+                r.name(),
+                m.0.name()
+            ));
             let fit = match joint_fit(ctx, &swapped, None) {
                 Ok(f) => f,
                 Err(err) => {
@@ -730,4 +734,51 @@ fn fitted_terms(
     let terms = ev.terms_at(c, &values).ok()?;
     cache.borrow_mut()[i] = Some((values, terms.clone()));
     Some(terms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compare::Tolerance;
+
+    fn comparison(energy: f64, energy_p: f64, energy_noise: f64) -> Comparison {
+        Comparison {
+            specimens: 200,
+            samples: 4000,
+            statistics: Vec::new(),
+            energy,
+            energy_p,
+            energy_noise,
+            tolerance: Tolerance {
+                within: true,
+                outside: Vec::new(),
+                bands: String::new(),
+            },
+        }
+    }
+
+    /// The discrepancy may move within its noise: −0.0119 → −0.0094 with noise 0.011 each
+    /// (a growth of 0.0025 against 1.96·0.0156 = 0.030) is not worse; a growth of 0.05 is;
+    /// and so is a model whose energy test turns significant (p 0.3 → 0.01) though the
+    /// distance grows within the noise; one that was significant before and stays so is
+    /// judged by the growth alone.
+    #[test]
+    fn the_discrepancy_may_move_within_its_noise() {
+        let before = comparison(-0.0119, 0.9, 0.011);
+        assert_eq!(worse_fit(&before, &comparison(-0.0094, 0.8, 0.011)), None);
+        let why = worse_fit(&before, &comparison(0.04, 0.3, 0.011)).unwrap();
+        assert!(why.contains("by more than 1.96 times its noise"), "{why}");
+        let turned = worse_fit(
+            &comparison(0.01, 0.3, 0.011),
+            &comparison(0.02, 0.01, 0.011),
+        );
+        assert!(turned.unwrap().contains("becomes significant"));
+        assert_eq!(
+            worse_fit(
+                &comparison(0.5, 0.005, 0.011),
+                &comparison(0.51, 0.005, 0.011)
+            ),
+            None
+        );
+    }
 }

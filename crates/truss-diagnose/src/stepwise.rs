@@ -110,7 +110,11 @@ impl Candidate for Combined<'_> {
     fn parameters(&self) -> &[Parameter] {
         &self.parameters
     }
-    fn apply(&self, values: &[f64], edit: &mut crate::baseline::CaseEdit) -> Result<(), DiagnoseError> {
+    fn apply(
+        &self,
+        values: &[f64],
+        edit: &mut crate::baseline::CaseEdit,
+    ) -> Result<(), DiagnoseError> {
         for (c, r) in self.parts.iter().zip(self.ranges()) {
             c.apply(&values[r], edit)?;
         }
@@ -312,13 +316,55 @@ mod tests {
         assert_eq!(furthest_moved(&params, &before, &before), None);
     }
 
+    /// Several effects as one: their parameters in order, cut back by `split`; applying the
+    /// combination is applying each in turn; each part projects its own slice (gravity's
+    /// |g| ≤ 1 on its three, the temperature field's left alone), a held parameter indexed
+    /// within the whole.
+    #[test]
+    fn combined_effects_apply_in_turn() {
+        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../jobs/diagnose-baseline.json");
+        let baseline = crate::baseline::Baseline::read(&job, "as-built").unwrap();
+        let (candidates, _) = crate::candidates::library(&baseline);
+        let pick = |n: &str| {
+            candidates
+                .iter()
+                .find(|c| c.name() == n)
+                .map(|c| c.as_ref())
+                .unwrap()
+        };
+        let (gravity, thermal) = (pick("gravity"), pick("thermal_gradient"));
+        let combined = Combined::new(vec![gravity, thermal]);
+        assert_eq!(combined.parameters().len(), 3 + 4);
+        assert_eq!(combined.parameters()[3].name, "gradient_x");
+        let values = [0.0, 0.6, 0.8, 0.001, 0.0, 0.0, 2.0];
+        let parts = combined.split(&values);
+        assert_eq!(parts, vec![vec![0.0, 0.6, 0.8], vec![0.001, 0.0, 0.0, 2.0]]);
+        let mut one = baseline.derived_case();
+        combined.apply(&values, &mut one).unwrap();
+        let mut each = baseline.derived_case();
+        gravity.apply(&parts[0], &mut each).unwrap();
+        thermal.apply(&parts[1], &mut each).unwrap();
+        assert_eq!(one, each);
+        assert_ne!(one, baseline.derived_case());
+        // |g|² = 0.36 + 2.56 with g_y held at 0.6: g_z scaled to √(1 − 0.36) = 0.8.
+        let mut v = [0.0, 0.6, 1.6, 0.001, 0.0, 0.0, 2.0];
+        combined.project(&mut v, Some(1));
+        assert_eq!(v[1], 0.6, "held");
+        assert!((v[2] - 0.8).abs() < 1e-12, "{v:?}");
+        assert_eq!(v[3..], values[3..]);
+    }
+
     /// The pairs the crate doc names get their own measurement, either way round.
     #[test]
     fn each_confusable_pair_names_its_measurement() {
         let m = separating_measurement("thermal_gradient", "length_bias");
         assert!(m.contains("temperature"), "{m}");
         assert_eq!(m, separating_measurement("length_bias", "thermal_gradient"));
-        assert!(separating_measurement("diagonal_pretension", "length_bias").contains("--measured-members"));
+        assert!(
+            separating_measurement("diagonal_pretension", "length_bias")
+                .contains("--measured-members")
+        );
         assert!(separating_measurement("backlash", "length_bias").contains("--measured-members"));
     }
 }
