@@ -190,21 +190,7 @@ impl Diagnosis {
     /// The effects of the final model in the order they entered it: each kept step's named
     /// effect, less those a kept step removed, a swapped one's replacement in its place.
     pub fn named_effects(&self) -> Vec<&str> {
-        let mut names: Vec<&str> = Vec::new();
-        for s in self.steps.iter().filter(|s| s.kept) {
-            names.extend(s.named_effect());
-            for r in &s.removed {
-                match &r.replaced_by {
-                    Some(by) => {
-                        for n in names.iter_mut().filter(|n| **n == r.name) {
-                            *n = by.as_str();
-                        }
-                    }
-                    None => names.retain(|n| *n != r.name),
-                }
-            }
-        }
-        names
+        final_effects(&self.steps)
     }
 
     /// The first added effect's name, or `none`.
@@ -216,6 +202,25 @@ impl Diagnosis {
     pub fn first_step(&self) -> &Step {
         &self.steps[0]
     }
+}
+
+/// The effects of the final model in the order they entered it ([`Diagnosis::named_effects`]).
+fn final_effects(steps: &[Step]) -> Vec<&str> {
+    let mut names: Vec<&str> = Vec::new();
+    for s in steps.iter().filter(|s| s.kept) {
+        names.extend(s.named_effect());
+        for r in &s.removed {
+            match &r.replaced_by {
+                Some(by) => {
+                    for n in names.iter_mut().filter(|n| **n == r.name) {
+                        *n = by.as_str();
+                    }
+                }
+                None => names.retain(|n| *n != r.name),
+            }
+        }
+    }
+    names
 }
 
 /// The verdict, why, the named candidate and those indistinguishable from it (indices).
@@ -606,10 +611,19 @@ fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
     } else {
         format!("step {}: {}", last.number, last.reason)
     };
+    let names = final_effects(steps);
+    let model = if names.len() == kept {
+        String::new()
+    } else {
+        format!(
+            " (the final model has {}: the others were removed or replaced on the way)",
+            names.join(" and ")
+        )
+    };
     (
         Verdict::Named,
         format!(
-            "{kept} effect{} added in turn. {}. Finally, {end}",
+            "{kept} effect{} added in turn{model}. {}. Finally, {end}",
             if kept == 1 { "" } else { "s" },
             added.join(". ")
         ),
@@ -692,6 +706,66 @@ mod tests {
             "{}",
             clear.reason
         );
+    }
+
+    /// The final model's effects from the steps: each kept step's named effect in turn, a
+    /// removed one taken out, a swapped one's replacement in its place, and nothing of a
+    /// step that is not kept (its removals included).
+    #[test]
+    fn final_effects_follow_removals_and_swaps() {
+        use crate::stepwise::Removal;
+        let removal = |name: &str, by: Option<&str>| Removal {
+            name: name.into(),
+            replaced_by: by.map(String::from),
+            added_in_step: 1,
+            lr_statistic: 0.0,
+            p_value: None,
+            delta_bic: 0.0,
+            explained_by: None,
+            separate_by: String::new(),
+        };
+        let step = |number: usize, named: &str, kept: bool, removed: Vec<Removal>| Step {
+            number,
+            verdict: Verdict::Named,
+            reason: String::new(),
+            named: Some(0),
+            kept,
+            indistinguishable: Vec::new(),
+            candidates: vec![score(named, 1, -10.0, true)],
+            log_likelihood_before: 0.0,
+            adjusted_p: Some(0.0),
+            before: comparison(),
+            after: None,
+            refitted: Vec::new(),
+            removed,
+            effects: Vec::new(),
+            seconds: 0.0,
+        };
+        let steps = vec![
+            step(1, "length_bias", true, Vec::new()),
+            step(
+                2,
+                "length_sigma",
+                true,
+                vec![removal("length_bias", Some("diagonal_pretension"))],
+            ),
+            step(
+                3,
+                "thermal_gradient",
+                true,
+                vec![removal("length_sigma", None)],
+            ),
+            step(4, "gravity", false, vec![removal("thermal_gradient", None)]),
+        ];
+        assert_eq!(
+            final_effects(&steps),
+            ["diagonal_pretension", "thermal_gradient"]
+        );
+        assert_eq!(
+            final_effects(&steps[..2]),
+            ["diagonal_pretension", "length_sigma"]
+        );
+        assert!(final_effects(&steps[3..]).is_empty());
     }
 
     /// ForwardStop by hand: −ln(1 − p) for p = 0.01, 0.04, 0.2 is 0.01005, 0.04082, 0.22314;
