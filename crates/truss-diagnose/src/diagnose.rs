@@ -10,8 +10,9 @@
 //! jointly, the effects added earlier are tested for removal given the others and tried
 //! swapped for a rival ([`crate::stepwise`]). The selection stops at the first step that
 //! names nothing (no candidate both significant at α/K and better by ΔBIC ≤ −2), at a named
-//! effect that makes the fit worse where the likelihood does not look (the discrepancy, the
-//! energy distance of the displacement vectors, grows beyond its noise: then it is not
+//! effect that makes the fit worse where the likelihood does not look (the model agreed in
+//! distribution, and with the effect the discrepancy, the energy distance of the
+//! displacement vectors, grows beyond its noise or turns significant: then it is not
 //! added; [`crate::step`]), or when no candidate is left. The false discovery rate over the
 //! steps is controlled by [`forward_stop`] on the steps' Bonferroni-adjusted p-values: named
 //! effects beyond its k̂ are not kept, and the final model is the one after the k̂-th kept
