@@ -106,8 +106,12 @@ for s in kept:
     for o in s["indistinguishable"]:
         ind.setdefault(s["named_effect"], set()).add(o)
     for r in s["removed_effects"]:
-        print(f"    step {s['number']}: {r['name']} (step {r['added_in_step']}) removed, "
-              f"ΔBIC {r['delta_bic']:.1f} given the others; taken over by {r.get('explained_by') or '-'}")
+        if r.get("replaced_by"):
+            print(f"    step {s['number']}: {r['name']} (step {r['added_in_step']}) replaced by "
+                  f"{r['replaced_by']} (the swapped model better by ΔBIC {-r['delta_bic']:.1f})")
+        else:
+            print(f"    step {s['number']}: {r['name']} (step {r['added_in_step']}) removed, "
+                  f"ΔBIC {r['delta_bic']:.1f} given the others; taken over by {r.get('explained_by') or '-'}")
 if expect == "-":
     ok = named == []
 elif expect == "backlash|indistinguishable":
