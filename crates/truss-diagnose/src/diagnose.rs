@@ -156,7 +156,7 @@ impl Verdict {
     }
 }
 
-/// A complete diagnosis: the steps of the forward selection and the final model.
+/// A complete diagnosis: the steps of the stepwise selection and the final model.
 pub struct Diagnosis {
     /// The overall verdict: `named` when an effect was added, else step 1's.
     pub verdict: Verdict,
@@ -374,7 +374,7 @@ pub fn decide(
     }
 }
 
-/// Most steps of the forward selection: one per candidate at most.
+/// Most steps of the selection: one per candidate at most.
 pub const MAX_STEPS: usize = 6;
 
 /// The number of steps whose named effects are kept: ForwardStop (G'Sell, Wager,
@@ -396,7 +396,7 @@ pub fn forward_stop(adjusted: &[f64], alpha: f64) -> usize {
     kept
 }
 
-/// The forward selection on measured data against the baseline case: step after step
+/// The stepwise selection on measured data against the baseline case: step after step
 /// ([`crate::step`]), each adding the strongest missing effect to the model, until no
 /// candidate is significant and clearly better by BIC, or none is left; then the false
 /// discovery rate over the steps decides how many of the named effects are kept

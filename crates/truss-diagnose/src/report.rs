@@ -13,8 +13,9 @@
 //! named_effect "none" or the first added effect's name
 //! named_effects [names]   every effect added, in order; [] when none
 //! steps       [{number, verdict, reason, named_effect ("none" when nothing was named),
-//!               kept (added to the model: significant, better by BIC, shrinking the
-//!               discrepancy, and kept by the false discovery rate over the steps),
+//!               kept (added to the model: significant, better by BIC, not spoiling a
+//!               model that agreed in distribution, and kept by the false discovery rate
+//!               over the steps; a later step may still remove or replace it),
 //!               parameters[] (the named effect's, as below), indistinguishable[],
 //!               adjusted_p (min(1, K·p) of the named one), log_likelihood_before,
 //!               candidates[] (as below, against the model of the step's start),

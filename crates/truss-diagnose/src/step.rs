@@ -1,4 +1,4 @@
-//! One step of the forward selection, as one pass through its stages:
+//! One step of the stepwise selection, as one pass through its stages:
 //!
 //! 1. **compare** (`compare_model`): the current model (the baseline with the effects added
 //!    so far) is simulated with N samples and the instrument's noise, compared with the
