@@ -108,6 +108,8 @@ pub struct Comparison {
     pub energy: f64,
     /// Its permutation p-value.
     pub energy_p: f64,
+    /// Its noise level, the permutations' RMS ([`EnergyTest::noise`]).
+    pub energy_noise: f64,
     /// Tolerance check.
     pub tolerance: Tolerance,
 }
@@ -463,8 +465,23 @@ fn ks_statistic(y: &[f64], x: &[f64]) -> Statistic {
     }
 }
 
-/// The energy distance (U-statistic) of standardised rows and its permutation p-value.
-pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> (f64, f64) {
+/// The energy distance of two samples and what chance alone gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnergyTest {
+    /// The energy distance (unbiased U-statistic; dimensionless, the rows standardised).
+    pub statistic: f64,
+    /// Its permutation p-value.
+    pub p_value: f64,
+    /// Its noise: the root mean square of the statistic over the permutations, √(Σ Eᵣ²/R),
+    /// the standard deviation of the U-statistic (mean 0) when both samples come from one
+    /// distribution. Two models compared with the same measurements differ in their
+    /// energy distances by chance by about √(noise₁² + noise₂²) or less.
+    pub noise: f64,
+}
+
+/// The energy distance (U-statistic) of standardised rows, its permutation p-value and its
+/// noise level under the permutations ([`EnergyTest`]).
+pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> EnergyTest {
     let n = (y.len() / d).min(2000);
     let m = (x.len() / d).min(1000);
     let total = n + m;
@@ -506,6 +523,7 @@ pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> (f64, f64) 
     let observed = statistic(&label);
     let replicates = 199;
     let mut exceed = 0;
+    let mut squares = 0.0;
     let mut state = 0x5eed_u64;
     for _ in 0..replicates {
         for i in (1..total).rev() {
@@ -513,11 +531,17 @@ pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> (f64, f64) 
             let j = (mix64(state) % (i as u64 + 1)) as usize;
             label.swap(i, j);
         }
-        if statistic(&label) >= observed {
+        let e = statistic(&label);
+        squares += e * e;
+        if e >= observed {
             exceed += 1;
         }
     }
-    (observed, (1 + exceed) as f64 / (replicates + 1) as f64)
+    EnergyTest {
+        statistic: observed,
+        p_value: (1 + exceed) as f64 / (replicates + 1) as f64,
+        noise: (squares / replicates as f64).sqrt(),
+    }
 }
 
 /// The comparison's family-wise level: a statistic disagrees when its Holm-adjusted p is
@@ -609,7 +633,11 @@ pub fn compare(
     let scale: Vec<f64> = (0..d)
         .map(|j| moments(&columns[j].1).sd.max(floor))
         .collect();
-    let (energy, energy_p) = energy_test(&measured.y, &sim.x_noisy, d, &scale);
+    let EnergyTest {
+        statistic: energy,
+        p_value: energy_p,
+        noise: energy_noise,
+    } = energy_test(&measured.y, &sim.x_noisy, d, &scale);
     stats.push(Statistic {
         id: "energy displacements".into(),
         kind: "energy",
@@ -671,6 +699,7 @@ pub fn compare(
         statistics: stats,
         energy,
         energy_p,
+        energy_noise,
         tolerance: Tolerance {
             within: outside.is_empty(),
             outside,
@@ -695,13 +724,39 @@ mod tests {
         };
         let y = gauss(1, 100, 0.0);
         let x = gauss(2, 400, 0.0);
-        let (e0, p0) = energy_test(&y, &x, 2, &[1.0, 1.0]);
+        let t0 = energy_test(&y, &x, 2, &[1.0, 1.0]);
+        let (e0, p0) = (t0.statistic, t0.p_value);
         assert!(p0 > 0.01, "null rejected: e = {e0}, p = {p0}");
+        assert!(e0.abs() < 3.0 * t0.noise, "e = {e0}, noise {}", t0.noise);
         let z = gauss(3, 100, 0.8);
-        let (e1, p1) = energy_test(&z, &x, 2, &[1.0, 1.0]);
+        let t1 = energy_test(&z, &x, 2, &[1.0, 1.0]);
+        let (e1, p1) = (t1.statistic, t1.p_value);
         assert!(
-            p1 < 0.01 && e1 > 5.0 * e0.abs(),
-            "shift missed: e = {e1}, p = {p1}"
+            p1 < 0.01 && e1 > 5.0 * e0.abs() && e1 > 10.0 * t1.noise,
+            "shift missed: e = {e1}, p = {p1}, noise {}",
+            t1.noise
+        );
+    }
+
+    /// The noise level is the statistic's spread under the null: over 40 independent pairs
+    /// of samples from one distribution (30 against 100 rows), the standard deviation of the
+    /// energy distance is within a factor 1.5 of the mean permutation noise (both estimate
+    /// the same SD; 40 draws give it to about ±11 %).
+    #[test]
+    fn energy_noise_is_the_spread_under_the_null() {
+        let gauss = |seed: u64, n: usize| -> Vec<f64> {
+            (0..n * 2)
+                .map(|i| crate::simulate::noise_normal(seed, i as u64, 0))
+                .collect()
+        };
+        let tests: Vec<EnergyTest> = (0..40)
+            .map(|k| energy_test(&gauss(100 + k, 30), &gauss(200 + k, 100), 2, &[1.0, 1.0]))
+            .collect();
+        let sd = (tests.iter().map(|t| t.statistic.powi(2)).sum::<f64>() / 40.0).sqrt();
+        let noise = tests.iter().map(|t| t.noise).sum::<f64>() / 40.0;
+        assert!(
+            sd < 1.5 * noise && noise < 1.5 * sd,
+            "spread {sd} against noise {noise}"
         );
     }
 }

@@ -1,4 +1,4 @@
-//! The forward selection: find the strongest missing effect, add it, look again at what is
+//! The stepwise selection: find the strongest missing effect, add it, look again at what is
 //! left, and repeat until nothing significant remains ([`diagnose`]).
 //!
 //! Each step ([`crate::step`]) compares the current model (the baseline with the effects
@@ -6,17 +6,17 @@
 //! ([`crate::score`]), decides from the tests and BIC ([`decide`]; the named candidate and
 //! those indistinguishable from it get profile-likelihood intervals, [`crate::profile`], and
 //! should a profile find a higher maximum the verdict is decided again on the new fits), and
-//! adds the named effect at its fitted values. The selection stops at the first step that
+//! adds the named effect at its fitted values; then every effect of the model is re-fitted
+//! jointly, the effects added earlier are tested for removal given the others and tried
+//! swapped for a rival ([`crate::stepwise`]). The selection stops at the first step that
 //! names nothing (no candidate both significant at α/K and better by ΔBIC ≤ −2), at a named
-//! effect that does not improve the fit where the likelihood does not look (the
-//! discrepancy, the energy distance of the displacement vectors, does not shrink with it:
-//! then it is not added), or when no candidate is left. The
-//! false discovery rate over the steps is controlled by [`forward_stop`] on the steps'
-//! Bonferroni-adjusted p-values: named effects beyond its k̂ are not kept.
-//!
-//! When a step adds an effect, every effect added before is re-fitted in turn with the
-//! others held (one pass of backfitting, not a joint fit of all of them): a scatter fitted
-//! before a mean shift was found has absorbed part of it, and gives it back.
+//! effect that makes the fit worse where the likelihood does not look (the model agreed in
+//! distribution, and with the effect the discrepancy, the energy distance of the
+//! displacement vectors, grows beyond its noise or turns significant: then it is not
+//! added; [`crate::step`]), or when no candidate is left. The false discovery rate over the
+//! steps is controlled by [`forward_stop`] on the steps' Bonferroni-adjusted p-values: named
+//! effects beyond its k̂ are not kept, and the final model is the one after the k̂-th kept
+//! step, with the removals and swaps of the steps up to it.
 
 use crate::baseline::{Baseline, CaseEdit};
 use crate::candidates::library;
@@ -156,7 +156,7 @@ impl Verdict {
     }
 }
 
-/// A complete diagnosis: the steps of the forward selection and the final model.
+/// A complete diagnosis: the steps of the stepwise selection and the final model.
 pub struct Diagnosis {
     /// The overall verdict: `named` when an effect was added, else step 1's.
     pub verdict: Verdict,
@@ -188,13 +188,10 @@ pub struct Diagnosis {
 }
 
 impl Diagnosis {
-    /// The effects added, in order.
+    /// The effects of the final model in the order they entered it: each kept step's named
+    /// effect, less those a kept step removed, a swapped one's replacement in its place.
     pub fn named_effects(&self) -> Vec<&str> {
-        self.steps
-            .iter()
-            .filter(|s| s.kept)
-            .filter_map(|s| s.named_effect())
-            .collect()
+        final_effects(&self.steps)
     }
 
     /// The first added effect's name, or `none`.
@@ -206,6 +203,25 @@ impl Diagnosis {
     pub fn first_step(&self) -> &Step {
         &self.steps[0]
     }
+}
+
+/// The effects of the final model in the order they entered it ([`Diagnosis::named_effects`]).
+fn final_effects(steps: &[Step]) -> Vec<&str> {
+    let mut names: Vec<&str> = Vec::new();
+    for s in steps.iter().filter(|s| s.kept) {
+        names.extend(s.named_effect());
+        for r in &s.removed {
+            match &r.replaced_by {
+                Some(by) => {
+                    for n in names.iter_mut().filter(|n| **n == r.name) {
+                        *n = by.as_str();
+                    }
+                }
+                None => names.retain(|n| *n != r.name),
+            }
+        }
+    }
+    names
 }
 
 /// The verdict, why, the named candidate and those indistinguishable from it (indices).
@@ -358,7 +374,7 @@ pub fn decide(
     }
 }
 
-/// Most steps of the forward selection: one per candidate at most.
+/// Most steps of the selection: one per candidate at most.
 pub const MAX_STEPS: usize = 6;
 
 /// The number of steps whose named effects are kept: ForwardStop (G'Sell, Wager,
@@ -380,7 +396,7 @@ pub fn forward_stop(adjusted: &[f64], alpha: f64) -> usize {
     kept
 }
 
-/// The forward selection on measured data against the baseline case: step after step
+/// The stepwise selection on measured data against the baseline case: step after step
 /// ([`crate::step`]), each adding the strongest missing effect to the model, until no
 /// candidate is significant and clearly better by BIC, or none is left; then the false
 /// discovery rate over the steps decides how many of the named effects are kept
@@ -452,13 +468,72 @@ pub fn diagnose(
         steps.push(step);
         match (named, next) {
             (Some(i), Some(model)) => {
+                let step = steps.last_mut().expect("just pushed");
+                let named = &step.candidates[i];
+                let rivals = step
+                    .candidates
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, c)| {
+                        j != i
+                            && c.significant
+                            && c.error.is_none()
+                            && c.delta_bic <= 0.5 * named.delta_bic
+                    })
+                    .map(|(_, c)| {
+                        (
+                            c.name.clone(),
+                            c.parameters.iter().map(|p| p.value).collect(),
+                        )
+                    })
+                    .collect();
                 let candidate = remaining.remove(i);
                 added.push(Added {
                     candidate,
                     values: Vec::new(),
+                    step: step.number,
+                    rivals,
+                });
+                for r in &step.removed {
+                    let Some(by) = &r.replaced_by else { continue };
+                    let e = added
+                        .iter()
+                        .position(|a| a.candidate.name() == r.name)
+                        .expect("a swapped effect is in the model");
+                    let j = remaining
+                        .iter()
+                        .position(|c| c.name() == by)
+                        .expect("a swapped-in candidate was remaining");
+                    added[e] = Added {
+                        candidate: remaining.remove(j),
+                        values: Vec::new(),
+                        step: step.number,
+                        rivals: Vec::new(),
+                    };
+                }
+                added.retain(|a| {
+                    !step
+                        .removed
+                        .iter()
+                        .any(|r| r.replaced_by.is_none() && r.name == a.candidate.name())
                 });
                 for (a, e) in added.iter_mut().zip(now) {
+                    debug_assert_eq!(a.candidate.name(), e.name);
                     a.values = e.parameters.iter().map(|p| p.2).collect();
+                }
+                let taken_over: Vec<(String, String)> = step
+                    .removed
+                    .iter()
+                    .filter_map(|r| r.explained_by.clone().map(|x| (x, r.name.clone())))
+                    .collect();
+                for (by, name) in taken_over {
+                    if let Some(s) = steps
+                        .iter_mut()
+                        .find(|s| s.kept && s.named_effect() == Some(by.as_str()))
+                        && !s.indistinguishable.contains(&name)
+                    {
+                        s.indistinguishable.push(name);
+                    }
                 }
                 models.push(model);
             }
@@ -537,10 +612,19 @@ fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
     } else {
         format!("step {}: {}", last.number, last.reason)
     };
+    let names = final_effects(steps);
+    let model = if names.len() == kept {
+        String::new()
+    } else {
+        format!(
+            " (the final model has {}: the others were removed or replaced on the way)",
+            names.join(" and ")
+        )
+    };
     (
         Verdict::Named,
         format!(
-            "{kept} effect{} added in turn. {}. Finally, {end}",
+            "{kept} effect{} added in turn{model}. {}. Finally, {end}",
             if kept == 1 { "" } else { "s" },
             added.join(". ")
         ),
@@ -579,6 +663,7 @@ mod tests {
             statistics: Vec::new(),
             energy: 0.0,
             energy_p: 1.0,
+            energy_noise: 0.0,
             tolerance: Tolerance {
                 within: true,
                 outside: Vec::new(),
@@ -622,6 +707,66 @@ mod tests {
             "{}",
             clear.reason
         );
+    }
+
+    /// The final model's effects from the steps: each kept step's named effect in turn, a
+    /// removed one taken out, a swapped one's replacement in its place, and nothing of a
+    /// step that is not kept (its removals included).
+    #[test]
+    fn final_effects_follow_removals_and_swaps() {
+        use crate::stepwise::Removal;
+        let removal = |name: &str, by: Option<&str>| Removal {
+            name: name.into(),
+            replaced_by: by.map(String::from),
+            added_in_step: 1,
+            lr_statistic: 0.0,
+            p_value: None,
+            delta_bic: 0.0,
+            explained_by: None,
+            separate_by: String::new(),
+        };
+        let step = |number: usize, named: &str, kept: bool, removed: Vec<Removal>| Step {
+            number,
+            verdict: Verdict::Named,
+            reason: String::new(),
+            named: Some(0),
+            kept,
+            indistinguishable: Vec::new(),
+            candidates: vec![score(named, 1, -10.0, true)],
+            log_likelihood_before: 0.0,
+            adjusted_p: Some(0.0),
+            before: comparison(),
+            after: None,
+            refitted: Vec::new(),
+            removed,
+            effects: Vec::new(),
+            seconds: 0.0,
+        };
+        let steps = vec![
+            step(1, "length_bias", true, Vec::new()),
+            step(
+                2,
+                "length_sigma",
+                true,
+                vec![removal("length_bias", Some("diagonal_pretension"))],
+            ),
+            step(
+                3,
+                "thermal_gradient",
+                true,
+                vec![removal("length_sigma", None)],
+            ),
+            step(4, "gravity", false, vec![removal("thermal_gradient", None)]),
+        ];
+        assert_eq!(
+            final_effects(&steps),
+            ["diagonal_pretension", "thermal_gradient"]
+        );
+        assert_eq!(
+            final_effects(&steps[..2]),
+            ["diagonal_pretension", "length_sigma"]
+        );
+        assert!(final_effects(&steps[3..]).is_empty());
     }
 
     /// ForwardStop by hand: −ln(1 − p) for p = 0.01, 0.04, 0.2 is 0.01005, 0.04082, 0.22314;

@@ -57,16 +57,21 @@
 //!    95 % region (threshold χ²_k(0.95)·c·λ̄) is projected on each parameter as well
 //!    (`joint_interval`). Every candidate also carries its Wald interval, c·A⁻¹BA⁻¹
 //!    ([`fit`]), reported beside the profile one.
-//! 3. **Add it, and look again**: the named effect is added at its fitted values and step 2
-//!    runs again against the updated model with the remaining candidates, and so on
-//!    ([`step`], [`diagnose`]): forward selection, until no candidate is significant and
-//!    clearly better, or a named effect does not shrink the discrepancy (it is then not
-//!    added), or none is left. The false discovery rate over the steps is held at α/2 by
-//!    ForwardStop on the steps' Bonferroni-adjusted p-values ([`diagnose::forward_stop`]);
-//!    the other half of α = 0.05 is the comparison's ([`compare::LEVEL`]), so that on data
-//!    missing nothing any verdict but agreement has a rate of at most α.
-//!    `DIR/updated-job.json` is the baseline job with every added effect in the case (same
-//!    case name), which mc-shard and mc-merge run as usual.
+//! 3. **Add it, and look again**: the named effect is added at its fitted values, every
+//!    effect of the model is re-fitted jointly, each effect added in an earlier step is
+//!    tested for removal given the others and tried swapped for a rival that explains the
+//!    same thing better jointly ([`stepwise`]), and step 2 runs again against the updated
+//!    model with the remaining candidates, and so on ([`step`], [`diagnose`]): stepwise
+//!    selection, until no candidate is significant and clearly better, or a named effect
+//!    spoils a model that agreed in distribution (the discrepancy grows beyond its noise,
+//!    or turns significant: it is then not added; [`step`]), or none is left. An effect removed because another took over what it explained is listed as
+//!    indistinguishable from it, with the measurement that would separate them. The false
+//!    discovery rate over the steps is held at α/2 by ForwardStop on the steps'
+//!    Bonferroni-adjusted p-values ([`diagnose::forward_stop`]; removals only take effects
+//!    out); the other half of α = 0.05 is the comparison's ([`compare::LEVEL`]), so that on
+//!    data missing nothing any verdict but agreement has a rate of at most α.
+//!    `DIR/updated-job.json` is the baseline job with every effect of the final model in
+//!    the case (same case name), which mc-shard and mc-merge run as usual.
 //! 4. **The gap shrinks**: each step's discrepancy before and after, and the baseline's
 //!    against the final model's, statistic by statistic.
 //!
@@ -110,6 +115,7 @@ pub mod report;
 pub mod score;
 pub mod simulate;
 pub mod step;
+pub mod stepwise;
 pub mod synth;
 
 pub use errors::DiagnoseError;

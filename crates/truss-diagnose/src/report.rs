@@ -1,6 +1,6 @@
 //! `diagnosis.json` and `diagnosis.md`.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 4)
+//! ## diagnosis.json (format `truss-diagnose`, version 5)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -13,18 +13,26 @@
 //! named_effect "none" or the first added effect's name
 //! named_effects [names]   every effect added, in order; [] when none
 //! steps       [{number, verdict, reason, named_effect ("none" when nothing was named),
-//!               kept (added to the model: significant, better by BIC, shrinking the
-//!               discrepancy, and kept by the false discovery rate over the steps),
+//!               kept (added to the model: significant, better by BIC, not spoiling a
+//!               model that agreed in distribution, and kept by the false discovery rate
+//!               over the steps; a later step may still remove or replace it),
 //!               parameters[] (the named effect's, as below), indistinguishable[],
 //!               adjusted_p (min(1, K·p) of the named one), log_likelihood_before,
 //!               candidates[] (as below, against the model of the step's start),
-//!               refitted[] (the effects added before, re-fitted with this one added:
-//!               candidate scores with Wald intervals),
-//!               discrepancy_before, discrepancy_after, seconds}]
+//!               refitted[] {name, parameters[]} (every effect of the model after this
+//!               step, this one last, re-fitted jointly: Wald intervals of the joint fit;
+//!               empty when the model has one effect),
+//!               removed_effects[] {name, added_in_step, lr_statistic, p_value, delta_bic,
+//!               explained_by?, separate_by} (earlier effects this step removed: given the
+//!               others they no longer improve the fit; `explained_by` took over what they
+//!               explained and is indistinguishable from them on these data),
+//!               discrepancy_before, discrepancy_after, discrepancy_noise_before,
+//!               discrepancy_noise_after (the energy distances' permutation noise), seconds}]
 //! effects     [{name, parameters [[name, unit, value]]}]   the final model's effects at
 //!              their final values (after the re-fits): what updated-job.json holds
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null}]
-//!              (the first added effect's, as fitted in its step)
+//!              (the first named effect's, as fitted in its step; for an effect swapped in,
+//!              the last joint re-fit's, Wald intervals)
 //!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
 //!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
 //!              indistinguishable from it, else "wald"; lower/upper null when not found;
@@ -43,7 +51,7 @@
 //! skipped     [{name, reason}]
 //! statistics  {before: Comparison (the baseline's), after: Comparison | null (the final
 //!              model's, with every added effect)}
-//!   Comparison {specimens, samples, energy, energy_p, tolerance {within, outside[], bands},
+//!   Comparison {specimens, samples, energy, energy_p, energy_noise, tolerance {within, outside[], bands},
 //!               statistics[] {id, kind, unit, measured, simulated, comparison, estimate
 //!               {value, lower, upper}, p_value, p_holm, disagrees, words}}
 //! discrepancy_before, discrepancy_after   (energy distance of the baseline and of the final
@@ -52,6 +60,10 @@
 //!             (in words)
 //! timing      {simulations, solves, seconds}
 //! ```
+//!
+//! Version 5 (from 4): stepwise selection: `steps[].refitted` is the joint re-fit
+//! ({name, parameters}), `steps[].removed_effects`, `named_effects` leaves removed effects
+//! out; `energy_noise` and the steps' `discrepancy_noise_*`.
 //!
 //! Version 4 (from 3): the forward selection: `named_effects`, `steps[]`, `effects`,
 //! `data.outliers`,
@@ -71,13 +83,14 @@ use crate::baseline::Baseline;
 use crate::compare::{Comparison, Statistic};
 use crate::diagnose::{CandidateScore, Diagnosis, FittedParameter, Verdict};
 use crate::measured::{DataReport, Measured};
-use crate::step::{ModelEffect, Step};
+use crate::step::{ModelEffect, RefitEffect, Step};
+use crate::stepwise::Removal;
 use serde::Serialize;
 
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -131,8 +144,8 @@ const METHOD: Method = Method {
     selection: "likelihood-ratio statistic Λ = 2(ℓ − ℓ₀)/(c·λ̄) against the baseline, c = 1 + n/N, λ̄ = max(1, tr(A⁻¹B)/k); p = P(χ²_k ≥ Λ), significant when p < 0.025/K (Bonferroni over the K candidates at α/2: the other half of α = 0.05 is the comparison's, so that data missing nothing get a verdict other than agreement at most 5 % of the time); ΔBIC = k·λ̄·ln n − 2(ℓ − ℓ₀)/c = λ̄·(k ln n − Λ) (n specimens), the BIC of a misspecified likelihood whose penalty counts the effective number of parameters tr(A⁻¹B) = k·λ̄ (Gao & Song 2010), so that candidates' likelihoods are compared unscaled. Named: the candidate with the lowest ΔBIC if it is significant and ΔBIC ≤ −2; indistinguishable: other candidates with ΔBIC within 2 of it, and significant candidates the named one does not fit significantly closer than by Vuong's test for non-nested models, z = Σ_u d_u/√(c·n·var d) < 1.96 with d_u the difference of the two maximised ℓ's terms for specimen u (its member observations included) (Vuong 1989): BIC then prefers the named one, but by its penalty or by a difference in ℓ within the specimens' own scatter, not by a fit the data show to be closer. Significant means better than the baseline, not present: when the baseline misses some effect, any candidate that mimics part of it improves on the baseline, and BIC chooses between them.",
     verdicts: "named: as above. cannot_tell: some candidate improves the fit but not both significantly and by ΔBIC ≤ −2, or none improves it and the data cannot show the baseline agrees within tolerance. none: no candidate improves it and the baseline agrees within tolerance (every coordinate's mean within ±0.5 predicted SD, its SD and θ_P's median and 95th percentile within a factor 1.3, judged by their 95 % intervals). unexplained: no candidate improves it, yet the baseline disagrees (a Holm-significant statistic, with at least 30 specimens; with fewer, cannot_tell).",
     statistics: "per coordinate, piston (mean top z), tan θ_x, tan θ_y: mean difference (Welch interval), SD ratio (interval on ln with kurtosis-corrected variance), covariances (fourth-moment variance); θ_P percentiles 50/90/95/99 (Hyndman–Fan definition 1) as ratios with Poisson-bootstrap intervals (B = 1000); KS on θ_P; energy distance with a permutation test (R = 199). The simulation carries the instrument's noise. Disagrees: Holm-adjusted p < 0.025 (half of α = 0.05; the candidates' tests have the other half). p-values under \"no difference\" use the simulated moments for both parts (the measured specimens are draws from the simulation under that hypothesis); the 95 % intervals are Welch's with Student's t.",
-    steps: "forward selection: step 1 tests every candidate against the baseline; a named effect is added at its fitted values and step 2 tests the remaining candidates against that model, and so on, until a step names nothing (no candidate significant at α/K and better by ΔBIC ≤ −2), or names an effect that does not shrink the discrepancy (the energy distance; then it is not added), or no candidate is left. Effects already added keep their own step's fit. The false discovery rate over the steps is held at α by ForwardStop (G'Sell et al. 2016) on the steps' Bonferroni-adjusted p-values min(1, K·p): the named effects kept are the first k̂, k̂ = max{k : −(1/k)·Σ_{s≤k} ln(1 − p_s) ≤ α}.",
-    discrepancy: "energy distance (unbiased U-statistic, Székely & Rizzo 2004) between the measured and simulated displacement vectors, each coordinate divided by its measured SD: 0 when the distributions agree.",
+    steps: "stepwise selection: step 1 tests every candidate against the baseline; a named effect is added at its fitted values, every effect of the model is re-fitted jointly (one trust-region Newton fit of all their parameters), each effect added in an earlier step is tested for removal given the others (Λ = 2(ℓ̂ − ℓ̂ without it)/(c·λ), removed, the least needed first, unless p < α/2 and ΔBIC ≤ −2), then tried swapped for a rival candidate of its own step (significant then and at least half its ΔBIC), the swap made when the swapped model's BIC is lower by 2 or more; then step 2 tests the remaining candidates against that model, and so on, until a step names nothing (no candidate significant at α/K and better by ΔBIC ≤ −2), or names an effect that, where the model before it agrees in distribution (energy test not significant at 0.025), makes the discrepancy grow beyond its noise (E_after − E_before > 1.96·√(s_before² + s_after²), s the energy distance's permutation RMS) or the energy test significant (then it is not added), or no candidate is left. A removed effect is listed as indistinguishable from the effect whose parameters moved furthest when it was removed. The false discovery rate over the steps is held at α by ForwardStop (G'Sell et al. 2016) on the steps' Bonferroni-adjusted p-values min(1, K·p): the named effects kept are the first k̂, k̂ = max{k : −(1/k)·Σ_{s≤k} ln(1 − p_s) ≤ α}, and removals only take effects out of the model.",
+    discrepancy: "energy distance (unbiased U-statistic, Székely & Rizzo 2004) between the measured and simulated displacement vectors, each coordinate divided by its measured SD: 0 when the distributions agree; its noise is the root mean square of the statistic over the R = 199 permutations.",
 };
 
 #[derive(Serialize)]
@@ -174,9 +187,12 @@ struct StepReport<'a> {
     adjusted_p: Option<f64>,
     log_likelihood_before: f64,
     candidates: &'a [CandidateScore],
-    refitted: &'a [CandidateScore],
+    refitted: &'a [RefitEffect],
+    removed_effects: &'a [Removal],
     discrepancy_before: f64,
+    discrepancy_noise_before: f64,
     discrepancy_after: f64,
+    discrepancy_noise_after: f64,
     seconds: f64,
 }
 
@@ -194,8 +210,14 @@ impl<'a> StepReport<'a> {
             log_likelihood_before: s.log_likelihood_before,
             candidates: &s.candidates,
             refitted: &s.refitted,
+            removed_effects: &s.removed,
             discrepancy_before: s.before.energy,
+            discrepancy_noise_before: s.before.energy_noise,
             discrepancy_after: s.after.as_ref().map_or(s.before.energy, |a| a.energy),
+            discrepancy_noise_after: s
+                .after
+                .as_ref()
+                .map_or(s.before.energy_noise, |a| a.energy_noise),
             seconds: s.seconds,
         }
     }
@@ -209,7 +231,11 @@ pub fn named_effect(d: &Diagnosis) -> &str {
 /// diagnosis.json.
 pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f64) -> String {
     let first = d.first_step();
-    let first_named = d.steps.iter().find(|s| s.kept).unwrap_or(first);
+    let first_named = d
+        .steps
+        .iter()
+        .find(|s| s.kept && s.named_effect() == Some(d.named_effect()))
+        .unwrap_or(first);
     let report = Report {
         format: FORMAT,
         format_version: FORMAT_VERSION,
@@ -227,12 +253,22 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
         reason: &d.reason,
         named_effect: d.named_effect(),
         named_effects: d.named_effects(),
-        parameters: if first_named.kept {
+        parameters: if first_named.kept && first_named.named_effect() == Some(d.named_effect()) {
             first_named.named_score().map_or(&[][..], |c| &c.parameters)
+        } else {
+            // Swapped in: the last joint re-fit's.
+            d.steps
+                .iter()
+                .filter(|s| s.kept)
+                .flat_map(|s| &s.refitted)
+                .rfind(|r| r.name == d.named_effect())
+                .map_or(&[][..], |r| &r.parameters)
+        },
+        indistinguishable: if first_named.named_effect() == Some(d.named_effect()) {
+            &first_named.indistinguishable
         } else {
             &[]
         },
-        indistinguishable: &first_named.indistinguishable,
         baseline: Baseline0 {
             log_likelihood: d.baseline_log_likelihood,
         },
@@ -515,8 +551,37 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
     );
     push(m, &format!("{}.\n", d.reason.trim_end_matches('.')));
     let span = spans(baseline);
-    for s in d.steps.iter().filter(|s| s.kept) {
-        let c = s.named_score().expect("a kept step names an effect");
+    for e in &d.effects {
+        let Some((s, c)) = d
+            .steps
+            .iter()
+            .filter(|s| s.kept)
+            .find_map(|s| s.named_score().filter(|c| c.name == e.name).map(|c| (s, c)))
+        else {
+            // Swapped in: its values and intervals are those of the last joint fit.
+            let fit = d
+                .steps
+                .iter()
+                .filter(|s| s.kept)
+                .flat_map(|s| &s.refitted)
+                .rfind(|r| r.name == e.name);
+            push(
+                m,
+                &format!("Fitted `{}` (swapped in; the last joint re-fit):\n", e.name),
+            );
+            for p in fit.map_or(&[][..], |f| &f.parameters) {
+                push(
+                    m,
+                    &format!(
+                        "- {}: {}",
+                        parameter_text(p),
+                        plain_reading(&e.name, p, span)
+                    ),
+                );
+            }
+            push(m, "");
+            continue;
+        };
         push(m, &format!("Fitted `{}` (step {}):\n", c.name, s.number));
         // The final value where a later step re-fitted it.
         let last = d
@@ -728,7 +793,7 @@ fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
     if !s.refitted.is_empty() {
         push(
             m,
-            "Effects added before, re-fitted with it (the others held; 95 % Wald intervals):\n",
+            "The model's effects re-fitted jointly (95 % Wald intervals of the joint fit):\n",
         );
         for c in &s.refitted {
             push(
@@ -736,16 +801,42 @@ fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
                 &format!(
                     "- `{}`: {}",
                     c.name,
-                    c.error.clone().unwrap_or_else(|| c
-                        .parameters
+                    c.parameters
                         .iter()
                         .map(parameter_text)
                         .collect::<Vec<_>>()
-                        .join("; "))
+                        .join("; ")
                 ),
             );
         }
         push(m, "");
+    }
+    for r in &s.removed {
+        if let Some(by) = &r.replaced_by {
+            push(
+                m,
+                &format!(
+                    "**Replaced: `{}`** (added in step {}) by `{by}`: with the other effects, re-fitted jointly, the model fits better with `{by}` in its place (ΔBIC = {:.1}; 2Δℓ/c = {:.1}). What would confirm it: {}.\n",
+                    r.name, r.added_in_step, r.delta_bic, r.lr_statistic, r.separate_by
+                ),
+            );
+            continue;
+        }
+        push(
+            m,
+            &format!(
+                "**Removed: `{}`** (added in step {}): given the other effects, re-fitted jointly, it no longer improves the fit (Λ = {:.1}, {}, ΔBIC = {:.1}).{}\n",
+                r.name,
+                r.added_in_step,
+                r.lr_statistic,
+                p_is(r.p_value.unwrap_or(1.0)),
+                r.delta_bic,
+                r.explained_by.as_ref().map_or(String::new(), |x| format!(
+                    " `{x}` took over what it explained: on these data the two are indistinguishable, and the answer names `{x}`. What would separate them: {}.",
+                    r.separate_by
+                ))
+            ),
+        );
     }
     let after = s.after.as_ref().map_or(s.before.energy, |a| a.energy);
     push(
@@ -911,13 +1002,21 @@ fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
             ));
         } else if !s.indistinguishable.is_empty() {
             advice.push(format!(
-                "Step {}: `{named}` cannot be told from {} with these data; a measurement that only one of them affects separates them (member lengths for length effects, temperatures for a thermal field, a test in another orientation for self-weight).",
+                "Step {}: `{named}` cannot be told from {} with these data; what would separate them: {}.",
                 s.number,
                 s.indistinguishable
                     .iter()
                     .map(|n| format!("`{n}`"))
                     .collect::<Vec<_>>()
-                    .join(", ")
+                    .join(", "),
+                s.indistinguishable
+                    .iter()
+                    .map(|n| format!(
+                        "from `{n}`, {}",
+                        crate::stepwise::separating_measurement(named, n)
+                    ))
+                    .collect::<Vec<_>>()
+                    .join("; ")
             ));
         }
     }

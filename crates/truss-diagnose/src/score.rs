@@ -225,7 +225,7 @@ fn objective<'a>(
 
 /// A candidate's projection of internal coordinates onto its feasible set, leaving the
 /// coordinate given (if any) where it is.
-fn projection(c: &dyn Candidate) -> impl Fn(&mut [f64], Option<usize>) + '_ {
+pub(crate) fn projection(c: &dyn Candidate) -> impl Fn(&mut [f64], Option<usize>) + '_ {
     let params = c.parameters();
     move |t: &mut [f64], fixed: Option<usize>| {
         let mut v: Vec<f64> = params
@@ -243,7 +243,7 @@ fn projection(c: &dyn Candidate) -> impl Fn(&mut [f64], Option<usize>) + '_ {
 }
 
 /// The score of a fit: the test against the baseline and the Wald intervals.
-fn score_of(c: &dyn Candidate, fit: &Fit, test: &Test) -> CandidateScore {
+pub(crate) fn score_of(c: &dyn Candidate, fit: &Fit, test: &Test) -> CandidateScore {
     let params = c.parameters();
     let k = params.len();
     let values = values_of(c, &fit.internal);
