@@ -58,7 +58,7 @@
 //! `descents_from_the_linearised_solution_end_in_different_equilibria`). The effect on the
 //! statistics is below what they resolve: the paper-3.4 report is identical to four
 //! significant digits whichever state those samples take (numerics 2 and 3 differ on three
-//! such samples), while θ_P95's 95 % interval is about ±2 %.
+//! such samples), while θ_P95's 95 % interval is about ±3 %.
 //!
 //! ## Allocation
 //!
