@@ -453,8 +453,12 @@ fn plain_reading(effect: &str, p: &FittedParameter, span: [f64; 3]) -> String {
             "the diagonals are on average {} shorter than nominal, pretensioning the frame",
             um(v.abs())
         ),
+        ("backlash", "spread") => format!(
+            "the joints' clearances scatter uniformly within ±{} of their mean (some joints tighter, some looser)",
+            um(v)
+        ),
         ("backlash", _) => format!(
-            "each pin joint has about {} of radial clearance (free play of its shaft in the hole)",
+            "each pin joint has on average about {} of radial clearance (free play of its shaft in the hole)",
             um(v)
         ),
         _ => String::new(),
