@@ -438,12 +438,15 @@ impl Candidate for DiagonalPretension {
 /// among joints (each joint of each specimen its own clearance, U\[mean − h, mean + h\], as
 /// the paper draws them). With the members measured one by one (per-specimen conditioning,
 /// [`crate::conditional`]) the scatter is resolved: on data made with the paper's
-/// U\[0.004, 0.017\] mm (mean 0.0105, h 0.0065), 200 specimens, seed 401, the fit gave mean
-/// 0.01053 \[0.01042, 0.01064\] and h 0.0057 \[0.0052, 0.0061\] mm (h's interval short of
-/// the truth, an open question: see `scripts/diagnose-check.sh`'s output) and named nothing
+/// U\[0.004, 0.017\] mm (mean 0.0105, h 0.0065), 200 specimens, the fit gave mean 0.01053
+/// \[0.01042, 0.01064\] and h 0.0057 \[0.0052, 0.0061\] mm at seed 401 (h's interval just
+/// short of the truth), 0.01058 \[0.01045, 0.01070\] and 0.0069 \[0.0063, 0.0076\] at 402,
+/// 0.01044 \[0.01032, 0.01055\] and 0.0062 \[0.0056, 0.0068\] at 403, and named nothing
 /// after it, where the one-clearance candidate left a scatter that the stepwise selection
 /// filled with self-weight and a length bias. On one clearance at every joint (0.0105 mm,
-/// seed 201) h came out 0.0016 \[0, 0.0037\] mm: not resolved, as it should be. Before
+/// seeds 201–203, N = 4000) h came out 0.0016 \[0, 0.0037\], 0 \[0, 0.0020\] and 0.0016
+/// \[0, 0.0034\] mm: not resolved, as it should be; with fewer simulated samples (N = 1200,
+/// seed 31) 0.0025 \[0.0008, 0.0040\]: resolved away from 0, a false spread. Before
 /// the conditioning (node positions alone) h came out 0 with an interval spanning its whole
 /// range in each of four data sets, and on the paper's data above (seed 401, no members)
 /// again 0 with the interval \[0, 0.0085\] mm, while the extra parameter's penalty let
