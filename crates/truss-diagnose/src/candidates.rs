@@ -8,7 +8,7 @@
 //! | `length_bias` | `bias.GROUP` \[mm\] in ±0.1 for each bar group | adds the bias to the group's length-error mean (a constant if it has none) |
 //! | `length_sigma` | `sigma.GROUP` \[mm\] from 1/5 to 5 times the stated σ, for each group with a stated spread | scales the group's spread about its mean to the new σ |
 //! | `diagonal_pretension` | `length_error` \[mm\] in \[−0.2, 0\] | adds a common length error to every cable group: diagonals made short, so pretensioned (lengthening them instead would make them slack, a different mechanism whose likelihood is not smooth at the null) |
-//! | `backlash` | `clearance` \[mm\] in \[0, 0.05\], the radial clearance of every pin joint (a scatter among joints is not resolved by node data; see [`Backlash`]) | pin joints with backlash at every node of a prism (`"backlash": true`: truss-core's virtual cable joints at their default stiffnesses) and the case's `backlash.clearance` the constant fitted; the members' draws are those of the baseline (common random numbers) |
+//! | `backlash` | `clearance` \[mm\] in \[0, 0.05\], the joints' mean radial clearance; `spread` \[mm\] in \[0, 0.05\] (held ≤ `clearance`), the half-width h of their uniform scatter among joints, the paper's U\[mean − h, mean + h\] (section 4.2.3) | pin joints with backlash at every node of a prism (`"backlash": true`: truss-core's virtual cable joints at their default stiffnesses) and the case's `backlash.clearance` the fitted distribution ([`clearance_distribution`]: a constant at h = 0); the members' and the joints' draws are those of the baseline (common random numbers: each joint's clearance is mean + h·(2u − 1), its u fixed) |
 //!
 //! Every candidate reduces to the baseline at its *null* parameters (zero, or the stated σ),
 //! so the baseline is nested in it and a likelihood-ratio test applies (for
@@ -96,6 +96,12 @@ pub type Library = (Vec<Box<dyn Candidate>>, Vec<(String, String)>);
 /// The candidates that apply to the baseline case, and the names of those that do not,
 /// with why.
 pub fn library(baseline: &Baseline) -> Library {
+    library_for(baseline, true)
+}
+
+/// [`library`], with `backlash`'s spread fitted only if `spread` (the diagnosis fits it with
+/// the members measured, [`Backlash`]; from node positions alone the clearance only).
+pub fn library_for(baseline: &Baseline, spread: bool) -> Library {
     let mut out: Vec<Box<dyn Candidate>> = Vec::new();
     let mut skipped = Vec::new();
     let case = baseline.case();
@@ -115,7 +121,7 @@ pub fn library(baseline: &Baseline) -> Library {
         }
     }
     match Backlash::applicable(baseline) {
-        Ok(()) => out.push(Box::new(Backlash::new())),
+        Ok(()) => out.push(Box::new(Backlash::new(spread))),
         Err(why) => skipped.push(("backlash".into(), why)),
     }
     if case.effects.gravity.is_some() {
@@ -428,21 +434,36 @@ impl Candidate for DiagonalPretension {
 
 /// Clearance at pin joints: the nodes of a prism become pin joints with backlash.
 ///
-/// One parameter, the clearance common to every joint. A scatter of the clearance among
-/// the joints is a second-order effect on node positions that 200 specimens do not resolve:
-/// fitted as a second parameter (the half-width of a uniform scatter) on data made with the
-/// paper's U\[0.004, 0.017\] mm, it came out 0 with an interval spanning its whole range
-/// \[0, 0.05\] mm in each of four data sets, and only cost the test a degree of freedom. So
-/// the fitted clearance stands for the joints' mean clearance.
+/// Two parameters: the joints' mean clearance and the half-width h of its uniform scatter
+/// among joints (each joint of each specimen its own clearance, U\[mean − h, mean + h\], as
+/// the paper draws them). With the members measured one by one (per-specimen conditioning,
+/// [`crate::conditional`]) the scatter is resolved: on data made with the paper's
+/// U\[0.004, 0.017\] mm (mean 0.0105, h 0.0065), 200 specimens, the fit gave mean 0.01053
+/// \[0.01042, 0.01064\] and h 0.0057 \[0.0052, 0.0061\] mm at seed 401 (h's interval just
+/// short of the truth), 0.01058 \[0.01045, 0.01070\] and 0.0069 \[0.0063, 0.0076\] at 402,
+/// 0.01044 \[0.01032, 0.01055\] and 0.0062 \[0.0056, 0.0068\] at 403, and named nothing
+/// after it, where the one-clearance candidate left a scatter that the stepwise selection
+/// filled with self-weight and a length bias. On one clearance at every joint (0.0105 mm,
+/// seeds 201–203, N = 4000) h came out 0.0016 \[0, 0.0037\], 0 \[0, 0.0020\] and 0.0016
+/// \[0, 0.0034\] mm: not resolved, as it should be; with fewer simulated samples (N = 1200,
+/// seed 31) 0.0025 \[0.0008, 0.0040\]: resolved away from 0, a false spread. Before
+/// the conditioning (node positions alone) h came out 0 with an interval spanning its whole
+/// range in each of four data sets, and on the paper's data above (seed 401, no members)
+/// again 0 with the interval \[0, 0.0085\] mm, while the extra parameter's penalty let
+/// `length_bias` win the BIC over backlash: so without members the candidate keeps the one
+/// parameter, the clearance, which then stands for the joints' mean ([`library_for`]).
+/// Where h's interval reaches 0 the report says the spread is not resolved by the data.
 pub struct Backlash {
     parameters: Vec<Parameter>,
 }
 
 impl Backlash {
-    fn new() -> Self {
-        Self {
-            parameters: vec![Parameter::linear("clearance", "mm", 0.0, 0.05, 0.0)],
+    fn new(spread: bool) -> Self {
+        let mut parameters = vec![Parameter::linear("clearance", "mm", 0.0, 0.05, 0.0)];
+        if spread {
+            parameters.push(Parameter::linear("spread", "mm", 0.0, 0.05, 0.0));
         }
+        Self { parameters }
     }
 
     /// Whether the baseline can take joint clearances: its model must be a prism the job
@@ -468,18 +489,30 @@ impl Candidate for Backlash {
         "backlash"
     }
     fn mechanism(&self) -> &'static str {
-        "clearance at the pin joints (every node a shaft in a hole with the same radial clearance)"
+        "clearance at the pin joints (every node a shaft in a hole; radial clearances uniform about their mean, U[mean − h, mean + h])"
     }
     fn parameters(&self) -> &[Parameter] {
         &self.parameters
     }
+    /// Keeps 0 ≤ h ≤ mean (no negative clearance): with h held (a profile over it) the
+    /// mean is raised to h, otherwise h is lowered to the mean.
+    fn project(&self, v: &mut [f64], fixed: Option<usize>) {
+        if v.len() > 1 && v[1] > v[0] {
+            match fixed {
+                Some(1) => v[0] = v[1],
+                _ => v[1] = v[0],
+            }
+        }
+    }
     /// At the null (no clearance) the case is left as it is; otherwise the prism gets pin
-    /// joints (truss-core's defaults) and the case the clearance as a constant.
+    /// joints (truss-core's defaults) and the case the clearances U\[mean − h, mean + h\]
+    /// (a constant at h = 0; h above the mean is held to it). A one-value `values` is h = 0.
     fn apply(&self, v: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError> {
         let clearance = v[0];
         if clearance <= 0.0 {
             return Ok(());
         }
+        let spread = v.get(1).copied().unwrap_or(0.0).min(clearance);
         let ModelSpec::Prism(prism) = &mut edit.model else {
             return Err(DiagnoseError::Usage(
                 "backlash: the case's model is not a prism the job generates".into(),
@@ -488,9 +521,25 @@ impl Candidate for Backlash {
         prism.backlash.get_or_insert_with(BacklashOptions::default);
         edit.model_edited = true;
         edit.case.backlash = Some(CaseBacklash {
-            clearance: DistributionSpec::Constant { value: clearance },
+            clearance: clearance_distribution(clearance, spread),
         });
         Ok(())
+    }
+}
+
+/// The joints' clearance distribution \[mm\] of mean `mean` and half-width `spread` (h):
+/// U\[mean − h, mean + h\], the paper's form (section 4.2.3: U\[0.004, 0.017\] mm), a
+/// constant when h = 0. The job's sampler draws a joint's clearance as low + (high − low)·u
+/// from the joint's own random word u, so c = mean + h·(2u − 1): with common random numbers
+/// every joint's clearance is linear in (mean, h), and the likelihood smooth in both.
+pub fn clearance_distribution(mean: f64, spread: f64) -> DistributionSpec {
+    if spread > 0.0 {
+        DistributionSpec::Uniform {
+            low: mean - spread,
+            high: mean + spread,
+        }
+    } else {
+        DistributionSpec::Constant { value: mean }
     }
 }
 
@@ -600,11 +649,11 @@ mod tests {
         assert!(skipped.iter().all(|(n, _)| n != "backlash"), "{skipped:?}");
         let c = candidates.iter().find(|c| c.name() == "backlash").unwrap();
         let mut null = baseline.derived_case();
-        c.apply(&[0.0], &mut null).unwrap();
+        c.apply(&[0.0, 0.0], &mut null).unwrap();
         assert!(!null.model_edited);
         assert_eq!(null.case, baseline.derived_case().case);
         let mut edit = baseline.derived_case();
-        c.apply(&[0.012], &mut edit).unwrap();
+        c.apply(&[0.012, 0.0], &mut edit).unwrap();
         let job = baseline.job_of(&edit, 10, None).unwrap();
         let case = &job.cases[0];
         let (rigid, pinned) = (baseline.model(), &case.model);
@@ -622,6 +671,68 @@ mod tests {
             assert_eq!(case.member_errors[i], baseline.case().member_errors[i]);
         }
         assert_eq!(job.seed, baseline.seed);
+    }
+
+    /// The spread h maps the joints' clearances to U\[mean − h, mean + h\] through the job's
+    /// own sampler: over 200 samples of the 5-stage prism's 30 joints (6000 draws) at mean
+    /// 0.0105 and h 0.0065 (the paper's U\[0.004, 0.017\]), every clearance lies in the
+    /// interval, their mean is 0.0105 within 4 standard errors (h/√3/√6000 = 4.8e-5 mm) and
+    /// their SD h/√3 within 5 %; each clearance is mean + h·(2u − 1) with the u the same at
+    /// every (mean, h) (common random numbers: the draws at h and at 1.5h differ from the mean
+    /// by exactly a factor 1.5); and at h = 0 the case is exactly the one-parameter candidate's.
+    #[test]
+    fn backlash_spread_draws_the_papers_uniform_clearances_with_common_random_numbers() {
+        let baseline = paper_job("rigid-sigma-0.033");
+        let (candidates, _) = library(&baseline);
+        let c = candidates.iter().find(|c| c.name() == "backlash").unwrap();
+        let draws = |mean: f64, h: f64| {
+            let mut edit = baseline.derived_case();
+            c.apply(&[mean, h], &mut edit).unwrap();
+            let job = baseline.job_of(&edit, 200, None).unwrap();
+            let case = &job.cases[0];
+            let key = truss_job::sampler::stream_key(job.seed, &case.name);
+            let (mut errors, mut clearances, mut all) = (Vec::new(), Vec::new(), Vec::new());
+            for k in 0..200 {
+                truss_job::sampler::draw_sample(&key, case, k, &mut errors, &mut clearances);
+                all.extend_from_slice(&clearances);
+            }
+            (case.backlash.unwrap().clearance, all)
+        };
+        let (mean, h) = (0.0105, 0.0065);
+        let (d, x) = draws(mean, h);
+        assert_eq!(
+            d,
+            DistributionSpec::Uniform {
+                low: mean - h,
+                high: mean + h
+            }
+        );
+        assert_eq!(x.len(), 200 * 30);
+        assert!(x.iter().all(|&c| mean - h <= c && c <= mean + h));
+        let n = x.len() as f64;
+        let m = x.iter().sum::<f64>() / n;
+        let sd = (x.iter().map(|c| (c - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt();
+        let se = h / 3f64.sqrt() / n.sqrt();
+        assert!((m - mean).abs() < 4.0 * se, "mean {m}");
+        assert!((sd / (h / 3f64.sqrt()) - 1.0).abs() < 0.05, "sd {sd}");
+        let (_, x2) = draws(mean, 1.5 * h);
+        for (a, b) in x.iter().zip(&x2) {
+            assert!(((b - mean) - 1.5 * (a - mean)).abs() < 1e-15, "{a} {b}");
+        }
+        let (d0, x0) = draws(mean, 0.0);
+        assert_eq!(d0, DistributionSpec::Constant { value: mean });
+        assert!(x0.iter().all(|&c| c == mean));
+        let (mut one, mut two) = (baseline.derived_case(), baseline.derived_case());
+        c.apply(&[mean], &mut one).unwrap();
+        c.apply(&[mean, 0.0], &mut two).unwrap();
+        assert_eq!(one.case, two.case);
+        // A spread beyond the mean would make clearances negative: held to the mean.
+        let mut v = [0.004, 0.006];
+        c.project(&mut v, None);
+        assert_eq!(v, [0.004, 0.004]);
+        let mut v = [0.004, 0.006];
+        c.project(&mut v, Some(1));
+        assert_eq!(v, [0.006, 0.006]);
     }
 
     /// A baseline whose model already has joints does not get the candidate, and says why.

@@ -19,7 +19,7 @@
 //! step, with the removals and swaps of the steps up to it.
 
 use crate::baseline::{Baseline, CaseEdit};
-use crate::candidates::library;
+use crate::candidates::library_for;
 use crate::compare::Comparison;
 use crate::errors::DiagnoseError;
 use crate::measured::Measured;
@@ -431,7 +431,7 @@ pub fn diagnose(
         baseline.case_name
     ));
     let mut models = vec![compare_model(&ctx, baseline.derived_case())?];
-    let (mut remaining, mut skipped) = library(baseline);
+    let (mut remaining, mut skipped) = library_for(baseline, measured.members.is_some());
     if let Some(only) = &settings.candidates {
         for name in only {
             if !remaining.iter().any(|c| c.name() == name)

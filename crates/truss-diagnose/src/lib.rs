@@ -82,7 +82,9 @@
 //!
 //! `backlash`, `gravity`, `thermal_gradient`, `length_bias`, `length_sigma`,
 //! `diagonal_pretension` (parameters and ranges in [`candidates`]). `backlash` turns the
-//! prism's nodes into truss-core's pin joints with a common clearance; on node positions
+//! prism's nodes into truss-core's pin joints whose clearances scatter uniformly among the
+//! joints about a fitted mean (its two parameters: the mean and the half-width, the spread
+//! resolved with the members measured; see [`candidates::Backlash`]); on node positions
 //! alone its main trace, the top surface lowered as the diagonals pull the joints across
 //! their clearance, is much what a length error or a uniform temperature change leaves. The
 //! members measured one by one (`--measured-members`) show whether the members themselves

@@ -61,6 +61,10 @@
 //! timing      {simulations, solves, seconds}
 //! ```
 //!
+//! Within version 5, the `backlash` candidate's `parameters` became `clearance` (the
+//! joints' mean clearance) and `spread` (the half-width of their uniform scatter; before:
+//! `clearance` only): the shape is unchanged, so the version stays.
+//!
 //! Version 5 (from 4): stepwise selection: `steps[].refitted` is the joint re-fit
 //! ({name, parameters}), `steps[].removed_effects`, `named_effects` leaves removed effects
 //! out; `energy_noise` and the steps' `discrepancy_noise_*`.
@@ -375,7 +379,16 @@ fn parameter_text(p: &FittedParameter) -> String {
             }
         )
     };
-    format!("{} = {} {}{iv}", p.name, g(p.value), p.unit)
+    // Backlash's spread (the half-width of the joints' clearances): where its interval
+    // reaches 0 the data cannot tell scattered clearances from equal ones.
+    let unresolved = if p.name == "spread"
+        && (i.lower.is_none_or(|l| l <= 0.0) || i.lower_at_range_end)
+    {
+        " — spread: not resolved by these data (its interval reaches 0: the joints may all have the same clearance, which the fitted `clearance` then stands for)"
+    } else {
+        ""
+    };
+    format!("{} = {} {}{iv}{unresolved}", p.name, g(p.value), p.unit)
 }
 
 /// The size of the model along x, y, z \[mm\], for the plain reading of gradients.
@@ -440,8 +453,12 @@ fn plain_reading(effect: &str, p: &FittedParameter, span: [f64; 3]) -> String {
             "the diagonals are on average {} shorter than nominal, pretensioning the frame",
             um(v.abs())
         ),
+        ("backlash", "spread") => format!(
+            "the joints' clearances scatter uniformly within ±{} of their mean (some joints tighter, some looser)",
+            um(v)
+        ),
         ("backlash", _) => format!(
-            "each pin joint has about {} of radial clearance (free play of its shaft in the hole)",
+            "each pin joint has on average about {} of radial clearance (free play of its shaft in the hole)",
             um(v)
         ),
         _ => String::new(),

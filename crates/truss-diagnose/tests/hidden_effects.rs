@@ -367,12 +367,15 @@ fn member_measurements_narrow_a_length_effect() {
 /// against the rigid case `rigid-sigma-0.033` of `jobs/paper-4.2.3.json` with backlash and
 /// its two rivals ([`RIVALS`]):
 /// - a common clearance of 0.0105 mm (the mean of the paper's U[0.004, 0.017]) hidden
-///   through the candidate: named, recovered within its interval, the gap at least halved;
+///   through the candidate: named, the clearance recovered within its interval, the gap at
+///   least halved. The spread is not checked here: at this test's N = 1200 it came out
+///   0.0025 [0.0008, 0.0040] mm on these equal clearances (resolved away from 0), while at
+///   the default N = 4000 (`scripts/diagnose-check.sh`, seeds 201–203, which fails a check
+///   whose spread is resolved on equal clearances) its interval reached 0 each time;
 /// - the paper's clearances themselves, made by the job's own backlash case
 ///   (`backlash-sigma-0.033`, not through the candidate): named and the gap at least
-///   halved. Their scatter among the joints is outside the one-parameter candidate, whose
-///   clearance then stands for an effective common one (`scripts/diagnose-check.sh` prints
-///   it against the mean).
+///   halved (`scripts/diagnose-check.sh` prints the fitted mean and spread against 0.0105
+///   and 0.0065 mm).
 ///
 /// The second is a check of power, not a certainty: with the earlier, centred joints, ten
 /// data sets (seeds 31–40, the default N = 4000) named backlash in 8. With free play (a
@@ -416,8 +419,9 @@ fn hidden_backlash_is_named_with_member_measurements() {
         .find(|c| c["name"] == "rigid-sigma-0.033")
         .unwrap();
     assert_eq!(case["model"]["prism"]["backlash"], true, "{case}");
+    let clearance = &case["backlash"]["clearance"];
     assert!(
-        case["backlash"]["clearance"]["constant"].is_object(),
+        clearance["constant"].is_object() || clearance["uniform"].is_object(),
         "{case}"
     );
 
