@@ -171,7 +171,15 @@ impl Normals {
 /// stages, σ = 0.0667 mm on battens and longerons.
 fn probe_sample(stages: usize, index: usize) -> (crate::Model, Vec<f64>) {
     let model = PrismOptions::with_stages(stages).model().unwrap();
-    let mut rng = Normals(34 + stages as u64);
+    let errors = nth_sample(&model, 34 + stages as u64, 0.0666666666666667, index);
+    (model, errors)
+}
+
+/// The length errors of sample `index` of the stream `seed` for `model`: σ·N(0, 1) on
+/// battens and longerons, none on diagonals, drawn in member order sample after sample (as
+/// the benchmark draws them).
+fn nth_sample(model: &crate::Model, seed: u64, sigma: f64, index: usize) -> Vec<f64> {
+    let mut rng = Normals(seed);
     let mut errors = vec![];
     for _ in 0..=index {
         errors = model
@@ -181,12 +189,12 @@ fn probe_sample(stages: usize, index: usize) -> (crate::Model, Vec<f64>) {
                 if m.group == "diagonal" {
                     0.0
                 } else {
-                    0.0666666666666667 * rng.normal()
+                    sigma * rng.normal()
                 }
             })
             .collect();
     }
-    (model, errors)
+    errors
 }
 
 /// The equilibrium is not always unique: sample 293 of the 10-stage path probe has two
@@ -387,22 +395,7 @@ fn energy_at(solver: &mut Solver, u: &[f64]) -> f64 {
 /// The length errors of sample `index` of the benchmark's stream (`benches/solve.rs`:
 /// seed 2024, σ = 0.0063 mm on battens and longerons) for `model`.
 fn bench_sample(model: &crate::Model, index: usize) -> Vec<f64> {
-    let mut rng = Normals(2024);
-    let mut errors = vec![];
-    for _ in 0..=index {
-        errors = model
-            .members()
-            .iter()
-            .map(|m| {
-                if m.group == "diagonal" {
-                    0.0
-                } else {
-                    0.0063 * rng.normal()
-                }
-            })
-            .collect();
-    }
-    errors
+    nth_sample(model, 2024, 0.0063, index)
 }
 
 /// Step 1 with a slack set too large for the capacitance matrix (pin joints in free play,
