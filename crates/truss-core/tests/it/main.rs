@@ -3,7 +3,6 @@
 
 mod backlash;
 mod common;
-mod dense_cholesky;
 mod hand_solutions;
 mod invariance;
 mod model_errors;
