@@ -209,13 +209,7 @@ impl Regression {
         }
         let chol = nalgebra::Cholesky::new(cov.clone())
             .ok_or_else(|| failed("the residual covariance is not positive definite".into()))?;
-        let log_det = 2.0
-            * chol
-                .l_dirty()
-                .diagonal()
-                .iter()
-                .map(|v| v.ln())
-                .sum::<f64>();
+        let log_det = crate::likelihood::log_det(&chol);
         Ok(Self {
             kept,
             e_mean,

@@ -90,6 +90,16 @@ impl DataSummary {
     }
 }
 
+/// ln det Σ from Σ's Cholesky factor L: 2·Σⱼ ln Lⱼⱼ.
+pub(crate) fn log_det(chol: &nalgebra::Cholesky<f64, nalgebra::Dyn>) -> f64 {
+    2.0 * chol
+        .l_dirty()
+        .diagonal()
+        .iter()
+        .map(|v| v.ln())
+        .sum::<f64>()
+}
+
 /// A case's Gaussian predictive distribution of one specimen.
 #[derive(Debug, Clone)]
 pub struct Gaussian {
@@ -114,13 +124,7 @@ impl Gaussian {
                 what: "the predictive covariance".into(),
                 message: "not positive definite".into(),
             })?;
-        let log_det = 2.0
-            * chol
-                .l_dirty()
-                .diagonal()
-                .iter()
-                .map(|v| v.ln())
-                .sum::<f64>();
+        let log_det = log_det(&chol);
         Ok(Self {
             mean,
             cov,
