@@ -28,6 +28,16 @@ fn merge(shards: &Path, out: &Path, extra: &[&str]) -> Output {
         .unwrap()
 }
 
+/// The merge succeeded (exit 0); else its stderr.
+fn assert_merged(o: &Output) {
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
 fn listing(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
@@ -44,21 +54,11 @@ fn same_job_reuses_the_directory_and_clears_its_own_plots() {
     job(1, &["a"]).write_split(shards.path(), 1);
     std::fs::write(out.path().join("notes.txt"), "mine").unwrap();
     let o = merge(shards.path(), out.path(), &[]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert_merged(&o);
     assert!(listing(out.path()).contains(&"theta_p-a.svg".to_string()));
     // Again without plots: the earlier plots do not stay beside the new report.
     let o = merge(shards.path(), out.path(), &["--no-plots"]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert_merged(&o);
     assert_eq!(listing(out.path()), ["notes.txt", "report.json"]);
 }
 
@@ -73,12 +73,7 @@ fn plot_like_files_without_a_report_are_left_alone() {
         std::fs::write(out.path().join(name), "not mc-merge's").unwrap();
     }
     let o = merge(shards.path(), out.path(), &[]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert_merged(&o);
     let files = listing(out.path());
     for name in ["theta_p-ecdf-before.svg", "qq-mine.png", "theta_p-a.svg"] {
         assert!(
@@ -128,12 +123,7 @@ fn plot_names_stay_unique_after_sanitising() {
     let out = tempfile::tempdir().unwrap();
     job(3, &["σ", "δ", "a/b", "a_b"]).write_split(shards.path(), 1);
     let o = merge(shards.path(), out.path(), &[]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    assert_merged(&o);
     let histograms: Vec<String> = listing(out.path())
         .into_iter()
         .filter(|f| f.starts_with("theta_p-") && f.ends_with(".svg"))
