@@ -8,7 +8,9 @@
 //! (factorise, triangular solves, evaluate, assemble) with the share of the solve that
 //! counts × kernel time accounts for. For comparison, a dense Cholesky of the same 5-stage
 //! tangent with faer. For 300 stages and for backlash, the histograms of the iteration and
-//! factorisation counts; the ratio of the backlash model's median to the rigid one's. Run with
+//! factorisation counts; the ratio of the backlash model's median to the rigid one's. Where
+//! the iterations come from: per count of soft directions of the linearised start (panels
+//! whose bracing is all slack), the samples, their mean iterations and median time. Run with
 //! `cargo bench -p truss-core`; `-- --quick` for fewer samples, `-- --only 5` (or `5b`, `30`,
 //! `300`) for one model alone (for a profiler), `-- --paths` for the probe of whether the
 //! converged state depends on the solver's path (see `path_independence`).
@@ -88,6 +90,7 @@ fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) -> f64 
         solver.solve(e).unwrap();
     }
     let (mut times, mut its, mut facts, mut evals) = (vec![], vec![], vec![], vec![]);
+    let mut soft = vec![];
     for e in &errors {
         let t = Instant::now();
         let r = black_box(solver.solve(black_box(e))).unwrap();
@@ -95,6 +98,7 @@ fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) -> f64 
         its.push(r.iterations as f64);
         facts.push(r.factorisations as f64);
         evals.push(r.evaluations as f64);
+        soft.push(r.soft_directions);
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     let (mi, mf, me) = (mean(&its), mean(&facts), mean(&evals));
@@ -173,6 +177,7 @@ fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) -> f64 
         100.0 * mf * (t_factor - t_copy) / median_time.0,
         100.0 * (mi + 1.0) * t_solve / median_time.0
     );
+    print_soft_directions(&soft, &its, &times);
     if histogram {
         for (what, counts) in [("iterations", &its), ("factorisations", &facts)] {
             let mut bins = std::collections::BTreeMap::new();
@@ -187,6 +192,40 @@ fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) -> f64 
         }
     }
     median_time.0
+}
+
+/// Where the iterations come from: the soft directions of each sample's linearised start
+/// (panels whose bracing is all slack, held by geometric stiffness the linearised problem
+/// lacks), and the mean iterations and median time of the samples with each count. Models
+/// whose start is not solved by the capacitance matrix report none.
+fn print_soft_directions(soft: &[u32], its: &[f64], times: &[f64]) {
+    if soft.iter().all(|&s| s == 0) {
+        println!("      soft directions of the linearised start: none counted");
+        return;
+    }
+    let mut groups: std::collections::BTreeMap<u32, (Vec<f64>, Vec<f64>)> = Default::default();
+    for ((&s, &i), &t) in soft.iter().zip(its).zip(times) {
+        let g = groups.entry(s).or_default();
+        g.0.push(i);
+        g.1.push(t);
+    }
+    let mean = soft.iter().map(|&s| s as f64).sum::<f64>() / soft.len() as f64;
+    let bars: Vec<String> = groups
+        .iter_mut()
+        .map(|(s, (i, t))| {
+            t.sort_by(f64::total_cmp);
+            format!(
+                "{s}: {} samples, {:.2} it, {:.2} µs",
+                i.len(),
+                i.iter().sum::<f64>() / i.len() as f64,
+                percentile(t, 0.5)
+            )
+        })
+        .collect();
+    println!(
+        "      soft directions of the linearised start (panels with all bracing slack): mean {mean:.2}; by count (samples, mean iterations, median time): {}",
+        bars.join("; ")
+    );
 }
 
 /// A dense Cholesky (faer) of a 45 × 45 matrix the shape of the 5-stage tangent, for

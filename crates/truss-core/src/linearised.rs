@@ -233,9 +233,14 @@ impl ActiveSet {
             .map_err(|_| ActiveSetFailure::NotPositiveDefinite)
     }
 
-    /// Whether the factorised slack set leaves a soft direction (see [`SOFT_PIVOT_RATIO`]).
-    pub fn is_soft(&self) -> bool {
-        !self.slack.is_empty() && self.capacitance.min_pivot_ratio() < SOFT_PIVOT_RATIO
+    /// The number of soft directions the factorised slack set leaves: one per panel whose
+    /// bracing is all slack (its capacitance pivots below [`SOFT_PIVOT_RATIO`]).
+    pub fn soft_directions(&self) -> usize {
+        if self.slack.is_empty() {
+            0
+        } else {
+            self.capacitance.soft_rows(SOFT_PIVOT_RATIO)
+        }
     }
 
     /// Sets the slack set to the cables (by position) whose `e` is negative; returns whether

@@ -81,6 +81,8 @@ pub(super) struct Progress {
     stalled: u32,
     /// The lowest out-of-balance force so far \[N\].
     lowest: f64,
+    /// Soft directions of the linearised start (see [`SolveReport::soft_directions`]).
+    soft_directions: u32,
 }
 
 /// How the step of one iteration was chosen.
@@ -152,6 +154,7 @@ impl Solver {
             slack_cables: self.slack_cable_count(),
             evaluations: self.evaluations,
             loose_joints: self.loose_joint_count(),
+            soft_directions: p.soft_directions,
         })
     }
 
@@ -160,9 +163,11 @@ impl Solver {
         let structure = Arc::clone(&self.structure);
         let mut factorisations = 0;
         let mut iterations = 0;
+        let mut soft_directions = 0;
         let mode = match self.linearised(&structure, &mut factorisations) {
-            Ok(mode) => {
+            Ok((mode, soft)) => {
                 iterations += 1;
+                soft_directions = soft;
                 mode
             }
             Err(_) => {
@@ -191,6 +196,7 @@ impl Solver {
             poor: false,
             stalled: 0,
             lowest: f64::INFINITY,
+            soft_directions,
         }
     }
 
@@ -414,14 +420,15 @@ impl Solver {
 
     /// Step 1: solves the linearised problem into `self.work.u`, and says how to go on: chord
     /// steps with the active set's Woodbury inverse when the model has a cable basis and
-    /// the final slack set leaves no soft direction, model steps otherwise. A piece with a
+    /// the final slack set leaves no soft direction, model steps otherwise; and how many
+    /// soft directions it leaves (0 when not solved by the capacitance matrix). A piece with a
     /// slack set too large for the capacitance matrix (see the `linearised` module) hands
     /// the iteration to [`Solver::linearised_banded`].
     fn linearised(
         &mut self,
         structure: &Structure,
         factorisations: &mut u32,
-    ) -> Result<Mode, ActiveSetFailure> {
+    ) -> Result<(Mode, u32), ActiveSetFailure> {
         for (st, m) in self.work.stretch.iter_mut().zip(&self.sample.members) {
             *st = m.initial_stretch;
         }
@@ -434,18 +441,20 @@ impl Solver {
                     &self.sample.loads,
                     &mut self.work.u,
                 ) {
-                    Ok(_) if self.factor.active.is_soft() => Ok(Mode::Tangent),
-                    Ok(_) => Ok(Mode::Chord),
+                    Ok(_) => {
+                        let soft = self.factor.active.soft_directions() as u32;
+                        Ok((if soft > 0 { Mode::Tangent } else { Mode::Chord }, soft))
+                    }
                     Err(ActiveSetFailure::LargeSlackSet) => {
                         self.linearised_banded(structure, factorisations)?;
-                        Ok(Mode::Tangent)
+                        Ok((Mode::Tangent, 0))
                     }
                     Err(e) => Err(e),
                 }
             }
             None => {
                 self.linearised_banded(structure, factorisations)?;
-                Ok(Mode::Tangent)
+                Ok((Mode::Tangent, 0))
             }
         }
     }

@@ -148,3 +148,63 @@ fn model_file_round_trips() {
     assert_eq!(back, model);
     assert_eq!(back.to_file().to_json(), text);
 }
+
+/// The solve report's `soft_directions` counts the panels whose two diagonals are both
+/// slack, each held only by their compression stiffness. By hand: Table 1's diagonals are
+/// 1.15 µm short, so with no other error every diagonal is taut (none); both diagonals of a
+/// panel 10 µm too long are slack whatever the panel's shear (one per such panel, in one
+/// stage or in two). And in each case, the count is the number of panels whose diagonals
+/// both end slack (one diagonal 10 µm too long leaves its partner slack too: a panel braced
+/// by one diagonal cannot hold the pretension the pair held).
+#[test]
+fn soft_directions_count_the_panels_whose_bracing_is_all_slack() {
+    let model = PrismOptions::with_stages(5).model().unwrap();
+    let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
+    let long = |diagonals: &[&str]| {
+        let mut errors = vec![0.0; model.members().len()];
+        for id in diagonals {
+            errors[model.member_index(id).unwrap()] = 0.01;
+        }
+        errors
+    };
+    let cases: [(&[&str], Option<u32>); 5] = [
+        (&[], Some(0)),
+        (&["diagonal.2.1.a"], None),
+        (&["diagonal.2.1.a", "diagonal.2.1.b"], Some(1)),
+        (
+            &[
+                "diagonal.2.1.a",
+                "diagonal.2.1.b",
+                "diagonal.4.0.a",
+                "diagonal.4.0.b",
+            ],
+            Some(2),
+        ),
+        (
+            &[
+                "diagonal.3.0.a",
+                "diagonal.3.0.b",
+                "diagonal.3.2.a",
+                "diagonal.3.2.b",
+            ],
+            Some(2),
+        ),
+    ];
+    for (diagonals, by_hand) in cases {
+        let report = solver.solve(&long(diagonals)).unwrap();
+        let slack = solver.equilibrium().unwrap().slack;
+        let id = |m: usize| model.members()[m].id.as_str();
+        let slack_panels = slack
+            .iter()
+            .filter(|&&m| id(m).ends_with(".a"))
+            .filter(|&&m| {
+                let partner = id(m).replace(".a", ".b");
+                slack.iter().any(|&k| id(k) == partner)
+            })
+            .count() as u32;
+        assert_eq!(report.soft_directions, slack_panels, "{diagonals:?}");
+        if let Some(soft) = by_hand {
+            assert_eq!(report.soft_directions, soft, "{diagonals:?}");
+        }
+    }
+}
