@@ -1,4 +1,7 @@
-//! `diagnosis.json` and `diagnosis.md`.
+//! `diagnosis.json` and `diagnosis.md`, the diagnosis's two reports. This module holds the
+//! JSON document (its schema below, the types it serialises and [`json`]) and the method
+//! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
+//! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
 //! ## diagnosis.json (format `truss-diagnose`, version 5)
 //!
