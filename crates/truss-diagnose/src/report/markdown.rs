@@ -1,0 +1,345 @@
+//! `diagnosis.md`: the diagnosis for people, section by section: the verdict and the
+//! fitted values, the data read, where the baseline disagrees with the measurements, each
+//! step of the selection, the updated job, the baseline against the final model, what to
+//! measure or do next, the plots and the method.
+
+use super::METHOD;
+use super::wording::{g, parameter_text, plain_reading, spans};
+use crate::baseline::Baseline;
+use crate::diagnose::{Diagnosis, FittedParameter, Verdict};
+use crate::measured::Measured;
+use discrepancy::{before_after_section, disagreement_section, step_section};
+
+mod discrepancy;
+
+/// diagnosis.md.
+pub fn markdown(
+    baseline: &Baseline,
+    measured: &Measured,
+    d: &Diagnosis,
+    plots: &[String],
+) -> String {
+    let mut m = String::new();
+    verdict_section(&mut m, baseline, d);
+    data_section(&mut m, baseline, measured, d);
+    disagreement_section(&mut m, d);
+    for s in &d.steps {
+        step_section(&mut m, baseline, s);
+    }
+    for (n, why) in &d.skipped {
+        push(&mut m, &format!("- `{n}` not tried: {why}."));
+    }
+    if !d.skipped.is_empty() {
+        push(&mut m, "");
+    }
+    updated_job_section(&mut m, baseline, d);
+    before_after_section(&mut m, d);
+    next_step_section(&mut m, measured, d);
+    method_section(&mut m, d, plots);
+    m
+}
+
+/// Appends `s` and a newline.
+fn push(m: &mut String, s: &str) {
+    m.push_str(s);
+    m.push('\n');
+}
+
+/// The title, the verdict and the fitted values.
+fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
+    push(
+        m,
+        &format!(
+            "# Diagnosis of case `{}` against the measurements\n",
+            baseline.case_name
+        ),
+    );
+    let named = d.named_effects();
+    push(
+        m,
+        &format!(
+            "**Verdict: {}** — {}.\n",
+            d.verdict.words(),
+            if named.is_empty() {
+                "no effect added".to_string()
+            } else {
+                format!(
+                    "effects added, in order: {}",
+                    named
+                        .iter()
+                        .map(|n| format!("`{n}`"))
+                        .collect::<Vec<_>>()
+                        .join(", then ")
+                )
+            }
+        ),
+    );
+    push(m, &format!("{}.\n", d.reason.trim_end_matches('.')));
+    let span = spans(baseline);
+    for e in &d.effects {
+        let Some((s, c)) = d
+            .steps
+            .iter()
+            .filter(|s| s.kept)
+            .find_map(|s| s.named_score().filter(|c| c.name == e.name).map(|c| (s, c)))
+        else {
+            // Swapped in: its values and intervals are those of the last joint fit.
+            let fit = d
+                .steps
+                .iter()
+                .filter(|s| s.kept)
+                .flat_map(|s| &s.refitted)
+                .rfind(|r| r.name == e.name);
+            push(
+                m,
+                &format!("Fitted `{}` (swapped in; the last joint re-fit):\n", e.name),
+            );
+            for p in fit.map_or(&[][..], |f| &f.parameters) {
+                push(
+                    m,
+                    &format!(
+                        "- {}: {}",
+                        parameter_text(p),
+                        plain_reading(&e.name, p, span)
+                    ),
+                );
+            }
+            push(m, "");
+            continue;
+        };
+        push(m, &format!("Fitted `{}` (step {}):\n", c.name, s.number));
+        // The final value where a later step re-fitted it.
+        let last = d
+            .effects
+            .iter()
+            .find(|e| e.name == c.name)
+            .map(|e| &e.parameters);
+        for p in &c.parameters {
+            let now = last
+                .and_then(|ps| ps.iter().find(|q| q.0 == p.name))
+                .map(|q| q.2)
+                .filter(|&v| v != p.value);
+            let reading = FittedParameter {
+                value: now.unwrap_or(p.value),
+                ..p.clone()
+            };
+            push(
+                m,
+                &format!(
+                    "- {}{}: {}",
+                    parameter_text(p),
+                    now.map_or(String::new(), |v| format!(
+                        "; {} {} after the later steps' re-fit",
+                        g(v),
+                        p.unit
+                    )),
+                    plain_reading(&c.name, &reading, span)
+                ),
+            );
+        }
+        push(m, "");
+    }
+}
+
+/// `## Data`: what was read, and what was not used.
+fn data_section(m: &mut String, baseline: &Baseline, measured: &Measured, d: &Diagnosis) {
+    let r = &measured.report;
+    push(m, "## Data\n");
+    push(
+        m,
+        &format!(
+            "{} rows from `{}`: {} specimens, {} used, {} left out for a missing node{}. Nodes compared: {}. Job `{}` (id {}), seed {}, N = {} simulated samples per evaluation.\n",
+            r.rows,
+            r.file,
+            r.specimens_in_file,
+            r.specimens_used,
+            r.left_out_count,
+            if r.left_out.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    " (first: {})",
+                    r.left_out
+                        .iter()
+                        .take(5)
+                        .map(|(s, n)| format!("{s} lacks {}", n.join(" ")))
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                )
+            },
+            r.nodes.join(", "),
+            baseline.path.display(),
+            &baseline.job.id[..12],
+            baseline.seed,
+            d.samples
+        ),
+    );
+    if !r.outliers.is_empty() {
+        push(
+            m,
+            &format!(
+                "Outliers left out ({}): {}.\n",
+                r.outliers.len(),
+                r.outliers
+                    .iter()
+                    .map(|o| o.words())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        );
+    }
+    if !r.unknown_nodes.is_empty() || !r.rare_nodes.is_empty() {
+        push(
+            m,
+            &format!(
+                "Ignored: unknown nodes [{}], nodes measured by fewer than half of the specimens [{}].\n",
+                r.unknown_nodes.join(", "),
+                r.rare_nodes.join(", ")
+            ),
+        );
+    }
+    if let Some(rows) = r.member_rows {
+        push(
+            m,
+            &format!(
+                "Member measurements: {rows} used, each specimen's own in its likelihood{}.\n",
+                if r.unknown_members.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; unknown members ignored: {}",
+                        r.unknown_members.join(", ")
+                    )
+                }
+            ),
+        );
+    }
+}
+
+/// `## The updated job`.
+fn updated_job_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
+    push(m, "## The updated job\n");
+    let named = d.named_effects();
+    push(
+        m,
+        &if named.is_empty() {
+            "No effect was added: `updated-job.json` is the baseline job.\n".into()
+        } else {
+            format!(
+                "`updated-job.json` is the baseline job with {} added to case `{}` at the fitted values; run it with mc-shard and mc-merge like any other job.\n",
+                named
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(" and "),
+                baseline.case_name
+            )
+        },
+    );
+}
+
+/// `## Next step`: what to measure or do next.
+fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
+    push(m, "## Next step\n");
+    let mut advice = Vec::new();
+    let joint_like = ["length_bias", "diagonal_pretension"];
+    for s in &d.steps {
+        let Some(named) = s.named_effect() else {
+            continue;
+        };
+        let mixes_backlash = (named == "backlash"
+            && s.indistinguishable
+                .iter()
+                .any(|o| joint_like.contains(&o.as_str())))
+            || (joint_like.contains(&named) && s.indistinguishable.iter().any(|o| o == "backlash"));
+        if mixes_backlash && measured.members.is_none() {
+            advice.push(format!(
+                "Step {}: `{named}` and {} fit the node positions equally well: joint free play shortens the truss much as a member-length error does. Measure the member lengths one by one (longerons and diagonals, to a few µm) and run again with `--measured-members`: then they separate.",
+                s.number,
+                s.indistinguishable
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        } else if !s.indistinguishable.is_empty() {
+            advice.push(format!(
+                "Step {}: `{named}` cannot be told from {} with these data; what would separate them: {}.",
+                s.number,
+                s.indistinguishable
+                    .iter()
+                    .map(|n| format!("`{n}`"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                s.indistinguishable
+                    .iter()
+                    .map(|n| format!(
+                        "from `{n}`, {}",
+                        crate::stepwise::separating_measurement(named, n)
+                    ))
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ));
+        }
+    }
+    match d.verdict {
+        Verdict::Named => advice.push(
+            "Run `updated-job.json` with mc-shard and mc-merge for the precision budget with the effects added.".into(),
+        ),
+        Verdict::None => advice.push(
+            "None needed: the baseline job's prediction stands for these trusses.".into(),
+        ),
+        Verdict::CannotTell => advice.push(format!(
+            "Measure more specimens: with {} the data cannot decide; about four times as many halve the intervals.",
+            measured.n()
+        )),
+        Verdict::Unexplained => advice.push(
+            "Look for a mechanism outside the candidates (a support that moves, a member bent or damaged, the instrument's own error): measure the supports and the instrument against a reference.".into(),
+        ),
+    }
+    if !measured.report.outliers.is_empty() {
+        advice.push("Check the outlier rows listed under Data against the instrument's records; they were left out.".into());
+    }
+    for a in advice {
+        push(m, &format!("- {a}"));
+    }
+    push(m, "");
+}
+
+/// The plots and `## Method`: how every number was found.
+fn method_section(m: &mut String, d: &Diagnosis, plots: &[String]) {
+    if !plots.is_empty() {
+        push(m, "Plots:\n");
+        for p in plots {
+            push(m, &format!("- ![{p}]({p})"));
+        }
+        push(m, "");
+    }
+    push(m, "## Method\n");
+    for (k, v) in [
+        ("Likelihood", METHOD.likelihood),
+        ("Fit", METHOD.fit),
+        ("Intervals", METHOD.intervals),
+        ("Selection", METHOD.selection),
+        ("Steps", METHOD.steps),
+        ("Verdicts", METHOD.verdicts),
+        ("Statistics", METHOD.statistics),
+        ("Discrepancy", METHOD.discrepancy),
+    ] {
+        push(m, &format!("- **{k}.** {v}"));
+    }
+    push(
+        m,
+        &format!(
+            "\n{} simulations ({} solves) in {:.1} s; per step: {}.",
+            d.work.0,
+            d.work.1,
+            d.work.2,
+            d.steps
+                .iter()
+                .map(|s| format!("{} {:.1} s", s.number, s.seconds))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    );
+}
