@@ -4,7 +4,7 @@
 //! measure or do next, the plots and the method.
 
 use super::METHOD;
-use super::wording::{g, parameter_text, plain_reading, spans};
+use super::wording::{code_list, g, parameter_text, plain_reading, spans};
 use crate::baseline::Baseline;
 use crate::diagnose::{Diagnosis, FittedParameter, Verdict};
 use crate::measured::Measured;
@@ -63,14 +63,7 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
             if named.is_empty() {
                 "no effect added".to_string()
             } else {
-                format!(
-                    "effects added, in order: {}",
-                    named
-                        .iter()
-                        .map(|n| format!("`{n}`"))
-                        .collect::<Vec<_>>()
-                        .join(", then ")
-                )
+                format!("effects added, in order: {}", code_list(&named, ", then "))
             }
         ),
     );
@@ -227,11 +220,7 @@ fn updated_job_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
         } else {
             format!(
                 "`updated-job.json` is the baseline job with {} added to case `{}` at the fitted values; run it with mc-shard and mc-merge like any other job.\n",
-                named
-                    .iter()
-                    .map(|n| format!("`{n}`"))
-                    .collect::<Vec<_>>()
-                    .join(" and "),
+                code_list(&named, " and "),
                 baseline.case_name
             )
         },
@@ -256,21 +245,13 @@ fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
             advice.push(format!(
                 "Step {}: `{named}` and {} fit the node positions equally well: joint free play shortens the truss much as a member-length error does. Measure the member lengths one by one (longerons and diagonals, to a few µm) and run again with `--measured-members`: then they separate.",
                 s.number,
-                s.indistinguishable
-                    .iter()
-                    .map(|n| format!("`{n}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                code_list(&s.indistinguishable, ", ")
             ));
         } else if !s.indistinguishable.is_empty() {
             advice.push(format!(
                 "Step {}: `{named}` cannot be told from {} with these data; what would separate them: {}.",
                 s.number,
-                s.indistinguishable
-                    .iter()
-                    .map(|n| format!("`{n}`"))
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                code_list(&s.indistinguishable, ", "),
                 s.indistinguishable
                     .iter()
                     .map(|n| format!(

@@ -168,3 +168,12 @@ pub(super) fn plain_reading(effect: &str, p: &FittedParameter, span: [f64; 3]) -
         _ => String::new(),
     }
 }
+
+/// Names in code spans, joined by `separator`: `` `a`, `b` ``.
+pub(super) fn code_list(names: &[impl std::fmt::Display], separator: &str) -> String {
+    names
+        .iter()
+        .map(|n| format!("`{n}`"))
+        .collect::<Vec<_>>()
+        .join(separator)
+}
