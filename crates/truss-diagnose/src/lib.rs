@@ -257,12 +257,7 @@ fn warn_left_out(r: &measured::DataReport) {
         warn(format!(
             "{} specimens left out for a missing node (first: {})",
             r.left_out_count,
-            r.left_out
-                .iter()
-                .take(5)
-                .map(|(s, n)| format!("{s} lacks {}", n.join(" ")))
-                .collect::<Vec<_>>()
-                .join("; ")
+            r.first_left_out()
         ));
     }
     if !r.unknown_nodes.is_empty() {

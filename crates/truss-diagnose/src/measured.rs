@@ -132,6 +132,18 @@ pub struct DataReport {
     pub unknown_members: Vec<String>,
 }
 
+impl DataReport {
+    /// The first five specimens left out for a missing node, in words: `s1 lacks n1 n2; …`.
+    pub fn first_left_out(&self) -> String {
+        self.left_out
+            .iter()
+            .take(5)
+            .map(|(s, n)| format!("{s} lacks {}", n.join(" ")))
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}
+
 /// Measured member length errors.
 #[derive(Debug, Clone, Default)]
 pub struct MemberData {

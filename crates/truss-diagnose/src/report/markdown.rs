@@ -150,15 +150,7 @@ fn data_section(m: &mut String, baseline: &Baseline, measured: &Measured, d: &Di
             if r.left_out.is_empty() {
                 String::new()
             } else {
-                format!(
-                    " (first: {})",
-                    r.left_out
-                        .iter()
-                        .take(5)
-                        .map(|(s, n)| format!("{s} lacks {}", n.join(" ")))
-                        .collect::<Vec<_>>()
-                        .join("; ")
-                )
+                format!(" (first: {})", r.first_left_out())
             },
             r.nodes.join(", "),
             baseline.path.display(),
