@@ -13,10 +13,15 @@
 //! samples, the true effect tried against one or two others); the `#[ignore]`d ones (run in
 //! release by scripts/test.sh) try every candidate on 80–200 specimens with N = 1200, and
 //! the null-data false-positive rate over 20 seeds at 100 specimens (at 30:
-//! `ONLY=null-fpr scripts/diagnose-check.sh`).
+//! `ONLY=null-fpr scripts/diagnose-check.sh`), and (in `hidden_effects/stepwise.rs`) two
+//! pairs of effects in which the stepwise selection must swap out or remove an effect it
+//! named first.
 //! `scripts/diagnose-check.sh` runs the full checks of the stepwise selection (null over ten
 //! seeds, each effect over five, five pairs over three seeds, backlash with and without
 //! members; 200 specimens, default N) with the release build; too slow for CI.
+
+#[path = "hidden_effects/stepwise.rs"]
+mod stepwise;
 
 use std::path::{Path, PathBuf};
 use truss_diagnose::diagnose::Settings;
