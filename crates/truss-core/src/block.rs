@@ -168,64 +168,48 @@ impl BlockBandMatrix {
             let a = &row[q];
             *d = [a[0][0], a[1][1], a[2][2]];
         }
-        for i in 0..self.nb {
-            let j0 = i.saturating_sub(q);
-            // Rows before i (already factorised) and row i, whose blocks (i, j0 ..= i) sit at
-            // `row[q − (i − j0) ..= q]`.
+        // Two block rows at a time where there are two: row i + 1's blocks left of column
+        // i need only the rows above i, so the two rows' chains of dependent block products
+        // interleave. Each block is the same expression, in the same order, as one row at a
+        // time: the same bits.
+        let mut i = 0;
+        while i < self.nb {
+            let pair = i + 1 < self.nb;
             let (done, from_i) = self.a.split_at_mut(i * w);
-            let row = &mut from_i[..w];
-            let first = q - (i - j0);
-            let earlier = done[j0 * w..].chunks_exact(w).zip(&self.inv_diag[j0..i]);
-            for (n, (row_j, inv)) in earlier.enumerate() {
-                // Blocks (i, j0 .. j) of row i and (j, j0 .. j) of row j, j = j0 + n.
-                let (left, at) = row.split_at_mut(first + n);
-                let mut s = at[0];
-                for (x, y) in left[first..].iter().zip(&row_j[q - n..q]) {
-                    sub_mul_t(&mut s, x, y);
+            let (row, below) = from_i.split_at_mut(w);
+            let mut next = if pair { Some(&mut below[..w]) } else { None };
+            let j0 = i.saturating_sub(q);
+            let j1 = (i + 1).saturating_sub(q);
+            for (n, (row_j, inv)) in done[j0 * w..]
+                .chunks_exact(w)
+                .zip(&self.inv_diag[j0..i])
+                .enumerate()
+            {
+                let j = j0 + n;
+                off_diagonal(row, q - (i - j0), n, row_j, inv, q);
+                if let Some(next) = next.as_deref_mut()
+                    && j >= j1
+                {
+                    off_diagonal(next, q - (i + 1 - j1), j - j1, row_j, inv, q);
                 }
-                let ljj = &row_j[q];
-                // Row by row: x·L_JJᵀ = s, i.e. L_JJ·xᵀ = sᵀ.
-                for r in &mut s {
-                    let x0 = r[0] * inv[0];
-                    let x1 = (r[1] - ljj[1][0] * x0) * inv[1];
-                    let x2 = (r[2] - ljj[2][0] * x0 - ljj[2][1] * x1) * inv[2];
-                    *r = [x0, x1, x2];
-                }
-                at[0] = s;
             }
-            let (left, at) = row.split_at_mut(q);
-            let mut s = at[0];
-            for l in &left[first..] {
-                sub_mul_t_lower(&mut s, l);
-            }
-            // 3×3 Cholesky of the lower triangle of s; a failed pivot is recorded and
-            // replaced by the row's diagonal.
-            let diag = self.diag[i];
-            let mut pivot = |k: usize, p: f64| -> f64 {
-                if p > PIVOT_TOLERANCE * diag[k] {
-                    p
-                } else {
-                    failures.push(PivotFailure {
-                        index: 3 * i + k,
-                        pivot: p,
-                    });
-                    diag[k].abs().max(f64::MIN_POSITIVE)
-                }
-            };
-            let mut l = ZERO;
-            l[0][0] = pivot(0, s[0][0]).sqrt();
-            let i0 = 1.0 / l[0][0];
-            l[1][0] = s[1][0] * i0;
-            l[2][0] = s[2][0] * i0;
-            l[1][1] = pivot(1, s[1][1] - l[1][0] * l[1][0]).sqrt();
-            let i1 = 1.0 / l[1][1];
-            l[2][1] = (s[2][1] - l[2][0] * l[1][0]) * i1;
-            l[2][2] = pivot(2, s[2][2] - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
-            at[0] = l;
-            self.inv_diag[i] = [i0, i1, 1.0 / l[2][2]];
-            if failures.len() >= max {
+            let (stop, inv) = diagonal(row, q - (i - j0), i, self.diag[i], failures, max);
+            self.inv_diag[i] = inv;
+            if stop {
                 return;
             }
+            if let Some(next) = next {
+                let first = q - (i + 1 - j1);
+                if i >= j1 {
+                    off_diagonal(next, first, i - j1, row, &self.inv_diag[i], q);
+                }
+                let (stop, inv) = diagonal(next, first, i + 1, self.diag[i + 1], failures, max);
+                self.inv_diag[i + 1] = inv;
+                if stop {
+                    return;
+                }
+            }
+            i += 2;
         }
         self.factored = failures.is_empty();
     }
@@ -331,6 +315,77 @@ impl BlockBandMatrix {
     }
 }
 
+/// Block `(i, j)` of the factor, `j = j0 + n`, in row `i`'s slots (`row[first ..]` holds
+/// blocks `j0 ..= i`): `L_ij = (A_ij − Σ_k L_ik·L_jkᵀ)·L_jj⁻ᵀ`, `k` from `j0` up, with row
+/// `j` (`row_j`, its diagonal's inverse pivots `inv`) already factorised.
+#[inline(always)]
+fn off_diagonal(
+    row: &mut [Block],
+    first: usize,
+    n: usize,
+    row_j: &[Block],
+    inv: &[f64; 3],
+    q: usize,
+) {
+    let (left, at) = row.split_at_mut(first + n);
+    let mut s = at[0];
+    for (x, y) in left[first..].iter().zip(&row_j[q - n..q]) {
+        sub_mul_t(&mut s, x, y);
+    }
+    let ljj = &row_j[q];
+    // Row by row: x·L_JJᵀ = s, i.e. L_JJ·xᵀ = sᵀ.
+    for r in &mut s {
+        let x0 = r[0] * inv[0];
+        let x1 = (r[1] - ljj[1][0] * x0) * inv[1];
+        let x2 = (r[2] - ljj[2][0] * x0 - ljj[2][1] * x1) * inv[2];
+        *r = [x0, x1, x2];
+    }
+    at[0] = s;
+}
+
+/// The diagonal block of row `i` (its other blocks factorised, from slot `first`):
+/// `L_ii = chol(A_ii − Σ_k L_ik·L_ikᵀ)`; a failed pivot is recorded and replaced by the row's
+/// original diagonal `diag`. Returns whether `max` failures are reached, and the inverse
+/// pivots.
+#[inline(always)]
+fn diagonal(
+    row: &mut [Block],
+    first: usize,
+    i: usize,
+    diag: [f64; 3],
+    failures: &mut Vec<PivotFailure>,
+    max: usize,
+) -> (bool, [f64; 3]) {
+    let q = row.len() - 1;
+    let (left, at) = row.split_at_mut(q);
+    let mut s = at[0];
+    for l in &left[first..] {
+        sub_mul_t_lower(&mut s, l);
+    }
+    let mut pivot = |k: usize, p: f64| -> f64 {
+        if p > PIVOT_TOLERANCE * diag[k] {
+            p
+        } else {
+            failures.push(PivotFailure {
+                index: 3 * i + k,
+                pivot: p,
+            });
+            diag[k].abs().max(f64::MIN_POSITIVE)
+        }
+    };
+    let mut l = ZERO;
+    l[0][0] = pivot(0, s[0][0]).sqrt();
+    let i0 = 1.0 / l[0][0];
+    l[1][0] = s[1][0] * i0;
+    l[2][0] = s[2][0] * i0;
+    l[1][1] = pivot(1, s[1][1] - l[1][0] * l[1][0]).sqrt();
+    let i1 = 1.0 / l[1][1];
+    l[2][1] = (s[2][1] - l[2][0] * l[1][0]) * i1;
+    l[2][2] = pivot(2, s[2][2] - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
+    at[0] = l;
+    (failures.len() >= max, [i0, i1, 1.0 / l[2][2]])
+}
+
 /// The lower triangle of `s −= l·lᵀ` for 3×3 blocks (the upper one is never read).
 #[inline(always)]
 fn sub_mul_t_lower(s: &mut Block, l: &Block) {
@@ -411,6 +466,73 @@ mod tests {
             for (u, v) in ax.iter().zip(&b) {
                 assert!((u - v).abs() < 1e-12, "nb={nb} q={q}: {u} vs {v}");
             }
+        }
+    }
+
+    /// The factor one block row at a time, as the module doc writes it: the reference that
+    /// [`BlockBandMatrix::factor_collecting`]'s two rows at a time must match bit for bit.
+    fn one_row_at_a_time(m: &mut BlockBandMatrix, failures: &mut Vec<PivotFailure>, max: usize) {
+        failures.clear();
+        let (q, w) = (m.q, m.q + 1);
+        let diag: Vec<[f64; 3]> =
+            m.a.chunks_exact(w)
+                .map(|row| [row[q][0][0], row[q][1][1], row[q][2][2]])
+                .collect();
+        for (i, &d) in diag.iter().enumerate() {
+            let j0 = i.saturating_sub(q);
+            let (done, from_i) = m.a.split_at_mut(i * w);
+            let row = &mut from_i[..w];
+            for (n, (row_j, inv)) in done[j0 * w..]
+                .chunks_exact(w)
+                .zip(&m.inv_diag[j0..i])
+                .enumerate()
+            {
+                off_diagonal(row, q - (i - j0), n, row_j, inv, q);
+            }
+            let (stop, inv) = diagonal(row, q - (i - j0), i, d, failures, max);
+            m.inv_diag[i] = inv;
+            if stop {
+                return;
+            }
+        }
+    }
+
+    #[test]
+    fn two_rows_at_a_time_give_the_one_row_factor_bit_for_bit() {
+        for (nb, q, indefinite) in [
+            (1usize, 0usize, false),
+            (5, 0, false),
+            (4, 1, false),
+            (15, 5, false),
+            (16, 5, false),
+            (10, 9, false),
+            (15, 5, true),
+        ] {
+            let mut a = spd(nb, q, nb as u64 * 7 + q as u64);
+            if indefinite {
+                // Two negative pivots: the collecting factorisation goes on past the first.
+                a.block_mut(4, 4)[1][1] = -50.0;
+                a.block_mut(9, 9)[0][0] = -50.0;
+            }
+            let (mut fast, mut slow) = (a.clone(), a.clone());
+            let (mut ff, mut fs) = (Vec::new(), Vec::new());
+            fast.factor_collecting(&mut ff, 2);
+            one_row_at_a_time(&mut slow, &mut fs, 2);
+            assert_eq!(ff, fs, "nb={nb} q={q}");
+            assert_eq!(ff.len(), if indefinite { 2 } else { 0 });
+            let rows = ff.last().map_or(nb, |f| f.index / 3 + 1);
+            for (k, (x, y)) in fast.a.iter().zip(&slow.a).take(rows * (q + 1)).enumerate() {
+                for (r, (xr, yr)) in x.iter().zip(y).enumerate() {
+                    for (c, (u, v)) in xr.iter().zip(yr).enumerate() {
+                        assert_eq!(
+                            u.to_bits(),
+                            v.to_bits(),
+                            "nb={nb} q={q} slot {k} [{r}][{c}]"
+                        );
+                    }
+                }
+            }
+            assert_eq!(fast.inv_diag[..rows], slow.inv_diag[..rows]);
         }
     }
 
