@@ -5,9 +5,9 @@
 
 use super::{diagnose, make};
 
-/// The step at which `effect` left the model, and the record of its leaving.
-fn removal<'a>(v: &'a serde_json::Value, effect: &str) -> (u64, &'a serde_json::Value) {
-    v["steps"]
+/// The record of `effect` leaving the model, which must have added it at an earlier step.
+fn removal<'a>(v: &'a serde_json::Value, effect: &str) -> &'a serde_json::Value {
+    let (step, r) = v["steps"]
         .as_array()
         .unwrap()
         .iter()
@@ -18,11 +18,14 @@ fn removal<'a>(v: &'a serde_json::Value, effect: &str) -> (u64, &'a serde_json::
                 .find(|r| r["name"] == effect)
                 .map(|r| (s["number"].as_u64().unwrap(), r))
         })
-        .unwrap_or_else(|| panic!("{effect} never removed: {}", v["steps"]))
+        .unwrap_or_else(|| panic!("{effect} never removed: {}", v["steps"]));
+    assert!(r["added_in_step"].as_u64().unwrap() < step, "{r}");
+    r
 }
 
-/// The final model's fitted value and 95 % interval of `effect`'s parameter `name`.
-fn fitted(v: &serde_json::Value, effect: &str, name: &str) -> (f64, f64, f64) {
+/// Each `(effect, parameter, truth)` inside the final model's 95 % interval of that
+/// parameter (the last kept step's joint re-fit).
+fn check_truths(v: &serde_json::Value, truths: &[(&str, &str, f64)]) {
     let step = v["steps"]
         .as_array()
         .unwrap()
@@ -30,25 +33,38 @@ fn fitted(v: &serde_json::Value, effect: &str, name: &str) -> (f64, f64, f64) {
         .rev()
         .find(|s| s["kept"] == true)
         .unwrap();
-    let p = step["refitted"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| e["name"] == effect)
-        .and_then(|e| {
-            e["parameters"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .find(|p| p["name"] == name)
-        })
-        .unwrap_or_else(|| panic!("{effect}.{name} not in the final model"));
-    let f = |x: &serde_json::Value| x.as_f64().unwrap();
-    (
-        f(&p["value"]),
-        f(&p["interval"]["lower"]),
-        f(&p["interval"]["upper"]),
-    )
+    for &(effect, name, truth) in truths {
+        let p = step["refitted"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["name"] == effect)
+            .and_then(|e| {
+                e["parameters"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .find(|p| p["name"] == name)
+            })
+            .unwrap_or_else(|| panic!("{effect}.{name} not in the final model"));
+        let f = |x: &serde_json::Value| x.as_f64().unwrap();
+        let (lo, hi) = (f(&p["interval"]["lower"]), f(&p["interval"]["upper"]));
+        assert!(
+            lo <= truth && truth <= hi,
+            "{effect}.{name}: truth {truth} outside [{lo}, {hi}] (fit {})",
+            p["value"]
+        );
+    }
+}
+
+/// The diagnosis of 200 specimens (seed 301) with `effects` hidden, and the effects it
+/// names, sorted.
+fn diagnose_pair(name: &str, effects: &str) -> (serde_json::Value, Vec<String>) {
+    let dir = tempfile::tempdir().unwrap();
+    let m = make(dir.path(), name, effects, 200, 301);
+    let v = diagnose(dir.path(), &m);
+    let named = named(&v);
+    (v, named)
 }
 
 fn named(v: &serde_json::Value) -> Vec<String> {
@@ -63,42 +79,33 @@ fn named(v: &serde_json::Value) -> Vec<String> {
 }
 
 /// A diagonal pretension (every diagonal 0.05 mm short) and a batten scatter of 15 µm: the
-/// pretension's uniform shortening first looks like a length bias, which is named at step 1;
-/// once the scatter is in the model, step 2 swaps the bias for the pretension (the swapped
-/// model better by far more than the ΔBIC of 2 a swap needs), and the fitted values hold the
-/// truth.
+/// pretension's uniform shortening first looks like a length bias, which is named at an
+/// earlier step; once the scatter is in the model, a later step swaps the bias for the
+/// pretension (the swapped model better by at least the ΔBIC of 2 a swap needs), and the
+/// fitted values hold the truth.
 #[test]
 #[ignore = "slow statistical check (tens of seconds): scripts/test.sh runs it in release"]
 fn a_stand_in_is_swapped_for_the_effect_it_stood_for() {
-    let dir = tempfile::tempdir().unwrap();
-    let m = make(
-        dir.path(),
+    let (v, named) = diagnose_pair(
         "pretension-sigma",
         "diagonal_pretension:length_error=-0.05;length_sigma:sigma.batten=0.015",
-        200,
-        301,
     );
-    let v = diagnose(dir.path(), &m);
     assert_eq!(
-        named(&v),
+        named,
         ["diagonal_pretension", "length_sigma"],
         "{}",
         v["reason"]
     );
-    let (step, r) = removal(&v, "length_bias");
-    assert!(r["added_in_step"].as_u64().unwrap() < step, "{r}");
+    let r = removal(&v, "length_bias");
     assert_eq!(r["replaced_by"], "diagonal_pretension", "{r}");
     assert!(r["delta_bic"].as_f64().unwrap() <= -2.0, "{r}");
-    for (effect, name, truth) in [
-        ("diagonal_pretension", "length_error", -0.05),
-        ("length_sigma", "sigma.batten", 0.015),
-    ] {
-        let (value, lo, hi) = fitted(&v, effect, name);
-        assert!(
-            lo <= truth && truth <= hi,
-            "{effect}.{name}: truth {truth} outside [{lo}, {hi}] (fit {value})"
-        );
-    }
+    check_truths(
+        &v,
+        &[
+            ("diagonal_pretension", "length_error", -0.05),
+            ("length_sigma", "sigma.batten", 0.015),
+        ],
+    );
 }
 
 /// A temperature field (0.002 K/mm along x on a uniform 2 K) and a batten scatter of 15 µm:
@@ -108,34 +115,25 @@ fn a_stand_in_is_swapped_for_the_effect_it_stood_for() {
 #[test]
 #[ignore = "slow statistical check (tens of seconds): scripts/test.sh runs it in release"]
 fn an_effect_a_later_one_explains_is_removed() {
-    let dir = tempfile::tempdir().unwrap();
-    let m = make(
-        dir.path(),
+    let (v, named) = diagnose_pair(
         "thermal-sigma",
         "thermal_gradient:gradient_x=0.002,offset=2;length_sigma:sigma.batten=0.015",
-        200,
-        301,
     );
-    let v = diagnose(dir.path(), &m);
     assert_eq!(
-        named(&v),
+        named,
         ["length_sigma", "thermal_gradient"],
         "{}",
         v["reason"]
     );
-    let (step, r) = removal(&v, "length_bias");
-    assert!(r["added_in_step"].as_u64().unwrap() < step, "{r}");
+    let r = removal(&v, "length_bias");
     assert!(r["replaced_by"].is_null(), "{r}");
     assert_eq!(r["explained_by"], "thermal_gradient", "{r}");
-    for (effect, name, truth) in [
-        ("thermal_gradient", "gradient_x", 0.002),
-        ("thermal_gradient", "offset", 2.0),
-        ("length_sigma", "sigma.batten", 0.015),
-    ] {
-        let (value, lo, hi) = fitted(&v, effect, name);
-        assert!(
-            lo <= truth && truth <= hi,
-            "{effect}.{name}: truth {truth} outside [{lo}, {hi}] (fit {value})"
-        );
-    }
+    check_truths(
+        &v,
+        &[
+            ("thermal_gradient", "gradient_x", 0.002),
+            ("thermal_gradient", "offset", 2.0),
+            ("length_sigma", "sigma.batten", 0.015),
+        ],
+    );
 }
