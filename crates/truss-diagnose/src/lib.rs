@@ -64,8 +64,9 @@
 //!    model with the remaining candidates, and so on ([`step`], [`diagnose`]): stepwise
 //!    selection, until no candidate is significant and clearly better, or a named effect
 //!    spoils a model that agreed in distribution (the discrepancy grows beyond its noise,
-//!    or turns significant: it is then not added; [`step`]), or none is left. An effect removed because another took over what it explained is listed as
-//!    indistinguishable from it, with the measurement that would separate them. The false
+//!    or turns significant: it is then not added; [`step`]), or none is left. An effect
+//!    removed because another took over what it explained is listed as indistinguishable
+//!    from it, with the measurement that would separate them. The false
 //!    discovery rate over the steps is held at α/2 by ForwardStop on the steps'
 //!    Bonferroni-adjusted p-values ([`diagnose::forward_stop`]; removals only take effects
 //!    out); the other half of α = 0.05 is the comparison's ([`compare::LEVEL`]), so that on
