@@ -89,11 +89,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "357d23775bd1f895024c5ce94c8e67d6af8fe5cbd91a77c4f5f4d008c24d9c2b",
-        "5a858bf8e734f176b91148bbb0875c2729d5b69585ac8a1d04aec50b2ce92086",
-        "8f2cc84d87bcfc515f27b31fd30cf297a875add765bedfe4fa6d9654587a40af",
-        "d10ed9436448feb99676e2a80222bbc3f50639eee30692fa9431b4c269832758",
-        "c876507151321e3438c3ba5db5ccc991ad33db5977a9819b54a935d81a748449",
+        "ebfc63116d87d924afb787b7fd379d2451721d619b2c5b02c436aab652307e2a",
+        "250ebc35d731f68192faca6b4669b8f390d78b9f27cebefb5b7b50bee177ec38",
+        "fcefaf52b48048f8232c4dadbfd9ee3356159c08f8de3797e318273796d73bee",
+        "7f95eed1a842b547589bf84637c37505cc0c2cfdc91b76242878045a89080f26",
+        "45df1731b9b09cbb99018312107caa2fe5c15cea496f18e6ae53ae0646c06bb1",
     ];
     for (what, (g, w)) in [
         "job id",

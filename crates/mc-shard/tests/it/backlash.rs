@@ -146,11 +146,11 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "2d5894eea68c782bf9303fe7539eff2b5ae0ba6d8a84f56642f2ce4aad6b0e13"
+        "da52d6fb28674045de66d2e726c4c81846d3c16eff973410cbf10a647d7e9e18"
     );
     assert_eq!(
         digest,
-        "c5d2519b8e7748cdb2510ac3d8db68781141aec271d257b995ff170917e7ab15"
+        "7d812d9ca77f5faa6ae7dfe3c174ab1e951a142eb3f6292b27aeff0ca50918fb"
     );
 }
 

@@ -22,18 +22,23 @@ const TRUST_GROWTH: f64 = 4.0;
 /// A step moves a node by at most this fraction of the shortest member.
 const TRUST_MEMBER_FRACTION: f64 = 0.2;
 
+/// A chord step's first trial is the model's minimiser along the line when it lies in
+/// `(1/FIRST_TRIAL_RANGE, FIRST_TRIAL_RANGE)` (see [`Solver::first_trial`]).
+const FIRST_TRIAL_RANGE: f64 = 4.0;
+
 /// At most this many trial points per line search.
 const MAX_TRIALS: u32 = 100;
 
 impl Solver {
     /// Line search along `self.work.d` from `self.work.u` (see the module doc); moves `self.work.u`,
     /// `self.work.r` and `self.work.states` to the accepted point and returns α, its evaluation and
-    /// `max |d|`.
+    /// `max |d|`. `chord`: the step's operator is older than the current point (see
+    /// [`Solver::first_trial`]).
     ///
     /// Keeps a bracket: `a`, the largest α seen with `φ' < 0` and sufficient decrease, and
     /// `b`, the smallest α seen with `φ' > 0`, or without sufficient decrease, or a
     /// non-finite force (where a member would collapse). The trials are: the full step
-    /// (unless `expand`), then the minimiser predicted by [`Solver::predict_alpha`], then
+    /// (unless `expand`; for a chord step, [`Solver::first_trial`]), then the minimiser predicted by [`Solver::predict_alpha`], then
     /// false position or bisection inside the bracket, or fourfold growth while there is no
     /// upper end. A trial is accepted when `|φ'(α)| ≤ η·|φ'_min|`, `φ'_min` the steepest
     /// descent rate seen (φ'(0) for a Newton step; larger along a direction of negative
@@ -55,6 +60,7 @@ impl Solver {
         iteration: u32,
         current: Evaluation,
         expand: bool,
+        chord: bool,
     ) -> Result<(f64, Evaluation, f64), SolveError> {
         let n = self.structure.free;
         let phi0 = dot_n(&self.work.r[..n], &self.work.d[..n]);
@@ -81,7 +87,11 @@ impl Solver {
         let mut side = 0i8;
         for trial in 0..MAX_TRIALS {
             let alpha = if trial == 0 && !expand {
-                1.0f64.min(cap)
+                if chord && self.options.chord_secant {
+                    self.first_trial(cap)
+                } else {
+                    1.0f64.min(cap)
+                }
             } else if trial <= 1 {
                 let predicted = self.predict_alpha(phi0, cap);
                 if predicted > a && predicted < b {
@@ -116,6 +126,13 @@ impl Solver {
                     || (trial == 0 && !expand && phi <= 0.0)
                     || (descending && alpha >= cap));
             if accept {
+                // The root of φ' by the secant through φ'(0) and φ'(α), for the next chord
+                // step (NaN: none; see `Solver::first_trial`).
+                self.chord_secant = if chord {
+                    alpha * phi0 / (phi0 - phi)
+                } else {
+                    f64::NAN
+                };
                 self.accept();
                 return Ok((alpha, eval, d_max));
             }
@@ -143,6 +160,28 @@ impl Solver {
             residual: current.residual,
             step: a * d_max,
         })
+    }
+
+    /// The first trial of a step whose operator is older than the current point (a chord
+    /// step): the secant minimiser of the last chord step,
+    ///
+    /// ```text
+    /// α = α₀·φ₀'(0) / (φ₀'(0) − φ₀'(α₀))      (the last step's α₀, φ₀'; see `Solver::chord_secant`)
+    /// ```
+    ///
+    /// when it lies in `(1/FIRST_TRIAL_RANGE, FIRST_TRIAL_RANGE)`, else the full step. A
+    /// chord step `d = −M⁻¹r` with an earlier tangent `M` is too short (or long) by the
+    /// same factor along the directions in which the tangent changed since (a panel whose
+    /// bracing is slack, whose stiffness the geometric terms set): the last step measured
+    /// that factor along its own line, and the next step's error lies mostly along the
+    /// same directions. Costs nothing: φ' at the accepted point is computed anyway.
+    fn first_trial(&self, cap: f64) -> f64 {
+        let a = self.chord_secant;
+        if a > 1.0 / FIRST_TRIAL_RANGE && a < FIRST_TRIAL_RANGE {
+            a.min(cap)
+        } else {
+            1.0f64.min(cap)
+        }
     }
 
     /// Predicts the minimiser of `φ(α) = Π(u + α·d)` in `(0, cap]` from a piecewise

@@ -35,9 +35,15 @@
 //!    full step is taken when `φ'(1) ≤ η·|φ'(0)|` (η = 0.5), else a root of `φ'` in
 //!    `(0, 1)` is bracketed (false position, bisecting when the bracket stops halving) until
 //!    `|φ'(α)| ≤ η·|φ'(0)|`. `φ'` is continuous because `Π` is continuously differentiable
-//!    where cables go slack.
+//!    where cables go slack. A chord step's first trial is not the full step but the
+//!    secant root of `φ'` along the last chord step, `α₀·φ₀'(0)/(φ₀'(0) − φ₀'(α₀))`
+//!    ([`SolveOptions::chord_secant`]): the chord operator, an earlier tangent, is too
+//!    stiff or too soft by about the same factor from one step to the next (in the
+//!    directions of the panels whose bracing is slack), and the last step measured it.
 //! 5. **Convergence** when either the out-of-balance force is at the rounding floor,
-//!    `‖r‖∞ ≤ residual_floor·F` with `F` the largest member force, or the last step
+//!    `‖r‖∞ ≤ max(residual_floor·F, 4·ε·k_max·‖u‖∞)` with `F` the largest member force and
+//!    `k_max` the stiffest member's `E·A/L₀` (the second term is the force's rounding
+//!    noise where the displacements are large, as in a tall tower), or the last step
 //!    satisfies `‖α·d‖∞ ≤ step_tolerance·‖u‖∞` and the error it leaves is no larger than the
 //!    step (a fresh tangent's quadratic convergence, or a measured contraction ≤ ½), or the
 //!    force has stopped falling within a thousand times the floor (an ill-conditioned tall
@@ -97,6 +103,9 @@ pub struct SolveOptions {
     pub reuse_factorisation: bool,
     /// Refactorise when a chord step is more than this fraction of the one before it.
     pub reuse_contraction: f64,
+    /// Start the line search of a chord step at the last chord step's secant minimiser
+    /// instead of the full step (step 4 of the module doc).
+    pub chord_secant: bool,
     /// Record every iteration (residual, step, slack cables) for debugging.
     pub record_iterations: bool,
 }
@@ -109,6 +118,7 @@ impl Default for SolveOptions {
             residual_floor: 1e-13,
             reuse_factorisation: true,
             reuse_contraction: 0.05,
+            chord_secant: true,
             record_iterations: false,
         }
     }
@@ -224,6 +234,10 @@ pub struct Solver {
     log: Vec<IterationRecord>,
     last: Option<SolveReport>,
     evaluations: u32,
+    /// The last chord step's secant minimiser along its line, relative to that step
+    /// (NaN when the last step was not a chord step, or switched a one-sided member):
+    /// the next chord step's first trial (see `line_search`).
+    chord_secant: f64,
 }
 
 /// What a sample sets: members, loads and clearances, and its scales.
@@ -241,6 +255,9 @@ struct SampleConstants {
     /// The sample's force scale \[N\]: the largest `k·|s₀|` of its members and of its
     /// loads, so that a solution whose forces all vanish still has a rounding floor.
     force_ref: f64,
+    /// The stiffest member's `k = E·A/L₀` \[N/mm\] (scales the rounding floor that the
+    /// displacements set on the force).
+    stiffest: f64,
 }
 
 /// The current point `u`, its out-of-balance force `r` and member states, the step `d`,
@@ -326,6 +343,7 @@ impl Solver {
                 loads: vec![0.0; n + 1],
                 scale: 0.0,
                 force_ref: 0.0,
+                stiffest: 0.0,
             },
             work: Workspace {
                 states: vec![zero_state; m],
@@ -356,6 +374,7 @@ impl Solver {
             log: Vec::new(),
             last: None,
             evaluations: 0,
+            chord_secant: f64::NAN,
             structure,
         }
     }
@@ -450,6 +469,8 @@ impl Solver {
             .map(|(m, k)| k * m.initial_stretch.abs())
             .chain(self.sample.loads.iter().map(|f| f.abs()))
             .fold(0.0, f64::max);
+        self.sample.stiffest = self.sample.tension.iter().copied().fold(0.0, f64::max);
+        self.chord_secant = f64::NAN;
         self.step.damping = 0.0;
         self.step.plain_step = false;
         self.step.pinned.fill(false);
