@@ -22,7 +22,7 @@ const TRUST_GROWTH: f64 = 4.0;
 /// A step moves a node by at most this fraction of the shortest member.
 const TRUST_MEMBER_FRACTION: f64 = 0.2;
 
-/// A chord step's first trial is the model's minimiser along the line when it lies in
+/// A chord step's first trial is the last chord step's secant root when it lies in
 /// `(1/FIRST_TRIAL_RANGE, FIRST_TRIAL_RANGE)` (see [`Solver::first_trial`]).
 const FIRST_TRIAL_RANGE: f64 = 4.0;
 
@@ -38,11 +38,12 @@ impl Solver {
     /// Keeps a bracket: `a`, the largest α seen with `φ' < 0` and sufficient decrease, and
     /// `b`, the smallest α seen with `φ' > 0`, or without sufficient decrease, or a
     /// non-finite force (where a member would collapse). The trials are: the full step
-    /// (unless `expand`; for a chord step, [`Solver::first_trial`]), then the minimiser predicted by [`Solver::predict_alpha`], then
-    /// false position or bisection inside the bracket, or fourfold growth while there is no
-    /// upper end. A trial is accepted when `|φ'(α)| ≤ η·|φ'_min|`, `φ'_min` the steepest
-    /// descent rate seen (φ'(0) for a Newton step; larger along a direction of negative
-    /// curvature, whose `φ'(0)` may be near zero), and the energy has fallen enough:
+    /// (unless `expand`; for a chord step, [`Solver::first_trial`]), then the minimiser
+    /// predicted by [`Solver::predict_alpha`], then false position or bisection inside the
+    /// bracket, or fourfold growth while there is no upper end. A trial is accepted when
+    /// `|φ'(α)| ≤ η·|φ'_min|`, `φ'_min` the steepest descent rate seen (φ'(0) for a Newton
+    /// step; larger along a direction of negative curvature, whose `φ'(0)` may be near
+    /// zero), and the energy has fallen enough:
     ///
     /// ```text
     /// Π(u + α·d) ≤ Π(u) + c₁·α·φ'(0) + τ,    c₁ = 1e-4,
@@ -166,7 +167,7 @@ impl Solver {
     /// step): the secant minimiser of the last chord step,
     ///
     /// ```text
-    /// α = α₀·φ₀'(0) / (φ₀'(0) − φ₀'(α₀))      (the last step's α₀, φ₀'; see `Solver::chord_secant`)
+    /// α = α₀·φ₀'(0) / (φ₀'(0) − φ₀'(α₀))    (α₀, φ₀': the last chord step's)
     /// ```
     ///
     /// when it lies in `(1/FIRST_TRIAL_RANGE, FIRST_TRIAL_RANGE)`, else the full step. A

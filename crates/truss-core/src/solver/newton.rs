@@ -266,8 +266,8 @@ impl Solver {
     /// and further steps only move the answer by that noise (on 300-stage towers, whose
     /// tops move 20–45 mm, the force stops falling at 0.6 to 1.2 `ε·k_max·‖u‖∞`, about
     /// 1e-11 N, while the force floor is a few 1e-12 N). It matters only where the
-    /// displacements are that large: for the paper's 5-stage prism it is a twentieth of
-    /// the force floor or less. Without it such a solve goes on until the stall rule
+    /// displacements are that large: for the paper's 5-stage prism it is a tenth of the
+    /// force floor or less (tested). Without it such a solve goes on until the stall rule
     /// accepts it, three iterations later. Like the force floor it scales with the length
     /// errors, so the answer stays homogeneous in them.
     pub(super) fn rounding_floor(&self) -> f64 {
