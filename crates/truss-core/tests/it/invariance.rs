@@ -9,7 +9,8 @@
 //! - Resolution: θ_P agrees with a solve run to the rounding floor to better than 1e-9, at 5
 //!   stages and at 60 (where some solves end on the displacements' rounding floor).
 //! - Compression ratio: θ_P statistics do not move, beyond their sampling noise, for cable
-//!   compression ratios from 1e-6 to 1e-3.
+//!   compression ratios from 1e-6 to 1e-3 at 5 stages, and (slow tier) from 1e-5 to 1e-2
+//!   at 30 stages and 1e-3 to 1e-2 at 300.
 
 use crate::common::*;
 use proptest::prelude::*;
@@ -241,41 +242,67 @@ fn theta_of_a_tall_tower_is_resolved_to_better_than_1e9() {
     );
 }
 
-/// θ_P statistics for compression ratios 1e-6 … 1e-3 (the default is 1e-4), with common
-/// random numbers: the 50th and 95th percentiles and the RMS of θ_P move by less than a
-/// tenth of their standard error (≈ 1.6 % of θ_P95 for 1500 samples), i.e. not beyond their
-/// own noise.
-#[test]
-fn theta_statistics_do_not_depend_on_the_compression_ratio() {
-    let n = 1500;
-    let stats = |ratio: f64| {
-        let model = PrismOptions {
-            compression_ratio: ratio,
-            ..PrismOptions::with_stages(5)
-        }
-        .model()
-        .unwrap();
-        let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
-        let mut rng = Normals::new(2024);
-        let mut t: Vec<f64> = (0..n)
-            .map(|_| {
-                let e = errors(&model, &["batten", "longeron"], SIGMA, &mut rng);
-                solver.solve(&e).unwrap();
-                solver.distortion().unwrap().theta_p
-            })
-            .collect();
-        t.sort_by(f64::total_cmp);
-        let rms = (t.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
-        [t[n / 2], t[(0.95 * n as f64) as usize], rms]
-    };
-    let base = stats(1e-4);
-    // Standard error of the 95th percentile of a Rayleigh sample, relative: about
-    // √(p(1−p)/n)/(f(q)·q) = 1.6 % at n = 1500; we ask for a tenth of it.
-    for ratio in [1e-6, 1e-5, 1e-3] {
-        let s = stats(ratio);
+/// The 50th and 95th percentiles and the RMS of θ_P over `n` samples of the `stages`-stage
+/// prism with the cables' compression ratio `ratio`, with common random numbers (the same
+/// draws for every ratio).
+fn theta_statistics(stages: usize, n: usize, ratio: f64) -> [f64; 3] {
+    let model = PrismOptions {
+        compression_ratio: ratio,
+        ..PrismOptions::with_stages(stages)
+    }
+    .model()
+    .unwrap();
+    let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
+    let mut rng = Normals::new(2024);
+    let mut t: Vec<f64> = (0..n)
+        .map(|_| {
+            let e = errors(&model, &["batten", "longeron"], SIGMA, &mut rng);
+            solver.solve(&e).unwrap();
+            solver.distortion().unwrap().theta_p
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    let rms = (t.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+    [t[n / 2], t[(0.95 * n as f64) as usize], rms]
+}
+
+/// Asserts that θ_P's statistics at each of `ratios` move from the default ratio's (1e-4)
+/// by less than a tenth of the 95th percentile's standard error: about
+/// `√(p(1−p)/n)/(f(q)·q)` for a Rayleigh sample, 1.6 % at n = 1500, i.e. not beyond their
+/// own noise. Returns the largest relative move.
+fn assert_ratio_does_not_matter(stages: usize, n: usize, ratios: &[f64]) -> f64 {
+    let base = theta_statistics(stages, n, 1e-4);
+    let bound = 0.1 * 0.016 * (1500.0 / n as f64).sqrt();
+    let mut worst: f64 = 0.0;
+    for &ratio in ratios {
+        let s = theta_statistics(stages, n, ratio);
         for (k, name) in ["p50", "p95", "rms"].iter().enumerate() {
             let rel = (s[k] / base[k] - 1.0).abs();
-            assert!(rel < 1.6e-3, "ratio {ratio:e}: {name} moved by {rel:.2e}");
+            worst = worst.max(rel);
+            assert!(
+                rel < bound,
+                "{stages} stages, ratio {ratio:e}: {name} moved by {rel:.2e} (bound {bound:.1e})"
+            );
         }
     }
+    worst
+}
+
+/// θ_P statistics for compression ratios 1e-6 … 1e-3 (the default is 1e-4) do not move
+/// beyond their own noise (see [`assert_ratio_does_not_matter`]), for the paper's 5 stages.
+#[test]
+fn theta_statistics_do_not_depend_on_the_compression_ratio() {
+    assert_ratio_does_not_matter(5, 1500, &[1e-6, 1e-5, 1e-3]);
+}
+
+/// The same for long trusses, where the ratio sets the solver's cost (a slack panel's
+/// regularising stiffness decides how nonlinear it is): at 30 stages for ratios 1e-5 …
+/// 1e-2, at 300 stages for 1e-3 and 1e-2 (smaller ratios take hundreds of factorisations
+/// per solve there).
+#[test]
+#[ignore = "slow: 300-stage solves, run in release by scripts/test.sh"]
+fn theta_statistics_of_long_trusses_do_not_depend_on_the_compression_ratio() {
+    let w30 = assert_ratio_does_not_matter(30, 1000, &[1e-5, 1e-3, 1e-2]);
+    let w300 = assert_ratio_does_not_matter(300, 100, &[1e-3, 1e-2]);
+    println!("largest relative move: {w30:.2e} at 30 stages, {w300:.2e} at 300");
 }
