@@ -85,6 +85,8 @@ pub(super) struct Progress {
     stalled: u32,
     /// The lowest out-of-balance force so far \[N\].
     lowest: f64,
+    /// The current point's largest displacement `‖u‖∞` \[mm\].
+    u_max: f64,
     /// Soft directions of the linearised start (see [`SolveReport::soft_directions`]).
     soft_directions: u32,
 }
@@ -144,8 +146,8 @@ impl Solver {
                     continue;
                 }
             };
-            let u_max = max_abs(&self.work.u[..self.structure.free]);
-            self.adapt_damping(&mut p, alpha, u_max)?;
+            p.u_max = max_abs(&self.work.u[..self.structure.free]);
+            self.adapt_damping(&mut p, alpha)?;
             if self.options.record_iterations {
                 self.record(&p, &choice, residual_before, alpha);
             }
@@ -155,7 +157,7 @@ impl Solver {
                 self.chord_secant = f64::NAN;
             }
             self.pin_failed_switches(choice.fresh, alpha);
-            if let Next::Done = self.step_converged(&mut p, &choice, u_max) {
+            if let Next::Done = self.step_converged(&mut p, &choice) {
                 break;
             }
         }
@@ -209,6 +211,7 @@ impl Solver {
             poor: false,
             stalled: 0,
             lowest: f64::INFINITY,
+            u_max: max_abs(&self.work.u[..structure.free]),
             soft_directions,
         }
     }
@@ -228,7 +231,7 @@ impl Solver {
             });
         }
         let floor = self.force_floor(eval);
-        if eval.residual == 0.0 || eval.residual <= floor.max(self.rounding_floor()) {
+        if eval.residual == 0.0 || eval.residual <= floor.max(self.rounding_floor(p.u_max)) {
             return Ok(Next::Done);
         }
         if eval.residual <= 0.5 * p.lowest {
@@ -270,8 +273,7 @@ impl Solver {
     /// force floor or less (tested). Without it such a solve goes on until the stall rule
     /// accepts it, three iterations later. Like the force floor it scales with the length
     /// errors, so the answer stays homogeneous in them.
-    pub(super) fn rounding_floor(&self) -> f64 {
-        let u_max = max_abs(&self.work.u[..self.structure.free]);
+    pub(super) fn rounding_floor(&self, u_max: f64) -> f64 {
         DISPLACEMENT_ROUNDING * f64::EPSILON * self.sample.stiffest * u_max
     }
 
@@ -343,19 +345,14 @@ impl Solver {
     /// After a line search: a step that no longer moves ([`STUCK_STEP`]) while the force
     /// is far from its floor raises the damping (an error once it is beyond
     /// [`DAMPING_MAX`]); full steps again relax it back towards Newton's method.
-    fn adapt_damping(
-        &mut self,
-        p: &mut Progress,
-        alpha: f64,
-        u_max: f64,
-    ) -> Result<(), SolveError> {
+    fn adapt_damping(&mut self, p: &mut Progress, alpha: f64) -> Result<(), SolveError> {
         // (Multiplied in this order, as ever: the comparison's rounding is part of the
         // results.)
         let far_from_floor = p.eval.residual
             > STALL_FLOOR_FACTOR
                 * self.options.residual_floor
                 * p.eval.force_scale.max(self.sample.force_ref);
-        if far_from_floor && p.step <= STUCK_STEP * u_max.max(self.sample.scale) {
+        if far_from_floor && p.step <= STUCK_STEP * p.u_max.max(self.sample.scale) {
             if !self.raise_damping() {
                 return Err(SolveError::NotConverged {
                     iterations: p.iterations,
@@ -415,9 +412,9 @@ impl Solver {
     /// is no larger than it (a fresh tangent's, or a contraction of at most
     /// [`CONVERGED_CONTRACTION`]). Otherwise notes whether a reused operator's step
     /// contracted too little to keep it.
-    fn step_converged(&self, p: &mut Progress, choice: &StepChoice, u_max: f64) -> Next {
+    fn step_converged(&self, p: &mut Progress, choice: &StepChoice) -> Next {
         let contraction = p.step / p.prev_step;
-        let small = p.step <= self.options.step_tolerance * u_max;
+        let small = p.step <= self.options.step_tolerance * p.u_max;
         let undamped = self.step.damping == 0.0;
         if small
             && !choice.curved

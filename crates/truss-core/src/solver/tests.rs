@@ -473,7 +473,8 @@ fn the_rounding_floor_is_below_the_force_floor_for_the_paper_prism() {
                 .iter()
                 .fold(0.0f64, |a, s| a.max(s.force.abs()));
             let floor = solver.options.residual_floor * force.max(solver.sample.force_ref);
-            worst = worst.max(solver.rounding_floor() / floor);
+            let u_max = evaluate::max_abs(&solver.work.u[..solver.structure.free]);
+            worst = worst.max(solver.rounding_floor(u_max) / floor);
         }
     }
     println!("largest rounding floor / force floor: {worst:.3}");
