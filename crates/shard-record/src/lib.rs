@@ -119,8 +119,18 @@ pub mod parameters {
     pub const BACKLASH: &str = "backlash";
     /// The joints' regularisation `k_c/k_t` (cases differing in it form their own series).
     pub const JOINT_COMPRESSION_RATIO: &str = "joint_compression_ratio";
+    /// The cables' compression stiffness over their tension stiffness, written only where it
+    /// is not the default 1e-4 (cases differing in it form their own series).
+    pub const CABLE_COMPRESSION_RATIO: &str = "cable_compression_ratio";
     /// Every key, in the order above.
-    pub const ALL: [&str; 5] = [SIGMA, STAGES, UNIFORM, BACKLASH, JOINT_COMPRESSION_RATIO];
+    pub const ALL: [&str; 6] = [
+        SIGMA,
+        STAGES,
+        UNIFORM,
+        BACKLASH,
+        JOINT_COMPRESSION_RATIO,
+        CABLE_COMPRESSION_RATIO,
+    ];
 }
 pub use scan::{ScanError, ShardScan, Tail, parse_record, read_shard, scan_shard};
 

@@ -446,6 +446,16 @@ impl Job {
             {
                 parameters.insert("uniform".to_string(), 1.0);
             }
+            // Cases whose cables have another compression ratio than the default form their
+            // own series too (absent at the default, so the records of earlier jobs stay
+            // as they were).
+            let cable_ratio = model.members().iter().find_map(|m| match m.behaviour {
+                truss_core::Behaviour::Cable { compression_ratio } => Some(compression_ratio),
+                truss_core::Behaviour::Bar => None,
+            });
+            if let Some(r) = cable_ratio.filter(|&r| r != truss_core::DEFAULT_COMPRESSION_RATIO) {
+                parameters.insert("cable_compression_ratio".to_string(), r);
+            }
             if let Some(j) = model.joints().first() {
                 // Cases differing in the joints' regularisation form their own series.
                 parameters.insert("backlash".to_string(), 1.0);

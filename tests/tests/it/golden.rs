@@ -110,17 +110,30 @@ fn golden_job_shards_and_report() {
 }
 
 /// The case parameters the job crate writes into a shard's header are the wire format's
-/// named keys, which the merge's sweeps read (`shard_record::parameters`).
+/// named keys, which the merge's sweeps read (`shard_record::parameters`); a case whose
+/// cables have another compression ratio than the default gets its own key (and so its own
+/// series), the others none.
 #[test]
 fn case_parameters_use_the_wire_formats_keys() {
-    let job = Job::from_json(JOB, Path::new(".")).unwrap();
-    let written: std::collections::BTreeSet<&str> = job
-        .cases
-        .iter()
-        .flat_map(|c| c.parameters.keys().map(String::as_str))
+    let with_ratio = JOB.replace(
+        r#"{"prism": {"stages": 3, "backlash": true}}"#,
+        r#"{"prism": {"stages": 3, "backlash": true, "compression_ratio": 1e-8}}"#,
+    );
+    assert_ne!(with_ratio, JOB);
+    let mut written = std::collections::BTreeSet::new();
+    for text in [JOB, &with_ratio] {
+        let job = Job::from_json(text, Path::new(".")).unwrap();
+        for c in &job.cases {
+            let ratio = c.parameters.get("cable_compression_ratio");
+            let expected = (text != JOB && c.name == "backlash").then_some(&1e-8);
+            assert_eq!(ratio, expected, "case {}", c.name);
+            written.extend(c.parameters.keys().cloned());
+        }
+    }
+    let known: std::collections::BTreeSet<String> = shard_record::parameters::ALL
+        .into_iter()
+        .map(String::from)
         .collect();
-    let known: std::collections::BTreeSet<&str> =
-        shard_record::parameters::ALL.into_iter().collect();
     assert!(
         written.is_subset(&known),
         "{written:?} not all in {known:?}"
