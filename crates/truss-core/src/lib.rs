@@ -110,9 +110,9 @@ pub use structure::Structure;
 /// Not of a truss with backlash joints in free play: there a stage whose longerons float in
 /// their holes is held by its slack diagonals' `r·k` (0.04 N/mm at 1e-4) and the geometric
 /// stiffness of what pretension is left, and the first wins. In the paper's Fig. 16 study at
-/// σ = 6.7 µm, θ_P95 is 5.6 % lower at 1e-8 than at 1e-4 (10,000 samples each, beyond both
-/// intervals), and within 0.3 % of that from 1e-7 to 1e-10 (the limit exists; a slow test
-/// checks it). A job can set the ratio per case (`"compression_ratio": 1e-8` in its prism);
+/// σ = 6.7 µm, θ_P95 is 5.6 % lower at 1e-8 than at 1e-4 (the same 10,000 draws; 4.4 % with
+/// independent draws, beyond both intervals), and within 0.3 % of that from 1e-7 to 1e-10
+/// (the limit exists; a slow test checks it). Solves at 1e-8 take about twice the time. A job can set the ratio per case (`"compression_ratio": 1e-8` in its prism);
 /// whether the default should change for backlash models is an open modelling decision
 /// (REPRODUCTION.md, "Backlash").
 pub const DEFAULT_COMPRESSION_RATIO: f64 = 1e-4;

@@ -625,7 +625,7 @@ fn the_answer_does_not_depend_on_the_regularisation() {
 /// test shows that the `r → 0` limit exists (θ_P95, σ_t and the mean top position agree
 /// within 1 % between 1e-7, 1e-8 and 1e-9, as the regularisation test above asks of the
 /// joints) and prints how far the default is from it (θ_P95 8 % higher over these 400
-/// samples; 5.6 % over 10,000, beyond its interval: REPRODUCTION.md has the study). Slow:
+/// samples; 5.6 % over 10,000 with the same draws: REPRODUCTION.md has the study). Slow:
 /// solves at 1e-9 take some 20 iterations.
 #[test]
 #[ignore = "slow: 1,200 backlash solves at small ratios, run in release by scripts/test.sh"]
