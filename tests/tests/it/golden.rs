@@ -89,11 +89,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "ebfc63116d87d924afb787b7fd379d2451721d619b2c5b02c436aab652307e2a",
+        "2cd28355e13dce46cf01da3c847e0efa913e64a8ee803ea045aca77b75ed2cff",
         "250ebc35d731f68192faca6b4669b8f390d78b9f27cebefb5b7b50bee177ec38",
         "fcefaf52b48048f8232c4dadbfd9ee3356159c08f8de3797e318273796d73bee",
         "7f95eed1a842b547589bf84637c37505cc0c2cfdc91b76242878045a89080f26",
-        "45df1731b9b09cbb99018312107caa2fe5c15cea496f18e6ae53ae0646c06bb1",
+        "008c35935ddad3e6c2e650af02e97c4f1dcc6c17617c4e416a3241190a53a258",
     ];
     for (what, (g, w)) in [
         "job id",

@@ -146,7 +146,7 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "da52d6fb28674045de66d2e726c4c81846d3c16eff973410cbf10a647d7e9e18"
+        "b5c603105f8b32c927bb71ea35348917b5497e830073e8f12d7988a3dbd6ad53"
     );
     assert_eq!(
         digest,
@@ -186,4 +186,35 @@ fn detail_names_each_joint_with_its_state() {
             assert!(d >= g && d - g < 1e-6 && contact > 0.0, "{id}: {d} for {g}");
         }
     }
+}
+
+/// A sample whose model step needs a Levenberg shift beyond 1 (a node held only by slack
+/// diagonals of ratio 1e-6, outweighed by the geometric stiffness at it) converges, to the
+/// θ_P the same draws give at a ratio of 1e-7 (where no shift beyond 1 is needed). With a
+/// shift limit of 1 it failed as a mechanism (`truss_core`'s `SHIFT_LIMIT_MIN`). Sample 1936
+/// of the Fig. 16 case at σ = 6.7 µm, as `jobs/paper-4.2.3.json` draws it.
+#[test]
+fn a_node_held_by_slack_diagonals_alone_is_not_a_mechanism() {
+    let job = |ratio: &str| {
+        let text = format!(
+            r#"{{"model": {{"prism": {{"stages": 5}}}}, "seed": 20210325, "cases": [
+  {{"name": "backlash-sigma-0.0067", "samples": 10000,
+    "model": {{"prism": {{"stages": 5, "backlash": true, "compression_ratio": {ratio}}}}},
+    {CLEARANCE},
+    "length_errors": {{"batten": {{"normal": {{"sigma": 0.0067}}}}, "longeron": {{"normal": {{"sigma": 0.0067}}}},
+                      "diagonal": {{"uniform": {{"low": -0.0201, "high": 0}}}}}}}}]}}"#
+        );
+        Job::from_json(&text, Path::new(".")).unwrap()
+    };
+    let theta = |ratio: &str| {
+        let line = mc_shard::reproduce::reproduce(&job(ratio), 0, 1936, false);
+        let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+        assert_eq!(v["status"], "converged", "ratio {ratio}: {line}");
+        v["theta_p"].as_f64().unwrap()
+    };
+    let (at_6, at_7) = (theta("1e-6"), theta("1e-7"));
+    assert!(
+        (at_6 / at_7 - 1.0).abs() < 1e-6,
+        "θ_P {at_6} at 1e-6, {at_7} at 1e-7"
+    );
 }

@@ -29,7 +29,7 @@
 //!    member forces outweighs the slack cables' small stiffness) or when step 1 fails. A
 //!    factorisation is reused while the slack set is unchanged and steps contract. Where
 //!    `K(u)` is not positive definite, `K + μ·diag(K)` is used with the smallest `μ` of
-//!    1e-9, 1e-7, …, 1 that is: a descent direction either way.
+//!    1e-9, 1e-7, …, 1e3 that is: a descent direction either way.
 //! 4. **Line search** on `φ(α) = Π(u + α·d)` using only its derivative
 //!    `φ'(α) = r(u + α·d)·d`, never differences of `Π` (which cancel at this precision): the
 //!    full step is taken when `φ'(1) ≤ η·|φ'(0)|` (η = 0.5), else a root of `φ'` in

@@ -40,9 +40,19 @@ const SHIFT_START: f64 = 1e-9;
 /// Each retry multiplies the shift by this.
 const SHIFT_RAISE: f64 = 100.0;
 
-/// Shifts are tried up to this many times the solver's damping (and at least up to 1);
-/// beyond, the structure is a mechanism.
+/// Shifts are tried up to this many times the solver's damping (and at least up to
+/// [`SHIFT_LIMIT_MIN`]); beyond, the structure is a mechanism.
 const SHIFT_LIMIT_FACTOR: f64 = 1e3;
+
+/// The least limit of the shift μ. It must exceed 1: a node held only by slack cables (in a
+/// truss with backlash joints whose longerons float) has a diagonal of about `r·E·A/L₀`,
+/// which the negative geometric stiffness `−N/L` of compressed members at it can outweigh,
+/// and then `K + μ·diag(K)` is positive definite only for some μ > 1. Measured: in the
+/// Fig. 16 study at σ = 6.7 µm, 1 sample in 10,000 with the diagonals' ratio 1e-6 and 2 with
+/// 1e-10 failed as mechanisms with a limit of 1; with this limit they converge (the first to
+/// the same θ_P as at 1e-7, within 3e-9). A true mechanism has a zero pivot whatever μ, and
+/// is still refused, after two more factorisations.
+const SHIFT_LIMIT_MIN: f64 = 1e4;
 
 /// What a model step produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -186,12 +196,12 @@ impl Solver {
         Ok(Step::Newton { shift })
     }
 
-    /// Assembles the model's `K(S)` for `S = self.factor.factor_slack` and factorises it (with the
-    /// solver's current damping μ₀ as a Levenberg shift `K + μ·diag(K)`); where it is not
+    /// Assembles the model's `K(S)` for `S = self.factor.factor_slack` and factorises it (with
+    /// the solver's current damping μ₀ as a Levenberg shift `K + μ·diag(K)`); where it is not
     /// positive definite, retries with μ = 1e-9 (or 100·μ₀), ×100 each time, up to
-    /// max(1, 1000·μ₀). Returns `Some(μ)` (the `Option` is for callers that stop at a curvature;
-    /// this one never does unless `allow_curvature`, which leaves the direction of the first
-    /// negative pivot in `self.work.d` and returns `None`).
+    /// max([`SHIFT_LIMIT_MIN`], 1000·μ₀). Returns `Some(μ)` (the `Option` is for callers that
+    /// stop at a curvature; this one never does unless `allow_curvature`, which leaves the
+    /// direction of the first negative pivot in `self.work.d` and returns `None`).
     pub(super) fn factor_model(
         &mut self,
         iteration: u32,
@@ -199,7 +209,7 @@ impl Solver {
         allow_curvature: bool,
     ) -> Result<Option<f64>, SolveError> {
         let mut shift = self.step.damping;
-        let limit = (SHIFT_LIMIT_FACTOR * self.step.damping).max(1.0);
+        let limit = (SHIFT_LIMIT_FACTOR * self.step.damping).max(SHIFT_LIMIT_MIN);
         loop {
             self.assemble_model();
             let s = &*self.structure;
