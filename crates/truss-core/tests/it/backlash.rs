@@ -597,22 +597,28 @@ fn the_answer_does_not_depend_on_the_regularisation() {
         .into_iter()
         .map(|r| (r, fig16_statistics(r)))
         .collect();
+    assert_neighbours_agree("k_c/k_t", &runs);
+}
+
+/// Asserts that θ_P95, σ_t and the mean top position of each run agree within 1 % with the
+/// next one's; `what` names the ratio that differs between them.
+fn assert_neighbours_agree(what: &str, runs: &[(f64, Statistics)]) {
     for pair in runs.windows(2) {
         let ((ra, (pa, sa, ma)), (rb, (pb, sb, mb))) = (pair[0], pair[1]);
-        eprintln!("k_c/k_t {ra:e}: θ_P95 {pa:.6e}, σ_t {sa:.6e}, mean top {ma:?} mm");
-        eprintln!("k_c/k_t {rb:e}: θ_P95 {pb:.6e}, σ_t {sb:.6e}, mean top {mb:?} mm");
+        eprintln!("{what} {ra:e}: θ_P95 {pa:.6e}, σ_t {sa:.6e}, mean top {ma:?} mm");
+        eprintln!("{what} {rb:e}: θ_P95 {pb:.6e}, σ_t {sb:.6e}, mean top {mb:?} mm");
         assert!(
             (pa - pb).abs() <= 0.01 * pb,
-            "θ_P95 {pa} at {ra:e}, {pb} at {rb:e}"
+            "θ_P95 {pa} at {what} {ra:e}, {pb} at {rb:e}"
         );
         assert!(
             (sa - sb).abs() <= 0.01 * sb,
-            "σ_t {sa} at {ra:e}, {sb} at {rb:e}"
+            "σ_t {sa} at {what} {ra:e}, {sb} at {rb:e}"
         );
         let gap = norm(sub(ma, mb));
         assert!(
             gap <= 0.01 * norm(mb),
-            "mean top {ma:?} at {ra:e}, {mb:?} at {rb:e}"
+            "mean top {ma:?} at {what} {ra:e}, {mb:?} at {rb:e}"
         );
     }
 }
@@ -634,22 +640,7 @@ fn the_diagonals_ratio_has_a_limit_that_the_default_is_not_in() {
         .into_iter()
         .map(|r| (r, fig16_statistics_with(0.0, r)))
         .collect();
-    for pair in runs.windows(2) {
-        let ((ra, (pa, sa, ma)), (rb, (pb, sb, mb))) = (pair[0], pair[1]);
-        assert!(
-            (pa - pb).abs() <= 0.01 * pb,
-            "θ_P95 {pa} at {ra:e}, {pb} at {rb:e}"
-        );
-        assert!(
-            (sa - sb).abs() <= 0.01 * sb,
-            "σ_t {sa} at {ra:e}, {sb} at {rb:e}"
-        );
-        let gap = norm(sub(ma, mb));
-        assert!(
-            gap <= 0.01 * norm(mb),
-            "mean top {ma:?} at {ra:e}, {mb:?} at {rb:e}"
-        );
-    }
+    assert_neighbours_agree("diagonals' ratio", &runs);
     let (p_limit, s_limit, _) = runs[2].1;
     let (p_default, s_default, _) = fig16_statistics(0.0);
     println!(
