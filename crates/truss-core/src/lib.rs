@@ -112,9 +112,10 @@ pub use structure::Structure;
 /// stiffness of what pretension is left, and the first wins. In the paper's Fig. 16 study at
 /// σ = 6.7 µm, θ_P95 is 5.6 % lower at 1e-8 than at 1e-4 (the same 10,000 draws; 4.4 % with
 /// independent draws, beyond both intervals), and within 0.3 % of that from 1e-7 to 1e-10
-/// (the limit exists; a slow test checks it). Solves at 1e-8 take about twice the time. A job can set the ratio per case (`"compression_ratio": 1e-8` in its prism);
-/// whether the default should change for backlash models is an open modelling decision
-/// (REPRODUCTION.md, "Backlash").
+/// (the limit exists; a slow test checks it). Solves at 1e-8 take about twice the time. A
+/// job can set the ratio per case (`"compression_ratio": 1e-8` in its prism); whether the
+/// default should change for backlash models is an open modelling decision (REPRODUCTION.md,
+/// "Backlash").
 pub const DEFAULT_COMPRESSION_RATIO: f64 = 1e-4;
 
 /// The largest length error this model answers for, as a fraction of the member's natural

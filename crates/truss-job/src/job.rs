@@ -446,9 +446,9 @@ impl Job {
             {
                 parameters.insert("uniform".to_string(), 1.0);
             }
-            // Cases whose cables have another compression ratio than the default form their
-            // own series too (absent at the default, so the records of earlier jobs stay
-            // as they were).
+            // Cases whose cables have another compression ratio than the default (the first
+            // cable's: a prism gives all its diagonals one) form their own series too; absent
+            // at the default, so the records of earlier jobs stay as they were.
             let cable_ratio = model.members().iter().find_map(|m| match m.behaviour {
                 truss_core::Behaviour::Cable { compression_ratio } => Some(compression_ratio),
                 truss_core::Behaviour::Bar => None,
