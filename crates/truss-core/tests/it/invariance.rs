@@ -16,7 +16,7 @@ use crate::common::*;
 use proptest::prelude::*;
 use truss_core::model_file::ModelFile;
 use truss_core::prism::PrismOptions;
-use truss_core::{Model, SolveOptions, Solver};
+use truss_core::{DEFAULT_COMPRESSION_RATIO, Model, SolveOptions, Solver};
 
 const SIGMA: f64 = 0.0063;
 
@@ -266,12 +266,12 @@ fn theta_statistics(stages: usize, sigma: f64, n: usize, ratio: f64) -> [f64; 3]
     [t[n / 2], t[(0.95 * n as f64) as usize], rms]
 }
 
-/// Asserts that θ_P's statistics at each of `ratios` move from the default ratio's (1e-4)
+/// Asserts that θ_P's statistics at each of `ratios` move from the default ratio's
 /// by less than a tenth of the 95th percentile's standard error: about
 /// `√(p(1−p)/n)/(f(q)·q)` for a Rayleigh sample, 1.6 % at n = 1500, i.e. not beyond their
 /// own noise. Returns the largest relative move.
 fn assert_ratio_does_not_matter(stages: usize, sigma: f64, n: usize, ratios: &[f64]) -> f64 {
-    let base = theta_statistics(stages, sigma, n, 1e-4);
+    let base = theta_statistics(stages, sigma, n, DEFAULT_COMPRESSION_RATIO);
     let bound = 0.1 * 0.016 * (1500.0 / n as f64).sqrt();
     let mut worst: f64 = 0.0;
     for &ratio in ratios {
