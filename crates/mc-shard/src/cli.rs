@@ -34,7 +34,8 @@ pub struct Cli {
 pub enum Command {
     /// Validate a job and print its id, cases, sample count and a suggested split.
     Plan(PlanArgs),
-    /// Run one shard (from --range, --shard, or the Slurm/Kubernetes environment).
+    /// Run one shard (from --range, --shard, or a batch system's environment: Slurm, AWS
+    /// Batch, Google Cloud Batch, Kubernetes, or MC_SHARD_INDEX/MC_SHARD_COUNT).
     Run(RunArgs),
     /// Print the exact line a shard holds for one sample (with --detail, its draws,
     /// iterations, displacements and forces).
@@ -185,7 +186,8 @@ pub struct RunArgs {
     /// Run the global sample indices A..B.
     #[arg(long, value_name = "A..B")]
     pub range: Option<String>,
-    /// Number of shards, for JOB_COMPLETION_INDEX (default: $MC_SHARD_COUNT).
+    /// Number of shards, for JOB_COMPLETION_INDEX or MC_SHARD_INDEX (default:
+    /// $MC_SHARD_COUNT).
     #[arg(long)]
     pub shards: Option<u64>,
     /// Worker threads (default: all cores).
@@ -383,16 +385,11 @@ fn inputs_command(a: InputsArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let job = Job::read(&a.job)?;
     let case = match &a.case {
         None => None,
-        Some(name) => Some(job.case_named(name).ok_or_else(|| {
-            RunError::Usage(format!("no case {name:?} (cases: {})", case_names(&job)))
-        })?),
+        Some(name) => Some(crate::select::case_named(&job, name)?),
     };
     let range = match &a.range {
         None => shard_record::ShardRange::new(0, job.samples()),
-        Some(text) => text
-            .parse::<shard_record::ShardRange>()
-            .and_then(|r| r.within(job.samples()))
-            .map_err(|e| RunError::Usage(format!("--range: {e}")))?,
+        Some(text) => crate::select::range_within(&job, "--range", text)?,
     };
     let io = |source| {
         CliError::Run(RunError::Shard(ShardError::Io {
@@ -406,15 +403,6 @@ fn inputs_command(a: InputsArgs, out: &mut dyn Write) -> Result<(), CliError> {
     w.flush().map_err(io)?;
     writeln!(out, "{}: {rows} samples' inputs (mm)", a.out.display())?;
     Ok(())
-}
-
-/// The job's case names, comma-separated.
-fn case_names(job: &Job) -> String {
-    job.cases
-        .iter()
-        .map(|c| c.name.as_str())
-        .collect::<Vec<_>>()
-        .join(", ")
 }
 
 /// `mc-shard run`: one shard, crash-safe and resumable.
@@ -479,20 +467,8 @@ fn run_command(a: RunArgs, out: &mut dyn Write) -> Result<(), CliError> {
 /// `mc-shard reproduce`: one sample's line, or its detail.
 fn reproduce_command(a: ReproduceArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let job = Job::read(&a.job)?;
-    let c = job.case_named(&a.case).ok_or_else(|| {
-        RunError::Usage(format!(
-            "no case {:?} (cases: {})",
-            a.case,
-            case_names(&job)
-        ))
-    })?;
-    if a.sample >= job.cases[c].samples {
-        return Err(RunError::Usage(format!(
-            "case {:?} has samples 0..{}, not {}",
-            a.case, job.cases[c].samples, a.sample
-        ))
-        .into());
-    }
+    let c = crate::select::case_named(&job, &a.case)?;
+    crate::select::check_sample(&job, c, a.sample)?;
     out.write_all(crate::reproduce::reproduce(&job, c, a.sample, a.detail).as_bytes())?;
     Ok(())
 }

@@ -3,7 +3,8 @@
 //! Turns a job file (a model, a seed, and cases of length-error distributions; see
 //! [`job`]) into samples, solves each with [`truss_core`], and writes the results as a shard
 //! file in the JSON Lines format of [`shard_record`]. A 50,000-sample job can be split over
-//! any number of processes, machines, Slurm array tasks or cron runs and still give exactly
+//! any number of processes, machines, array tasks of a batch scheduler (Slurm, AWS Batch,
+//! Google Cloud Batch, Kubernetes, HTCondor) or cron runs and still give exactly
 //! the same numbers.
 //!
 //! ## Determinism

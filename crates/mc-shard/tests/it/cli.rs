@@ -7,11 +7,10 @@ use std::process::{Command, Output};
 
 fn mc_shard(args: &[&str], env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_mc-shard"));
-    c.args(args)
-        .env_remove("SLURM_ARRAY_TASK_ID")
-        .env_remove("SLURM_ARRAY_TASK_COUNT")
-        .env_remove("JOB_COMPLETION_INDEX")
-        .env_remove("MC_SHARD_COUNT");
+    c.args(args);
+    for k in mc_shard::select::VARIABLES {
+        c.env_remove(k);
+    }
     for (k, v) in env {
         c.env(k, v);
     }

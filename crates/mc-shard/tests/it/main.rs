@@ -10,6 +10,7 @@ mod interrupt;
 mod job;
 mod pool;
 mod sampling;
+mod schedulers;
 mod schema;
 mod verify;
 mod work;
