@@ -28,6 +28,144 @@ use shard_record::ShardRange;
 use std::collections::BTreeMap;
 use std::io::Write;
 
+/// The columns of the inputs of some cases of a job (see the module doc): the union of their
+/// member ids, then of the joint ids of those that draw clearances; and per case, where each
+/// of its members and joints goes. `mc-shard inputs` writes it as CSV, the Python package as
+/// a 2-D array, so both hold the same numbers.
+#[derive(Debug, Clone)]
+pub struct InputTable {
+    /// Member ids, the first columns.
+    pub members: Vec<String>,
+    /// Joint ids, the columns after the members'.
+    pub joints: Vec<String>,
+    /// Per case of the job: `None` when it is not in the table, else its stream key and each
+    /// of its members' and (drawn) joints' column.
+    cases: Vec<Option<CaseColumns>>,
+}
+
+/// A case's place in the table.
+#[derive(Debug, Clone)]
+struct CaseColumns {
+    key: [u8; 32],
+    members: Vec<usize>,
+    joints: Vec<usize>,
+}
+
+/// Scratch for [`InputTable::row`]: the draws of one sample.
+#[derive(Debug, Clone, Default)]
+pub struct Draws {
+    errors: Vec<f64>,
+    clearances: Vec<f64>,
+}
+
+impl InputTable {
+    /// The table of the samples of `job` in the global indices `range` (only case `case`'s,
+    /// if given).
+    pub fn new(job: &Job, case: Option<usize>, range: ShardRange) -> Self {
+        let chosen = |c: usize| {
+            let r = ShardRange::new(
+                job.cases[c].start,
+                job.cases[c].start + job.cases[c].samples,
+            );
+            case.is_none_or(|x| x == c) && r.start < range.end && range.start < r.end
+        };
+        let (mut members, mut joints) = (Vec::<String>::new(), Vec::<String>::new());
+        for (c, case) in job.cases.iter().enumerate().filter(|(c, _)| chosen(*c)) {
+            for m in case.model.members() {
+                if !members.contains(&m.id) {
+                    members.push(m.id.clone());
+                }
+            }
+            if job.cases[c].backlash.is_some() {
+                for j in case.model.joints() {
+                    if !joints.contains(&j.id) {
+                        joints.push(j.id.clone());
+                    }
+                }
+            }
+        }
+        let column = |ids: &[String]| -> BTreeMap<String, usize> {
+            ids.iter()
+                .enumerate()
+                .map(|(i, m)| (m.clone(), i))
+                .collect()
+        };
+        let (member_col, joint_col) = (column(&members), column(&joints));
+        let cases = (0..job.cases.len())
+            .map(|c| {
+                let case = &job.cases[c];
+                chosen(c).then(|| CaseColumns {
+                    key: stream_key(job.seed, &case.name),
+                    members: case
+                        .model
+                        .members()
+                        .iter()
+                        .map(|m| member_col[&m.id])
+                        .collect(),
+                    joints: if case.backlash.is_some() {
+                        case.model
+                            .joints()
+                            .iter()
+                            .map(|j| joint_col[&j.id])
+                            .collect()
+                    } else {
+                        Vec::new()
+                    },
+                })
+            })
+            .collect();
+        Self {
+            members,
+            joints,
+            cases,
+        }
+    }
+
+    /// The number of columns: members, then joints.
+    pub fn width(&self) -> usize {
+        self.members.len() + self.joints.len()
+    }
+
+    /// The CSV header's input columns: `length_error:ID` per member, `clearance:ID` per joint.
+    pub fn header(&self) -> Vec<String> {
+        let members = self.members.iter().map(|m| format!("length_error:{m}"));
+        members
+            .chain(self.joints.iter().map(|j| format!("clearance:{j}")))
+            .collect()
+    }
+
+    /// The inputs of sample `k` of case `c` \[mm\] into `row` ([`InputTable::width`] cells;
+    /// `None` where its model has no such member or joint, or its case draws no clearances).
+    /// Returns false, leaving `row` alone, when the case is not in the table.
+    pub fn row(
+        &self,
+        job: &Job,
+        c: usize,
+        k: u64,
+        draws: &mut Draws,
+        row: &mut [Option<f64>],
+    ) -> bool {
+        let Some(Some(columns)) = self.cases.get(c) else {
+            return false;
+        };
+        draw_sample(
+            &columns.key,
+            &job.cases[c],
+            k,
+            &mut draws.errors,
+            &mut draws.clearances,
+        );
+        row.fill(None);
+        for (&col, &e) in columns.members.iter().zip(&draws.errors) {
+            row[col] = Some(e);
+        }
+        for (&col, &e) in columns.joints.iter().zip(&draws.clearances) {
+            row[self.members.len() + col] = Some(e);
+        }
+        true
+    }
+}
+
 /// Writes the inputs of global indices `range` of `job` (only case `case`'s, if given) as
 /// CSV to `out`; returns the number of rows.
 pub fn write_inputs(
@@ -36,47 +174,9 @@ pub fn write_inputs(
     range: ShardRange,
     out: &mut dyn Write,
 ) -> std::io::Result<u64> {
-    let cases: Vec<usize> = (0..job.cases.len())
-        .filter(|&c| case.is_none_or(|x| x == c))
-        .filter(|&c| {
-            let r = ShardRange::new(
-                job.cases[c].start,
-                job.cases[c].start + job.cases[c].samples,
-            );
-            r.start < range.end && range.start < r.end
-        })
-        .collect();
-    // Columns: the union of member ids, then of joint ids (of cases drawing clearances).
-    let mut members: Vec<String> = Vec::new();
-    let mut joints: Vec<String> = Vec::new();
-    for &c in &cases {
-        let model = &job.cases[c].model;
-        for m in model.members() {
-            if !members.contains(&m.id) {
-                members.push(m.id.clone());
-            }
-        }
-        if job.cases[c].backlash.is_some() {
-            for j in model.joints() {
-                if !joints.contains(&j.id) {
-                    joints.push(j.id.clone());
-                }
-            }
-        }
-    }
-    let member_col: BTreeMap<&str, usize> = members
-        .iter()
-        .enumerate()
-        .map(|(i, m)| (m.as_str(), i))
-        .collect();
-    let joint_col: BTreeMap<&str, usize> = joints
-        .iter()
-        .enumerate()
-        .map(|(i, j)| (j.as_str(), i))
-        .collect();
+    let table = InputTable::new(job, case, range);
     let mut header = vec!["index".to_string(), "case".into(), "sample".into()];
-    header.extend(members.iter().map(|m| format!("length_error:{m}")));
-    header.extend(joints.iter().map(|j| format!("clearance:{j}")));
+    header.extend(table.header());
     writeln!(
         out,
         "{}",
@@ -86,43 +186,23 @@ pub fn write_inputs(
             .collect::<Vec<_>>()
             .join(",")
     )?;
-
-    let (mut errors, mut clearances) = (Vec::new(), Vec::new());
-    let mut row = Vec::new();
+    let mut draws = Draws::default();
+    let mut row = vec![None; table.width()];
     let mut rows = 0;
-    for &c in &cases {
-        let case = &job.cases[c];
-        let key = stream_key(job.seed, &case.name);
-        let from = range.start.max(case.start) - case.start;
-        let to = range.end.min(case.start + case.samples) - case.start;
-        // Each member's and joint's column in this case's model.
-        let m_cols: Vec<usize> = case
-            .model
-            .members()
-            .iter()
-            .map(|m| member_col[m.id.as_str()])
-            .collect();
-        let j_cols: Vec<usize> = if case.backlash.is_some() {
-            case.model
-                .joints()
-                .iter()
-                .map(|j| joint_col[j.id.as_str()])
-                .collect()
-        } else {
-            Vec::new()
-        };
+    for (c, case) in job.cases.iter().enumerate() {
+        let from = range.start.max(case.start);
+        let to = range.end.min(case.start + case.samples);
         let name = csv_field(&case.name);
-        for k in from..to {
-            draw_sample(&key, case, k, &mut errors, &mut clearances);
-            row.clear();
-            row.resize(members.len() + joints.len(), String::new());
-            for (&col, e) in m_cols.iter().zip(&errors) {
-                row[col] = e.to_string();
+        for index in from..to {
+            let k = index - case.start;
+            if !table.row(job, c, k, &mut draws, &mut row) {
+                break;
             }
-            for (&col, e) in j_cols.iter().zip(&clearances) {
-                row[members.len() + col] = e.to_string();
-            }
-            writeln!(out, "{},{name},{k},{}", case.start + k, row.join(","))?;
+            let cells: Vec<String> = row
+                .iter()
+                .map(|v| v.map_or(String::new(), |e| e.to_string()))
+                .collect();
+            writeln!(out, "{index},{name},{k},{}", cells.join(","))?;
             rows += 1;
         }
     }

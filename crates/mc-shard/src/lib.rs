@@ -46,6 +46,9 @@
 //! in full before it is skipped; a shard is resumed or skipped only if its header matches
 //! the job (id, range, cases and their parameters). `audit` checks the numbers themselves.
 //!
+//! In memory, [`batch::solve_range`] solves a range on T threads and hands the records back in
+//! index order (the Python package `truss_mc` runs jobs through it).
+//!
 //! Running every shard on one machine and merging (`truss-mc run-all`) lives in the crate
 //! above both runner and merge, `truss-mc`: this crate, the worker that runs on every
 //! cluster node, links neither the merge nor an async runtime.
@@ -61,6 +64,7 @@
 //! finished sample kept ([`interrupt`]).
 
 pub mod audit;
+pub mod batch;
 pub mod cli;
 pub mod errors;
 pub mod inputs;

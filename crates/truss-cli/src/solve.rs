@@ -94,16 +94,9 @@ pub fn parse_length_errors(model: &Model, specs: &[String]) -> Result<Vec<f64>, 
                  (--length-error {first:?}); give each member once"
             )));
         }
-        let max = model.max_length_error(m);
-        if v.abs() > max {
-            return Err(CliError::Usage(format!(
-                "--length-error {spec:?}: {v} mm is more than {}% of the member's natural \
-                 length {} mm ({max} mm), beyond the elastic range where the model means \
-                 anything",
-                100.0 * truss_core::MAX_LENGTH_ERROR_FRACTION,
-                model.members()[m].natural_length
-            )));
-        }
+        model
+            .check_length_error(m, v)
+            .map_err(|e| CliError::Usage(format!("--length-error {spec:?}: {e}")))?;
         given[m] = Some(spec.as_str());
         errors[m] = v;
     }

@@ -238,6 +238,25 @@ impl Model {
         self.members[m].natural_length / MAX_LENGTH_ERROR_FRACTION.recip()
     }
 
+    /// Checks a length error `value` \[mm\] for member `m`: finite and within
+    /// [`Model::max_length_error`]; the message says why not (the tools prefix the flag or
+    /// key that gave it).
+    pub fn check_length_error(&self, m: usize, value: f64) -> Result<(), String> {
+        if !value.is_finite() {
+            return Err(format!("{value} is not a finite number of mm"));
+        }
+        let max = self.max_length_error(m);
+        if value.abs() > max {
+            return Err(format!(
+                "{value} mm is more than {}% of the member's natural length {} mm ({max} mm), \
+                 beyond the elastic range where the model means anything",
+                100.0 * MAX_LENGTH_ERROR_FRACTION,
+                self.members[m].natural_length
+            ));
+        }
+        Ok(())
+    }
+
     /// The nodes.
     pub fn nodes(&self) -> &[Node] {
         &self.nodes

@@ -192,25 +192,10 @@ impl ModelSpec {
                         .as_str()
                         .map(|f| ModelSpec::File(PathBuf::from(f)))
                         .ok_or_else(|| JobError::at(&format!("{path}.file"), "expected a path")),
-                    "prism" => {
-                        let at = format!("{path}.prism");
-                        let options: PrismOptions = serde_path_to_error::deserialize(inner)
-                            .map_err(|e| {
-                                let sub = e.path().to_string();
-                                JobError::at(
-                                    &if sub == "." {
-                                        at.clone()
-                                    } else {
-                                        format!("{at}.{sub}")
-                                    },
-                                    &e.into_inner().to_string(),
-                                )
-                            })?;
-                        options
-                            .check()
-                            .map_err(|(field, m)| JobError::at(&format!("{at}.{field}"), &m))?;
-                        Ok(ModelSpec::Prism(options))
-                    }
+                    "prism" => Ok(ModelSpec::Prism(parse_prism(
+                        inner,
+                        &format!("{path}.prism"),
+                    )?)),
                     _ => Err(bad()),
                 }
             }
@@ -225,6 +210,26 @@ impl ModelSpec {
             other => other,
         }
     }
+}
+
+/// Parses a prism's options as a job writes them (`{"stages": 5, …}`, see
+/// [`truss_core::prism_spec`]) and checks them, naming faults by their JSON path under `at`.
+pub fn parse_prism(value: &serde_json::Value, at: &str) -> Result<PrismOptions, JobError> {
+    let options: PrismOptions = serde_path_to_error::deserialize(value).map_err(|e| {
+        let sub = e.path().to_string();
+        JobError::at(
+            &if sub == "." {
+                at.to_string()
+            } else {
+                format!("{at}.{sub}")
+            },
+            &e.into_inner().to_string(),
+        )
+    })?;
+    options
+        .check()
+        .map_err(|(field, m)| JobError::at(&format!("{at}.{field}"), &m))?;
+    Ok(options)
 }
 
 impl JobSpec {
