@@ -1,0 +1,142 @@
+//! Reading shard files back as columns: every file verified as the merge verifies it
+//! (`shard_record::read_shard`: each line's form and place, every checkpoint, the end
+//! line's digests), one job across the files, and an index present in two files only if its
+//! lines are identical; the samples in index order, each field of the sample lines a column
+//! ([`crate::columns`]). With `partial`, an incomplete file (a run still going, or stopped)
+//! gives the lines its last checkpoint verifies.
+
+use crate::columns::Table;
+use crate::errors::{Failure, Kind};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use shard_record::{Begin, Record, parse_record, read_shard, scan_shard};
+use std::hash::{DefaultHasher, Hasher};
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+
+/// The begin line of `path`, if it reads and parses (the full read reports any fault).
+fn header(path: &Path) -> Option<Begin> {
+    let mut line = Vec::new();
+    let file = std::fs::File::open(path).ok()?;
+    std::io::BufReader::new(file)
+        .read_until(b'\n', &mut line)
+        .ok()?;
+    match parse_record(&line) {
+        Ok(Record::Begin(b)) => Some(b),
+        _ => None,
+    }
+}
+
+/// A 64-bit fingerprint of a line's bytes (SipHash with fixed keys: the same in every run).
+fn fingerprint(line: &[u8]) -> u64 {
+    let mut h = DefaultHasher::new();
+    h.write(line);
+    h.finish()
+}
+
+/// What the files hold: the first file's header and the samples as columns.
+struct Read {
+    begin: Begin,
+    table: Table,
+}
+
+/// Reads `files` (see the module doc).
+fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
+    if files.is_empty() {
+        return Err(Failure::new(Kind::Usage, "no shard files given"));
+    }
+    let mut order: Vec<(u64, &PathBuf)> = files
+        .iter()
+        .map(|f| (header(f).map_or(0, |b| b.range.start), f))
+        .collect();
+    order.sort();
+    let mut table = Table::new();
+    // (index, fingerprint, file) of every sample taken, in index order.
+    let mut taken: Vec<(u64, u64, usize)> = Vec::new();
+    let mut first: Option<(Begin, &PathBuf)> = None;
+    for (n, (_, path)) in order.iter().enumerate() {
+        let visit = |index: u64, _: &shard_record::Sample, line: &[u8]| {
+            let fp = fingerprint(line);
+            if let Some(&(last, _, _)) = taken.last()
+                && index <= last
+            {
+                let at = taken.partition_point(|t| t.0 < index);
+                return match taken.get(at) {
+                    Some(&(i, f, other)) if i == index && f != fp => Err(format!(
+                        "index {index} differs from its line in {} (overlapping shards disagree)",
+                        order[other].1.display()
+                    )),
+                    _ => Ok(()),
+                };
+            }
+            let record: serde_json::Map<String, serde_json::Value> =
+                serde_json::from_slice(line).map_err(|e| format!("not a JSON object: {e}"))?;
+            table.push(&record);
+            taken.push((index, fp, n));
+            Ok(())
+        };
+        let scan = if partial {
+            scan_shard(path, visit)
+        } else {
+            read_shard(path, visit)
+        }
+        .map_err(Failure::from)?;
+        match &first {
+            None => first = Some((scan.begin, path)),
+            Some((begin, first_path))
+                if (&begin.job_id, begin.job_samples, &begin.cases)
+                    != (
+                        &scan.begin.job_id,
+                        scan.begin.job_samples,
+                        &scan.begin.cases,
+                    ) =>
+            {
+                return Err(Failure::new(
+                    Kind::Verification,
+                    format!(
+                        "{}: a shard of job {} ({} samples), but {} is of job {} ({} samples): \
+                         shards of two jobs",
+                        path.display(),
+                        scan.begin.job_id,
+                        scan.begin.job_samples,
+                        first_path.display(),
+                        begin.job_id,
+                        begin.job_samples
+                    ),
+                ));
+            }
+            Some(_) => {}
+        }
+    }
+    let (begin, _) = first.expect("at least one file was read");
+    Ok(Read { begin, table })
+}
+
+/// Reads shard files (see the module doc): returns `job_id`, `job_samples`, `cases` (as the
+/// headers list them: `name`, `start`, `samples`, `parameters`) and `columns`.
+#[pyfunction]
+#[pyo3(signature = (files, partial = false))]
+pub fn read_shard_files<'py>(
+    py: Python<'py>,
+    files: Vec<PathBuf>,
+    partial: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let read = py.detach(|| read(&files, partial))?;
+    let out = PyDict::new(py);
+    out.set_item("job_id", &read.begin.job_id)?;
+    out.set_item("job_samples", read.begin.job_samples)?;
+    let cases = read.begin.cases.iter().map(|c| {
+        let d = PyDict::new(py);
+        d.set_item("name", &c.name)?;
+        d.set_item("start", c.start)?;
+        d.set_item("samples", c.samples)?;
+        d.set_item("parameters", c.parameters.clone())?;
+        Ok(d)
+    });
+    out.set_item(
+        "cases",
+        PyList::new(py, cases.collect::<PyResult<Vec<_>>>()?)?,
+    )?;
+    out.set_item("columns", read.table.to_python(py)?)?;
+    Ok(out)
+}
