@@ -7,7 +7,10 @@
 #    verification, property and CLI tests of every crate and the cross-crate pipeline
 #    (tests/), then the slow statistical checks that the default run ignores
 #    (cargo test --release -- --ignored).
-# 2. The release binaries, then the end-to-end checks with real parts:
+# 2. The release binaries, then the Python package: built into target/py-venv with
+#    `maturin develop --release` (the workspace's target/release, shared with the binaries)
+#    and its pytest tests, which compare its numbers with the release binaries' bytes.
+# 3. The end-to-end checks with real parts:
 #    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
 #      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted;
 #    - scripts/smoke-test.sh: the README's main command on a small job, and its SVG plots
@@ -20,7 +23,7 @@ cd "$REPO"
 # where its time went.
 phase() { echo "test: $1 (at ${SECONDS} s)" >&2; }
 
-command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && [ -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] || scripts/setup.sh
+command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && [ -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] && [ -x target/py-venv/bin/maturin ] || scripts/setup.sh
 
 phase "cargo test --workspace (without the png feature)"
 # Without mc-merge's default feature png: resvg's build is about 90 s of CPU in the debug
@@ -36,6 +39,14 @@ done
 
 phase "release binaries"
 cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-mc
+
+phase "Python package: maturin develop --release, then pytest"
+(
+    # shellcheck disable=SC1091
+    . target/py-venv/bin/activate
+    maturin develop --release --quiet
+    python -m pytest python/tests -q
+)
 
 phase "Slurm end to end"
 scripts/slurm/e2e-test.sh

@@ -5,9 +5,9 @@
 //! Workers take chunks of consecutive indices from a shared counter and send each finished
 //! chunk to the calling thread, which hands the chunks to `take` in index order. The order of
 //! what `take` sees, and each sample's record, depend only on the job and the range, never
-//! on the thread count. While it waits, the calling thread calls `take(None)` at least every
-//! [`TICK`], so a caller can check for an interrupt; an error from `take` stops the workers
-//! before their next sample and is returned.
+//! on the thread count. Between chunks, and while it waits for one, the calling thread calls
+//! `take(None)` once every [`TICK`], so a caller can check for an interrupt; an error from
+//! `take` stops the workers before their next sample and is returned.
 
 use crate::job::Job;
 use crate::worker::Worker;
@@ -15,12 +15,12 @@ use shard_record::ShardRange;
 use std::collections::BTreeMap;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{RecvTimeoutError, sync_channel};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// Indices a worker takes at a time (as the runner's chunks: few wakeups of the caller).
 const CHUNK: u64 = 64;
 
-/// The longest the calling thread waits without calling `take(None)`.
+/// How often the calling thread calls `take(None)` (as long as the run lasts).
 pub const TICK: Duration = Duration::from_millis(100);
 
 /// Solves the indices `range` of `job` on `threads` threads; `each` turns a worker and an
@@ -71,7 +71,14 @@ pub fn solve_range<T: Send, E>(
         drop(tx);
         let mut pending: BTreeMap<u64, Vec<T>> = BTreeMap::new();
         let mut expect = range.start;
+        let mut ticked = Instant::now();
         let result = loop {
+            if ticked.elapsed() >= TICK {
+                ticked = Instant::now();
+                if let Err(e) = take(None) {
+                    break Err(e);
+                }
+            }
             match rx.recv_timeout(TICK) {
                 Ok((start, chunk)) => {
                     pending.insert(start, chunk);
@@ -87,11 +94,7 @@ pub fn solve_range<T: Send, E>(
                         break Err(e);
                     }
                 }
-                Err(RecvTimeoutError::Timeout) => {
-                    if let Err(e) = take(None) {
-                        break Err(e);
-                    }
-                }
+                Err(RecvTimeoutError::Timeout) => {}
                 Err(RecvTimeoutError::Disconnected) => break Ok(()),
             }
         };

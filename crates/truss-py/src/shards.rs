@@ -55,7 +55,8 @@ fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
     let mut taken: Vec<(u64, u64, usize)> = Vec::new();
     let mut first: Option<(Begin, &PathBuf)> = None;
     for (n, (_, path)) in order.iter().enumerate() {
-        let visit = |index: u64, _: &shard_record::Sample, line: &[u8]| {
+        let visit = |_line_number: u64, sample: &shard_record::Sample, line: &[u8]| {
+            let index = sample.index;
             let fp = fingerprint(line);
             if let Some(&(last, _, _)) = taken.last()
                 && index <= last

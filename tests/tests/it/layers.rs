@@ -6,7 +6,9 @@
 //! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
 //! - the solver links nothing of ours; nor do the statistics and the wire format;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
-//! - the tolerance study links the solver, the job and the statistics, and nothing else of ours.
+//! - the tolerance study links the solver, the job and the statistics, and nothing else of ours;
+//! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
+//!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -72,10 +74,11 @@ fn dependencies_point_one_way() {
         "mc-shard",
         "mc-merge",
         "truss-tolerance",
+        "truss-py",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
     }
-    let forbidden: [(&str, &[&str]); 6] = [
+    let forbidden: [(&str, &[&str]); 7] = [
         (
             "mc-shard",
             &["mc-merge", "tokio", "plotters", "statrs", "truss-stats"],
@@ -87,6 +90,17 @@ fn dependencies_point_one_way() {
         (
             "truss-diagnose",
             &["mc-shard", "mc-merge", "shard-record", "truss-mc"],
+        ),
+        (
+            "truss-py",
+            &[
+                "mc-merge",
+                "truss-mc",
+                "truss-diagnose",
+                "truss-tolerance",
+                "truss-stats",
+                "tokio",
+            ],
         ),
     ];
     for (package, banned) in forbidden {

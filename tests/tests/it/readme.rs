@@ -12,6 +12,9 @@
 //! - Scripts (`scripts/…`): the file exists, is executable, and names every flag used.
 //! - `kubectl … -f FILE`: the file exists. `cargo run … -p BIN -- ARGS` runs as `BIN ARGS`;
 //!   other `cargo` lines are not checked.
+//! - Other schedulers' clients (`aws`, `gcloud`, `condor_submit_dag`): every file of `jobs/`
+//!   they name (also as `file://…` or `--config=…`) exists. `pip install .`: the
+//!   repository's root has the `pyproject.toml` it builds (the Python tests install it).
 //!
 //! The binaries are the ones `cargo test --workspace` builds beside this test's executable
 //! (`target/debug`); run alone (`cargo test -p pipeline-tests`) with them missing, the test
@@ -232,6 +235,25 @@ fn readme_commands_run() {
             if let Some(at) = words.iter().position(|w| w == "-f") {
                 assert!(root().join(&words[at + 1]).exists(), "{command}");
             }
+        } else if ["aws", "gcloud", "condor_submit_dag"].contains(&first) {
+            let files: Vec<&str> = words
+                .iter()
+                .map(|w| {
+                    w.trim_start_matches("file://")
+                        .trim_start_matches("--config=")
+                })
+                .filter(|w| w.starts_with("jobs/"))
+                .collect();
+            assert!(
+                !files.is_empty(),
+                "README: `{command}` names no file of jobs/"
+            );
+            for f in files {
+                assert!(root().join(f).is_file(), "README: `{command}`: no {f}");
+            }
+        } else if first == "pip" {
+            assert_eq!(words[1..], ["install", "."], "README: `{command}`");
+            assert!(root().join("pyproject.toml").is_file());
         } else if let Some(bin) = cargo_run(&words) {
             // `cargo run --release -p BIN -- ARGS` runs BIN ARGS (the binary is built here).
             let at = words
