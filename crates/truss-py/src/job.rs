@@ -170,24 +170,29 @@ impl PyJob {
             let mut samples = Table::new();
             let mut values = Vec::new();
             let each = |w: &mut mc_shard::worker::Worker<'_>, i: u64| {
-                let record = match serde_json::to_value(w.sample(i)) {
-                    Ok(serde_json::Value::Object(m)) => Ok(m),
-                    other => Err(format!(
-                        "sample {i}'s record is not a JSON object: {other:?}"
-                    )),
-                };
+                // The shard line's bytes, read back into columns on the calling thread: a
+                // worker allocates little that another thread frees (the allocator's
+                // arenas would be contended).
+                let mut line = Vec::with_capacity(256);
+                w.sample(i).write_line(&mut line);
                 let row = table.as_ref().map(|t| {
                     let mut v = Vec::with_capacity(t.width());
                     let mut row = vec![None; t.width()];
                     push_row(&job, t, i, &mut Draws::default(), &mut row, &mut v);
                     v
                 });
-                (record, row)
+                (line, row)
             };
             mc_shard::batch::solve_range(&job, range, threads, each, |chunk| match chunk {
                 Some(chunk) => {
-                    for (record, row) in chunk {
-                        samples.push(&record.map_err(PyRuntimeError::new_err)?);
+                    for (line, row) in chunk {
+                        let record: serde_json::Map<String, serde_json::Value> =
+                            serde_json::from_slice(&line).map_err(|e| {
+                                PyRuntimeError::new_err(format!(
+                                    "a sample line does not read back: {e}"
+                                ))
+                            })?;
+                        samples.push(&record);
                         values.extend(row.unwrap_or_default());
                     }
                     Ok(())
