@@ -7,9 +7,9 @@ number comes from the same Rust code as the command-line tools, so it equals wha
 bit for bit; errors are :mod:`truss_mc.errors` exceptions with the tools' messages. Units:
 mm, N, MPa, rad.
 
->>> import truss_mc
->>> s = truss_mc.solve(truss_mc.prism(stages=5), {"longeron.1.0": 0.01})
->>> s.theta_p  # rad
+    import truss_mc
+    s = truss_mc.solve(truss_mc.prism(stages=5), {"longeron.1.0": 0.01})
+    s.theta_p  # rad
 """
 
 from __future__ import annotations

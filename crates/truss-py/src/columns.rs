@@ -235,6 +235,23 @@ impl Table {
     }
 }
 
+/// Cases as the shard header lists them, for Python: dicts of `name`, `start` (the global
+/// index of the first sample), `samples` and `parameters`.
+pub fn cases<'py>(
+    py: Python<'py>,
+    cases: impl Iterator<Item = shard_record::CaseInfo>,
+) -> PyResult<Bound<'py, PyList>> {
+    let dicts = cases.map(|c| {
+        let d = pyo3::types::PyDict::new(py);
+        d.set_item("name", c.name)?;
+        d.set_item("start", c.start)?;
+        d.set_item("samples", c.samples)?;
+        d.set_item("parameters", c.parameters)?;
+        Ok(d)
+    });
+    PyList::new(py, dicts.collect::<PyResult<Vec<_>>>()?)
+}
+
 /// Python bytes of the concatenated little-endian encodings `parts`.
 pub fn bytes<'py, const N: usize>(
     py: Python<'py>,

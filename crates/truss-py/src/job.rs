@@ -126,15 +126,13 @@ impl PyJob {
     /// `parameters` (as the shard header writes them).
     #[getter]
     fn cases<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let cases = self.job.cases.iter().map(|c| {
-            let d = PyDict::new(py);
-            d.set_item("name", &c.name)?;
-            d.set_item("start", c.start)?;
-            d.set_item("samples", c.samples)?;
-            d.set_item("parameters", c.parameters.clone())?;
-            Ok(d)
+        let info = self.job.cases.iter().map(|c| shard_record::CaseInfo {
+            name: c.name.clone(),
+            start: c.start,
+            samples: c.samples,
+            parameters: c.parameters.clone(),
         });
-        PyList::new(py, cases.collect::<PyResult<Vec<_>>>()?)
+        crate::columns::cases(py, info)
     }
 
     /// The model of case `case`.

@@ -8,7 +8,7 @@
 use crate::columns::Table;
 use crate::errors::{Failure, Kind};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::PyDict;
 use shard_record::{Begin, Record, parse_record, read_shard, scan_shard};
 use std::hash::{DefaultHasher, Hasher};
 use std::io::BufRead;
@@ -126,17 +126,9 @@ pub fn read_shard_files<'py>(
     let out = PyDict::new(py);
     out.set_item("job_id", &read.begin.job_id)?;
     out.set_item("job_samples", read.begin.job_samples)?;
-    let cases = read.begin.cases.iter().map(|c| {
-        let d = PyDict::new(py);
-        d.set_item("name", &c.name)?;
-        d.set_item("start", c.start)?;
-        d.set_item("samples", c.samples)?;
-        d.set_item("parameters", c.parameters.clone())?;
-        Ok(d)
-    });
     out.set_item(
         "cases",
-        PyList::new(py, cases.collect::<PyResult<Vec<_>>>()?)?,
+        crate::columns::cases(py, read.begin.cases.into_iter())?,
     )?;
     out.set_item("columns", read.table.to_python(py)?)?;
     Ok(out)
