@@ -140,7 +140,7 @@ class Solution:
 
     def displacement(self, node_id: str) -> np.ndarray:
         """The displacement [mm] of node ``node_id``."""
-        return self.displacements[self.node_ids.index(node_id)]
+        return np.asarray(self.displacements[self.node_ids.index(node_id)])
 
     def force(self, member_id: str) -> float:
         """The axial force [N] of member ``member_id``."""

@@ -56,7 +56,7 @@ class Inputs:
         return self.values[:, len(self.member_ids) :]
 
     def __len__(self) -> int:
-        return self.values.shape[0]
+        return int(self.values.shape[0])
 
     def to_pandas(self) -> Any:
         """A pandas DataFrame with ``mc-shard inputs``' columns (needs pandas)."""
@@ -105,13 +105,13 @@ class Samples:
     @property
     def converged(self) -> np.ndarray:
         """Whether each sample converged."""
-        return self._columns["status"] == "converged"
+        return np.asarray(self._columns["status"] == "converged", dtype=bool)
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self._columns[name]
 
     def __getattr__(self, name: str) -> np.ndarray:
-        columns = self.__dict__.get("_columns", {})
+        columns: Dict[str, np.ndarray] = self.__dict__.get("_columns", {})
         if name in columns:
             return columns[name]
         raise AttributeError(f"no field {name!r} (fields: {', '.join(columns)})")
