@@ -9,8 +9,8 @@
 #   (the font mc-merge's own PNG rendering and rsvg-convert draw text with).
 # - A Python virtual environment for the Python package's tests, target/py-venv (under the
 #   git-ignored target/), with the pinned tools of python/requirements-test.txt (maturin,
-#   pytest, numpy) from PyPI; then, if PyPI has wheels for this Python, the optional ones of
-#   python/requirements-optional.txt (pandas, OpenTURNS), whose tests skip without them.
+#   pytest, numpy) from PyPI; then, if PyPI has a wheel for this Python, OpenTURNS
+#   (python/requirements-optional.txt), without which the example's test is skipped.
 #   Debian's python3-venv is installed if python3 cannot make a virtual environment.
 # - Nothing else: the Rust toolchain comes with the machine; crates come from crates.io
 #   when cargo builds (Cargo.lock pins them).
@@ -49,6 +49,6 @@ fi
 "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check -r "$REPO/python/requirements-test.txt"
 "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check --only-binary=:all: \
     -r "$REPO/python/requirements-optional.txt" \
-    || echo "setup: pandas or OpenTURNS has no wheel for this Python; their tests will be skipped" >&2
+    || echo "setup: OpenTURNS has no wheel for this Python; the example's test will be skipped" >&2
 echo "setup: Python environment in $VENV" >&2
 echo "setup: done" >&2

@@ -69,7 +69,11 @@ def test_ctrl_c_stops_a_run() -> None:
 
 
 def test_pandas_when_installed(small_job: Path) -> None:
-    pandas = pytest.importorskip("pandas", reason="pandas is not installed (truss_mc does not need it)")
+    pandas = pytest.importorskip(
+        "pandas",
+        reason="pandas is not installed (truss_mc does not need it, scripts/setup.sh does not "
+        "install it): target/py-venv/bin/pip install pandas to run this test",
+    )
     samples = truss_mc.Job.from_file(small_job).run("normal", inputs=True)
     frame = samples.to_pandas()
     assert list(frame.columns) == samples.fields
