@@ -7,5 +7,6 @@ mod export;
 mod plots;
 mod report_dir;
 mod schema;
+mod shared_dir;
 mod statistics;
 mod sweep;
