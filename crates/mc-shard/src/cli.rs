@@ -306,6 +306,7 @@ pub fn run_exit_code(e: &RunError) -> u8 {
         }
         RunError::Job(_) => exit::INVALID_INPUT,
         RunError::Shard(ShardError::Io { .. }) => exit::IO,
+        RunError::Shard(ShardError::Files(e)) => e.exit_code(),
         RunError::Shard(_) => exit::IN_THE_WAY,
     }
 }
@@ -400,10 +401,11 @@ fn inputs_command(a: InputsArgs, out: &mut dyn Write) -> Result<(), CliError> {
             source,
         }))
     };
-    let file = std::fs::File::create(&a.out).map_err(io)?;
-    let mut w = std::io::BufWriter::new(file);
+    // Written whole or not at all: a full disk leaves the old file at its name.
+    let files = |e: run_dir::RunDirError| CliError::Run(RunError::Shard(e.into()));
+    let mut w = run_dir::OutputFile::create(&a.out).map_err(files)?;
     let rows = crate::inputs::write_inputs(&job, case, range, &mut w).map_err(io)?;
-    w.flush().map_err(io)?;
+    w.commit().map_err(files)?;
     writeln!(out, "{}: {rows} samples' inputs (mm)", a.out.display())?;
     Ok(())
 }

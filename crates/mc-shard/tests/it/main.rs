@@ -11,5 +11,6 @@ mod job;
 mod pool;
 mod sampling;
 mod schema;
+mod shared_dir;
 mod verify;
 mod work;
