@@ -100,6 +100,9 @@ impl Error {
 
 /// Runs a command, writing its report to `out`; progress goes to stderr.
 pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
+    if let Command::Shard(mc_shard::cli::Command::Run(_)) = &cli.command {
+        crate::run_all::die_with_parent();
+    }
     match cli.command {
         Command::Shard(mc_shard::cli::Command::Completions(a)) => {
             let mut cmd = <Cli as clap::CommandFactory>::command();

@@ -352,3 +352,144 @@ fn run_all_stops_its_workers_on_sigterm_and_resumes() {
         "resumed lines differ"
     );
 }
+
+/// `kill -9` of `run-all` (as the out-of-memory killer sends it): its shard processes stop
+/// too (a parent-death signal gives them SIGTERM, so each keeps its finished lines), and
+/// no shard stays locked, so a rerun is not told a file is in the way.
+#[test]
+fn run_all_killed_leaves_no_worker_running() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    // 100,000 samples of a 30-stage truss per shard: far longer than the test waits.
+    let job = write(
+        dir.path(),
+        "job.json",
+        r#"{"model": {"prism": {"stages": 30}}, "seed": 12, "cases": [
+  {"name": "normal", "samples": 200000,
+   "length_errors": {"batten": {"normal": {"sigma": 0.0063}},
+                     "longeron": {"normal": {"sigma": 0.0063}}}}]}"#,
+    );
+    let out = dir.path().join("all");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_truss-mc"))
+        .args(["run-all", "--job", job.to_str().unwrap(), "--out"])
+        .arg(&out)
+        .args(["--shards", "2", "--workers", "2", "--quiet", "--no-merge"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let pid = child.id();
+    let started = Instant::now();
+    let workers = loop {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "run-all ended too soon"
+        );
+        let workers = children_of(pid);
+        if workers.len() == 2 && sample_lines(&out).len() > 200 {
+            break workers;
+        }
+        assert!(started.elapsed() < Duration::from_secs(120), "no workers");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while workers.iter().any(|w| alive(*w)) && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let survivors: Vec<u32> = workers.iter().copied().filter(|w| alive(*w)).collect();
+    for w in &survivors {
+        let _ = Command::new("kill").args(["-9", &w.to_string()]).status();
+    }
+    assert!(
+        survivors.is_empty(),
+        "workers {survivors:?} outlived run-all"
+    );
+    // Every shard's lock is free, and each kept its lines (a stop checkpoint).
+    for entry in std::fs::read_dir(&out).unwrap().flatten() {
+        let f = std::fs::File::open(entry.path()).unwrap();
+        f.try_lock().expect("no shard stays locked");
+    }
+    let status = truss_mc(
+        &[
+            "status",
+            "--job",
+            job.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--shards",
+            "2",
+        ],
+        &[],
+    );
+    let text = String::from_utf8_lossy(&status.stdout);
+    assert_eq!(text.matches(": partial (").count(), 2, "{text}");
+}
+
+/// A shard locked by a live process: `run-all` says to wait for it or stop it, with its pid,
+/// not to move the file away (exit 5).
+#[test]
+fn run_all_advice_for_a_live_lock_is_to_wait() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "job.json", &small_job(10));
+    let out = dir.path().join("o");
+    std::fs::create_dir_all(&out).unwrap();
+    let held = std::fs::File::create(out.join("shard-0000000000-0000000020.jsonl")).unwrap();
+    held.lock().unwrap();
+    let r = truss_mc(
+        &[
+            "run-all",
+            "--job",
+            job.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--shards",
+            "1",
+            "-q",
+        ],
+        &[],
+    );
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(5), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "another process is writing this shard (pid {}): wait for it or stop it",
+            std::process::id()
+        )),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("move it away"), "{stderr}");
+}
+
+/// `DIR/report` a symbolic link: refused before any shard runs (exit 5), naming it; where
+/// it points stays empty.
+#[test]
+fn run_all_refuses_a_linked_report_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "job.json", &small_job(10));
+    let out = dir.path().join("o");
+    std::fs::create_dir_all(&out).unwrap();
+    let elsewhere = dir.path().join("elsewhere");
+    std::fs::create_dir(&elsewhere).unwrap();
+    std::os::unix::fs::symlink(&elsewhere, out.join("report")).unwrap();
+    let r = truss_mc(
+        &[
+            "run-all",
+            "--job",
+            job.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "-q",
+        ],
+        &[],
+    );
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(5), "{stderr}");
+    assert!(
+        stderr.contains(&out.join("report").display().to_string()),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_dir(&elsewhere).unwrap().count(), 0);
+    assert!(sample_lines(&out).is_empty(), "nothing ran");
+}
