@@ -220,6 +220,12 @@ impl Model {
             &loads,
             top_surface.as_ref(),
         )?;
+        let play: f64 = joints.iter().map(|j| j.clearance).sum();
+        for (i, m) in members.iter().enumerate() {
+            let length = distance(nodes[m.nodes[0]].xyz, nodes[m.nodes[1]].xyz);
+            let item = format!("members[{i}] (id {:?})", m.id);
+            check_initial_strain(&item, m.natural_length, length, play)?;
+        }
         Ok(Self {
             nodes,
             members,
@@ -517,6 +523,53 @@ fn check_member(
         youngs_modulus,
         natural_length,
         behaviour,
+    })
+}
+
+/// Whether a member of natural length `natural` \[mm\] between nodes `length` \[mm\] apart
+/// can start within the elastic range: `|length − natural| ≤ natural ×`
+/// [`MAX_LENGTH_ERROR_FRACTION`] `+ play`, the bound a length error has
+/// ([`Model::max_length_error`]) widened by `play` \[mm\], the model's joint clearances
+/// summed. Free play moves each hole by at most its clearance from its shaft, so the
+/// distance between any two nodes once it is taken up is within that sum of the nominal one
+/// (0 without joints: the bound is then exact). Beyond it the initial strain
+/// `(length − natural)/natural` could only be taken up by yielding, which the model does not
+/// represent.
+pub fn initial_strain_allowed(natural: f64, length: f64, play: f64) -> bool {
+    (natural - length).abs() <= natural / MAX_LENGTH_ERROR_FRACTION.recip() + play
+}
+
+/// Refuses member `item`'s natural length beyond [`initial_strain_allowed`].
+fn check_initial_strain(
+    item: &str,
+    natural: f64,
+    length: f64,
+    play: f64,
+) -> Result<(), ModelError> {
+    if initial_strain_allowed(natural, length, play) {
+        return Ok(());
+    }
+    let max = natural / MAX_LENGTH_ERROR_FRACTION.recip() + play;
+    Err(ModelError::Invalid {
+        item: item.to_string(),
+        message: format!(
+            "natural_length {} mm differs from the distance between its nodes, {} mm, by more \
+             than {}% of it{} ({} mm): an initial strain beyond the elastic range, where the \
+             model means nothing (see truss_core::MAX_LENGTH_ERROR_FRACTION); a member that \
+             long is another design, to be drawn with its own node positions",
+            crate::readable(natural),
+            crate::readable(length),
+            100.0 * MAX_LENGTH_ERROR_FRACTION,
+            if play > 0.0 {
+                format!(
+                    " and the joints' summed clearance {} mm",
+                    crate::readable(play)
+                )
+            } else {
+                String::new()
+            },
+            crate::readable(max)
+        ),
     })
 }
 
