@@ -175,8 +175,10 @@ impl Helper {
         };
         match self {
             Helper::Completions { shell } => {
-                clap_complete::generate(*shell, &mut command, "mc-merge", out);
-                Ok(())
+                // Through memory: clap_complete panics when its writer fails.
+                let mut script = Vec::new();
+                clap_complete::generate(*shell, &mut command, "mc-merge", &mut script);
+                out.write_all(&script).map_err(stdout)
             }
             Helper::Man => clap_mangen::Man::new(command).render(out).map_err(stdout),
         }

@@ -149,10 +149,10 @@ pub struct WorkArgs {
     pub threads: Option<usize>,
     /// Seconds between heartbeats of a claim (more than 0, at most a week, less than
     /// --stale-after).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
     pub heartbeat: f64,
     /// Seconds after which an untouched claim is stale and taken over (at most a week).
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     pub stale_after: f64,
     /// Show no progress.
     #[arg(long, short = 'q')]
@@ -298,12 +298,7 @@ impl CliError {
 pub fn run_exit_code(e: &RunError) -> u8 {
     match e {
         RunError::Usage(_) => exit::USAGE,
-        RunError::Job(JobError::Io { .. }) => exit::IO,
-        RunError::Job(JobError::InFile { source, .. })
-            if matches!(**source, JobError::Io { .. }) =>
-        {
-            exit::IO
-        }
+        RunError::Job(e) if e.is_io() => exit::IO,
         RunError::Job(_) => exit::INVALID_INPUT,
         RunError::Shard(ShardError::Io { .. }) => exit::IO,
         RunError::Shard(ShardError::Files(e)) => e.exit_code(),
@@ -321,13 +316,29 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Status(a) => status_command(a, out),
         Command::Audit(a) => audit_command(a, out),
         Command::Inputs(a) => inputs_command(a, out),
-        Command::Completions(a) => {
-            let mut cmd = <Cli as clap::CommandFactory>::command();
-            clap_complete::generate(a.shell, &mut cmd, "mc-shard", out);
-            Ok(())
-        }
+        Command::Completions(a) => completions(
+            a.shell,
+            <Cli as clap::CommandFactory>::command(),
+            "mc-shard",
+            out,
+        ),
         Command::Man => man_page(<Cli as clap::CommandFactory>::command(), out),
     }
+}
+
+/// Writes `cmd`'s completion script for `shell` to `out`, through memory first:
+/// `clap_complete` panics when its writer fails (a full disk), and a failed write is an
+/// I/O error like any other.
+pub fn completions(
+    shell: clap_complete::Shell,
+    mut cmd: clap::Command,
+    name: &str,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let mut script = Vec::new();
+    clap_complete::generate(shell, &mut cmd, name, &mut script);
+    out.write_all(&script)?;
+    Ok(())
 }
 
 /// Writes `cmd`'s man page (roff), with a section per subcommand, to `out`.

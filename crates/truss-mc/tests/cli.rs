@@ -493,3 +493,22 @@ fn run_all_refuses_a_linked_report_directory() {
     assert_eq!(std::fs::read_dir(&elsewhere).unwrap().count(), 0);
     assert!(sample_lines(&out).is_empty(), "nothing ran");
 }
+
+/// A completion script that cannot be written (`/dev/full`) is an I/O error (exit 4), not
+/// a panic (clap's generator panics when its writer fails).
+#[test]
+fn unwritable_output_is_an_io_error() {
+    let o = Command::new(env!("CARGO_BIN_EXE_truss-mc"))
+        .args(["completions", "bash"])
+        .stdout(
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open("/dev/full")
+                .unwrap(),
+        )
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(4), "{stderr}");
+    assert!(stderr.starts_with("truss-mc: error: "), "{stderr}");
+}

@@ -8,7 +8,8 @@
 //! - the run directory's file rules (`run-dir`) link only the exit codes, so every writer,
 //!   however low, can share them;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
-//! - the tolerance study links the solver, the job and the statistics, and nothing else of ours.
+//! - the tolerance study links the solver, the job, the statistics and the file rules, and
+//!   nothing else of ours.
 
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -120,11 +121,20 @@ fn dependencies_point_one_way() {
         .cloned()
         .collect();
     assert_eq!(job, ["truss-core"]);
-    // truss-tolerance sits on the job, the solver and the statistics: not the runner, the
-    // merge, the wire format or the diagnosis.
+    // truss-tolerance sits on the job, the solver, the statistics and the run directory's
+    // file rules: not the runner, the merge, the wire format or the diagnosis.
     let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
         .intersection(&ours)
         .cloned()
         .collect();
-    assert_eq!(tolerance, ["truss-core", "truss-job", "truss-stats"]);
+    assert_eq!(
+        tolerance,
+        [
+            "run-dir",
+            "truss-core",
+            "truss-exit",
+            "truss-job",
+            "truss-stats"
+        ]
+    );
 }

@@ -310,3 +310,24 @@ fn angles_outside_a_right_angle_are_refused_naming_the_line() {
         assert!(stderr.contains("theta_p"), "{stderr}");
     }
 }
+
+/// A completion script that cannot be written (`/dev/full`) is an I/O error (exit 4), not
+/// a panic (clap's generator panics when its writer fails).
+#[test]
+fn unwritable_output_is_an_io_error() {
+    for args in [["completions", "bash"].as_slice(), ["man"].as_slice()] {
+        let o = Command::new(env!("CARGO_BIN_EXE_mc-merge"))
+            .args(args)
+            .stdout(
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .open("/dev/full")
+                    .unwrap(),
+            )
+            .output()
+            .unwrap();
+        let (status, stderr) = code(&o);
+        assert_eq!(status, Some(4), "{args:?}: {stderr}");
+        assert!(stderr.starts_with("mc-merge: error: "), "{stderr}");
+    }
+}

@@ -269,3 +269,24 @@ fn a_live_lock_names_its_holder() {
     drop(held);
     assert_eq!(code(&run_range(&job, &out, "0..20")).0, Some(0));
 }
+
+/// A completion script or man page that cannot be written (`/dev/full`) is an I/O error
+/// (exit 4), not a panic (clap's generator panics when its writer fails).
+#[test]
+fn unwritable_output_is_an_io_error() {
+    for args in [["completions", "bash"].as_slice(), ["man"].as_slice()] {
+        let o = Command::new(env!("CARGO_BIN_EXE_mc-shard"))
+            .args(args)
+            .stdout(
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .open("/dev/full")
+                    .unwrap(),
+            )
+            .output()
+            .unwrap();
+        let (status, stderr) = code(&o);
+        assert_eq!(status, Some(4), "{args:?}: {stderr}");
+        assert!(stderr.starts_with("mc-shard: error: "), "{stderr}");
+    }
+}
