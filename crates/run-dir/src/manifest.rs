@@ -87,6 +87,14 @@ impl OutputDir {
         })
     }
 
+    /// Refuses, before any work and without creating anything, the names among `names` in
+    /// `dir` that could not be written: a link or a non-file stands there.
+    pub fn check(dir: &Path, names: &[&str]) -> Result<(), RunDirError> {
+        names
+            .iter()
+            .try_for_each(|n| crate::output::check_final(&dir.join(n)))
+    }
+
     /// The directory.
     pub fn path(&self) -> &Path {
         &self.dir

@@ -2,6 +2,7 @@
 //! hostile or meaningless input ([`limits`]).
 
 mod cli;
+mod files;
 mod limits;
 
 use std::process::Command;
