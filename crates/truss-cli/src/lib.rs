@@ -37,8 +37,9 @@
 //! | 0 | success |
 //! | 1 | internal error (a bug) |
 //! | 2 | usage error (bad arguments) |
-//! | 3 | the model file, job or measured data is invalid (the message names the item or line) |
+//! | 3 | the model file, job or measured data is invalid (the message names the item or line), or a file named is not a regular file |
 //! | 4 | a file could not be read or written |
+//! | 5 | a file in the way: a symbolic link or a non-file at an output's name, or an output directory another process is writing |
 //! | 6 | a tolerance allocation did not verify (its files are written) |
 //! | 7 | the solve failed (not converged, mechanism; the JSON result says why), or a diagnosis's simulation failed |
 

@@ -77,7 +77,11 @@
 //!    against the final model's, statistic by statistic.
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
-//! plots of [`plot`]. Progress goes to stderr.
+//! plots of [`plot`], each written through a temporary file and never through a link (a
+//! link or a non-file at any of [`OUTPUTS`] is refused before the work), with the directory
+//! locked while they are written and listed in `.truss-diagnose.manifest` (crate
+//! `run-dir`). The measured files are read only if they are regular files of at most
+//! 64 MiB (`/dev/zero` or a FIFO is refused at once). Progress goes to stderr.
 //!
 //! ## Candidate effects
 //!

@@ -21,7 +21,7 @@
 //! |---|---|
 //! | `model` | `{"prism": {...}}` (the paper's truss: `stages` and any of `side`, `height`, `batten_area`, `batten_modulus`, `longeron_area`, `longeron_modulus`, `diagonal_area`, `diagonal_modulus`, `diagonal_length` (mm, or `"exact"`), `compression_ratio`, `backlash`: `true` or `{"clearance", "tension_factor", "compression_ratio"}` for pin joints with clearance, see [`truss_core::prism::BacklashOptions`]), or a model file: `"path.json"` or `{"file": "path.json"}`, relative to the job file |
 //! | `seed` | a u64; with the case name and sample index it keys every random draw |
-//! | `cases[].name` | unique; names the case in shard files and reports |
+//! | `cases[].name` | unique, at most [`MAX_CASE_NAME_BYTES`] bytes, no control characters; names the case in shard files, reports and plot file names |
 //! | `cases[].samples` | ≥ 1 |
 //! | `cases[].model` | optional: this case's own model, same forms as `model` |
 //! | `cases[].length_errors` | per member group, a distribution of the length error (natural length minus nominal, mm): `{"normal": {"sigma": s}}` (optional `"mean"`), `{"uniform": {"low": a, "high": b}}`, `{"constant": {"value": v}}`. Groups not named get none. |
@@ -46,7 +46,10 @@
 //! alone or with a thermal effect's `α·ΔT·L`; a clearance can exceed
 //! [`MAX_CLEARANCE_FRACTION`](truss_core::model::MAX_CLEARANCE_FRACTION) of a jointed
 //! member's length; an effect's value is implausible (see [`crate::effects`]); a group is
-//! named twice, or given two distributions.
+//! named twice, or given two distributions; a case name is longer than
+//! [`MAX_CASE_NAME_BYTES`] or holds a control character ([`check_case_name`]). A model file
+//! the job names that cannot be read (missing, no permission) is an I/O failure
+//! ([`JobError::ModelIo`]), as the job file's own is; one that is not a model is invalid.
 //!
 //! ## Job id
 //!
