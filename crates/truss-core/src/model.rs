@@ -223,8 +223,16 @@ impl Model {
         let play: f64 = joints.iter().map(|j| j.clearance).sum();
         for (i, m) in members.iter().enumerate() {
             let length = distance(nodes[m.nodes[0]].xyz, nodes[m.nodes[1]].xyz);
-            let item = format!("members[{i}] (id {:?})", m.id);
-            check_initial_strain(&item, m.natural_length, length, play)?;
+            let what = "the distance between its nodes";
+            if let Some(fault) = initial_strain_fault(m.natural_length, length, play, what) {
+                return Err(ModelError::Invalid {
+                    item: format!("members[{i}] (id {:?})", m.id),
+                    message: format!(
+                        "natural_length {fault}; a member that long is another design, to be \
+                         drawn with its own node positions"
+                    ),
+                });
+            }
         }
         Ok(Self {
             nodes,
@@ -526,8 +534,9 @@ fn check_member(
     })
 }
 
-/// Whether a member of natural length `natural` \[mm\] between nodes `length` \[mm\] apart
-/// can start within the elastic range: `|length − natural| ≤ natural ×`
+/// Why a natural length `natural` \[mm\] cannot start within the elastic range between
+/// points `length` \[mm\] apart (`what` says which: `the distance between its nodes`), or
+/// `None` if it can: it can when `|length − natural| ≤ natural ×`
 /// [`MAX_LENGTH_ERROR_FRACTION`] `+ play`, the bound a length error has
 /// ([`Model::max_length_error`]) widened by `play` \[mm\], the model's joint clearances
 /// summed. Free play moves each hole by at most its clearance from its shaft, so the
@@ -535,42 +544,28 @@ fn check_member(
 /// (0 without joints: the bound is then exact). Beyond it the initial strain
 /// `(length − natural)/natural` could only be taken up by yielding, which the model does not
 /// represent.
-pub fn initial_strain_allowed(natural: f64, length: f64, play: f64) -> bool {
-    (natural - length).abs() <= natural / MAX_LENGTH_ERROR_FRACTION.recip() + play
-}
-
-/// Refuses member `item`'s natural length beyond [`initial_strain_allowed`].
-fn check_initial_strain(
-    item: &str,
-    natural: f64,
-    length: f64,
-    play: f64,
-) -> Result<(), ModelError> {
-    if initial_strain_allowed(natural, length, play) {
-        return Ok(());
-    }
+pub fn initial_strain_fault(natural: f64, length: f64, play: f64, what: &str) -> Option<String> {
     let max = natural / MAX_LENGTH_ERROR_FRACTION.recip() + play;
-    Err(ModelError::Invalid {
-        item: item.to_string(),
-        message: format!(
-            "natural_length {} mm differs from the distance between its nodes, {} mm, by more \
-             than {}% of it{} ({} mm): an initial strain beyond the elastic range, where the \
-             model means nothing (see truss_core::MAX_LENGTH_ERROR_FRACTION); a member that \
-             long is another design, to be drawn with its own node positions",
-            crate::readable(natural),
-            crate::readable(length),
-            100.0 * MAX_LENGTH_ERROR_FRACTION,
-            if play > 0.0 {
-                format!(
-                    " and the joints' summed clearance {} mm",
-                    crate::readable(play)
-                )
-            } else {
-                String::new()
-            },
-            crate::readable(max)
-        ),
-    })
+    if (natural - length).abs() <= max {
+        return None;
+    }
+    let free_play = if play > 0.0 {
+        format!(
+            " and the joints' summed clearance {} mm",
+            crate::readable(play)
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{} mm is more than {}% of itself{free_play} ({} mm) from {what}, {} mm: an initial \
+         strain beyond the elastic range, where the model means nothing (see \
+         truss_core::MAX_LENGTH_ERROR_FRACTION)",
+        crate::readable(natural),
+        100.0 * MAX_LENGTH_ERROR_FRACTION,
+        crate::readable(max),
+        crate::readable(length)
+    ))
 }
 
 fn parse_fixed(item: &str, s: &SupportSpec) -> Result<Vec<usize>, ModelError> {

@@ -161,7 +161,7 @@ impl PrismOptions {
     /// natural length in (0, [`MAX_COORDINATE`]] mm and within
     /// [`MAX_LENGTH_ERROR_FRACTION`](crate::MAX_LENGTH_ERROR_FRACTION) of itself (plus the
     /// joints' summed clearance) of the face diagonal, an initial strain within the elastic
-    /// range ([`crate::model::initial_strain_allowed`]); a clearance in
+    /// range ([`crate::model::initial_strain_fault`]); a clearance in
     /// [0, [`MAX_CLEARANCE_FRACTION`] × the shorter of side and height]; joint tension
     /// factor in (0, 10⁹]; joint compression ratio in [0, [`MAX_JOINT_COMPRESSION_RATIO`]].
     pub fn check(&self) -> Result<(), (&'static str, String)> {
@@ -219,26 +219,9 @@ impl PrismOptions {
                 .backlash
                 .as_ref()
                 .map_or(0.0, |b| 6.0 * self.stages as f64 * b.clearance);
-            if !crate::model::initial_strain_allowed(d, face, play) {
-                return Err((
-                    "diagonal_length",
-                    format!(
-                        "{} mm is more than {}% of itself{} from the face diagonal \
-                         √(side² + height²) = {} mm: an initial strain beyond the elastic range, \
-                         where the model means nothing (see truss_core::MAX_LENGTH_ERROR_FRACTION)",
-                        crate::readable(d),
-                        100.0 * crate::MAX_LENGTH_ERROR_FRACTION,
-                        if play > 0.0 {
-                            format!(
-                                " and the joints' summed clearance {} mm",
-                                crate::readable(play)
-                            )
-                        } else {
-                            String::new()
-                        },
-                        crate::readable(face)
-                    ),
-                ));
+            let what = "the face diagonal √(side² + height²)";
+            if let Some(fault) = crate::model::initial_strain_fault(d, face, play, what) {
+                return Err(("diagonal_length", fault));
             }
         }
         if let Some(b) = &self.backlash {

@@ -4,6 +4,8 @@
 mod cli;
 mod common;
 mod export;
+#[path = "../../../run-dir/tests/support/hostile.rs"]
+mod hostile;
 mod plots;
 mod report_dir;
 mod schema;

@@ -4,9 +4,9 @@
 //! files, and a θ_P that cannot be an angle is refused naming its line.
 
 use crate::common::{SynthCase, SynthJob};
-use std::path::{Path, PathBuf};
+use crate::hostile::{assert_untouched, code, fifo, precious, run_bounded, run_into_full};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
 
 fn job(seed: u64) -> SynthJob {
     SynthJob::new(
@@ -28,24 +28,6 @@ fn merge_into(shards: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut all = vec!["--out", out.to_str().unwrap()];
     all.extend_from_slice(extra);
     mc_merge(&[shards], &all)
-}
-
-fn code(o: &Output) -> (Option<i32>, String) {
-    (
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
-
-/// A file outside the report directory that a planted link points at.
-fn precious(dir: &Path) -> PathBuf {
-    let p = dir.join("precious.txt");
-    std::fs::write(&p, "the user's own file").unwrap();
-    p
-}
-
-fn untouched(p: &Path) {
-    assert_eq!(std::fs::read_to_string(p).unwrap(), "the user's own file");
 }
 
 /// A link named like a plot, in a new report directory or in one mc-merge wrote before, is
@@ -71,7 +53,7 @@ fn links_named_like_outputs_are_refused() {
         let (status, stderr) = code(&merge_into(shards.path(), out.path(), &[]));
         assert_eq!(status, Some(5), "{name}: {stderr}");
         assert!(stderr.contains(name), "{stderr}");
-        untouched(&target);
+        assert_untouched(&target);
     }
 }
 
@@ -149,7 +131,7 @@ fn the_export_never_writes_through_a_link() {
     std::os::unix::fs::symlink(&target, dir.path().join("samples.csv.partial")).unwrap();
     let o = mc_merge(&[shards.path()], &["--export", csv.to_str().unwrap()]);
     assert_eq!(code(&o).0, Some(0), "{}", code(&o).1);
-    untouched(&target);
+    assert_untouched(&target);
     assert!(std::fs::read_to_string(&csv).unwrap().starts_with("index,"));
     std::fs::remove_file(&csv).unwrap();
     std::os::unix::fs::symlink(&target, &csv).unwrap();
@@ -159,7 +141,7 @@ fn the_export_never_writes_through_a_link() {
     ));
     assert_eq!(status, Some(5), "{stderr}");
     assert!(stderr.contains("samples.csv"), "{stderr}");
-    untouched(&target);
+    assert_untouched(&target);
 }
 
 /// A report directory being written by another process is refused at once (exit 5),
@@ -183,7 +165,7 @@ fn one_merge_at_a_time_per_report_directory() {
     );
     assert!(!out.path().join("report.json").exists());
     drop(lock);
-    for _ in 0..4 {
+    for _ in 0..2 {
         let start = || {
             Command::new(env!("CARGO_BIN_EXE_mc-merge"))
                 .arg(shards.path())
@@ -223,27 +205,9 @@ fn one_merge_at_a_time_per_report_directory() {
     }
 }
 
-/// Runs mc-merge on `path` under a 2 GB address-space limit (so that a regression cannot
-/// take the machine's memory) and a 20 s deadline; returns the exit code and stderr.
+/// Runs mc-merge on `path`, bounded (see `hostile::run_bounded`).
 fn merge_bounded(path: &Path) -> (Option<i32>, String) {
-    let mut child = Command::new("sh")
-        .arg("-c")
-        .arg("ulimit -v 2000000; exec \"$0\" \"$@\"")
-        .arg(env!("CARGO_BIN_EXE_mc-merge"))
-        .arg(path)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let started = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if started.elapsed() > Duration::from_secs(20) {
-            child.kill().unwrap();
-            panic!("mc-merge {} did not finish in 20 s", path.display());
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    code(&child.wait_with_output().unwrap())
+    run_bounded(Path::new(env!("CARGO_BIN_EXE_mc-merge")), &[path])
 }
 
 /// `/dev/zero`, a link to it and a FIFO named on the command line are refused at once
@@ -253,14 +217,7 @@ fn named_inputs_must_be_regular_files() {
     let dir = tempfile::tempdir().unwrap();
     let link = dir.path().join("zero.jsonl");
     std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
-    let fifo = dir.path().join("fifo.jsonl");
-    assert!(
-        Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
+    let fifo = fifo(dir.path(), "fifo.jsonl");
     for path in [Path::new("/dev/zero"), &link, &fifo] {
         let (status, stderr) = merge_bounded(path);
         assert_eq!(status, Some(3), "{}: {stderr}", path.display());
@@ -311,22 +268,12 @@ fn angles_outside_a_right_angle_are_refused_naming_the_line() {
     }
 }
 
-/// A completion script that cannot be written (`/dev/full`) is an I/O error (exit 4), not
-/// a panic (clap's generator panics when its writer fails).
+/// A completion script or man page that cannot be written (`/dev/full`) is an I/O error
+/// (exit 4), not a panic (clap's generator panics when its writer fails).
 #[test]
 fn unwritable_output_is_an_io_error() {
     for args in [["completions", "bash"].as_slice(), ["man"].as_slice()] {
-        let o = Command::new(env!("CARGO_BIN_EXE_mc-merge"))
-            .args(args)
-            .stdout(
-                std::fs::OpenOptions::new()
-                    .write(true)
-                    .open("/dev/full")
-                    .unwrap(),
-            )
-            .output()
-            .unwrap();
-        let (status, stderr) = code(&o);
+        let (status, stderr) = run_into_full(Path::new(env!("CARGO_BIN_EXE_mc-merge")), args);
         assert_eq!(status, Some(4), "{args:?}: {stderr}");
         assert!(stderr.starts_with("mc-merge: error: "), "{stderr}");
     }

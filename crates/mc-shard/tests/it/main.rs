@@ -6,6 +6,8 @@ mod binary;
 mod cli;
 mod common;
 mod determinism;
+#[path = "../../../run-dir/tests/support/hostile.rs"]
+mod hostile;
 mod interrupt;
 mod job;
 mod pool;

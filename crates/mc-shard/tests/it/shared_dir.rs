@@ -5,16 +5,10 @@
 
 use crate::binary::mc_shard;
 use crate::common::*;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
-
-fn code(o: &Output) -> (Option<i32>, String) {
-    (
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
+use crate::hostile::{assert_untouched, code, fifo, precious, run_bounded, run_into_full};
+use std::ffi::OsStr;
+use std::path::Path;
+use std::process::{Command, Output};
 
 fn run_range(job: &Path, out: &Path, range: &str) -> Output {
     mc_shard(&[
@@ -29,17 +23,6 @@ fn run_range(job: &Path, out: &Path, range: &str) -> Output {
         "1",
         "-q",
     ])
-}
-
-/// A file outside the run directory that a planted link points at.
-fn precious(dir: &Path) -> PathBuf {
-    let p = dir.join("precious.txt");
-    std::fs::write(&p, "the user's own file").unwrap();
-    p
-}
-
-fn untouched(p: &Path) {
-    assert_eq!(std::fs::read_to_string(p).unwrap(), "the user's own file");
 }
 
 /// A link at the shard's name is refused (exit 5) naming it, and what it points at keeps its
@@ -59,7 +42,7 @@ fn a_link_at_a_shards_name_is_refused() {
         stderr.contains(&name) && stderr.contains("symbolic link"),
         "{stderr}"
     );
-    untouched(&target);
+    assert_untouched(&target);
 }
 
 /// A regular file at a shard's name that does not begin with a begin record (one
@@ -184,7 +167,7 @@ fn inputs_are_written_whole_or_not_at_all() {
         link.to_str().unwrap(),
     ]);
     assert_eq!(code(&o).0, Some(5), "{}", code(&o).1);
-    untouched(&target);
+    assert_untouched(&target);
 }
 
 /// `audit` given `/dev/zero`, a link to it or a FIFO refuses it at once (exit 3), naming
@@ -195,35 +178,15 @@ fn audit_reads_only_regular_files_and_writes_no_link() {
     let job = write(dir.path(), "job.json", &small_job(10));
     let link = dir.path().join("zero.jsonl");
     std::os::unix::fs::symlink("/dev/zero", &link).unwrap();
-    let fifo = dir.path().join("fifo.jsonl");
-    assert!(
-        Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
+    let fifo = fifo(dir.path(), "fifo.jsonl");
     for path in [Path::new("/dev/zero"), &link, &fifo] {
-        let mut child = Command::new("sh")
-            .arg("-c")
-            .arg("ulimit -v 2000000; exec \"$0\" \"$@\"")
-            .arg(env!("CARGO_BIN_EXE_mc-shard"))
-            .args(["audit", "--job"])
-            .arg(&job)
-            .arg(path)
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        let started = Instant::now();
-        while child.try_wait().unwrap().is_none() {
-            if started.elapsed() > Duration::from_secs(20) {
-                child.kill().unwrap();
-                panic!("audit of {} did not finish in 20 s", path.display());
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
-        let (status, stderr) = code(&child.wait_with_output().unwrap());
+        let args = [
+            OsStr::new("audit"),
+            "--job".as_ref(),
+            job.as_os_str(),
+            path.as_os_str(),
+        ];
+        let (status, stderr) = run_bounded(Path::new(env!("CARGO_BIN_EXE_mc-shard")), &args);
         assert_eq!(status, Some(3), "{}: {stderr}", path.display());
         assert!(
             stderr.contains(&path.display().to_string()) && stderr.contains("not a regular file"),
@@ -243,7 +206,7 @@ fn audit_reads_only_regular_files_and_writes_no_link() {
         "3",
     ]);
     assert_eq!(code(&o).0, Some(5), "{}", code(&o).1);
-    untouched(&target);
+    assert_untouched(&target);
 }
 
 /// A shard whose lock another process holds is refused (exit 5) with that process's pid and
@@ -275,17 +238,7 @@ fn a_live_lock_names_its_holder() {
 #[test]
 fn unwritable_output_is_an_io_error() {
     for args in [["completions", "bash"].as_slice(), ["man"].as_slice()] {
-        let o = Command::new(env!("CARGO_BIN_EXE_mc-shard"))
-            .args(args)
-            .stdout(
-                std::fs::OpenOptions::new()
-                    .write(true)
-                    .open("/dev/full")
-                    .unwrap(),
-            )
-            .output()
-            .unwrap();
-        let (status, stderr) = code(&o);
+        let (status, stderr) = run_into_full(Path::new(env!("CARGO_BIN_EXE_mc-shard")), args);
         assert_eq!(status, Some(4), "{args:?}: {stderr}");
         assert!(stderr.starts_with("mc-shard: error: "), "{stderr}");
     }

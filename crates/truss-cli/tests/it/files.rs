@@ -3,34 +3,17 @@
 //! command line are read only if they are regular files; output that cannot be written is
 //! an I/O error.
 
+use crate::hostile::{assert_untouched, code, fifo, precious, run_bounded};
 use crate::truss;
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
-
-fn code(o: &Output) -> (Option<i32>, String) {
-    (
-        o.status.code(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
 
 fn job_path() -> &'static str {
     concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../jobs/diagnose-baseline.json"
     )
-}
-
-/// A file outside the output directory that a planted link points at.
-fn precious(dir: &Path) -> std::path::PathBuf {
-    let p = dir.join("precious.txt");
-    std::fs::write(&p, "the user's own file").unwrap();
-    p
-}
-
-fn untouched(p: &Path) {
-    assert_eq!(std::fs::read_to_string(p).unwrap(), "the user's own file");
 }
 
 /// Measured data of 30 specimens, as `synth-measured` writes it.
@@ -56,26 +39,9 @@ fn measured(dir: &Path) -> std::path::PathBuf {
     path
 }
 
-/// Runs `truss` with `args` under a 2 GB address-space limit and a 30 s deadline.
+/// Runs `truss` with `args`, bounded (see `hostile::run_bounded`).
 fn truss_bounded(args: &[&str]) -> (Option<i32>, String) {
-    let mut child = Command::new("sh")
-        .arg("-c")
-        .arg("ulimit -v 2000000; exec \"$0\" \"$@\"")
-        .arg(env!("CARGO_BIN_EXE_truss"))
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let started = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if started.elapsed() > Duration::from_secs(30) {
-            child.kill().unwrap();
-            panic!("truss {args:?} did not finish in 30 s");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    code(&child.wait_with_output().unwrap())
+    run_bounded(Path::new(env!("CARGO_BIN_EXE_truss")), args)
 }
 
 /// A link at `diagnosis.md` or at a diagnosis plot's name is refused (exit 5), naming it,
@@ -115,7 +81,7 @@ fn diagnose_never_writes_through_a_link() {
             started.elapsed() < Duration::from_secs(5),
             "refused before the work"
         );
-        untouched(&target);
+        assert_untouched(&target);
     }
 }
 
@@ -125,14 +91,7 @@ fn diagnose_never_writes_through_a_link() {
 fn diagnose_reads_only_regular_files() {
     let dir = tempfile::tempdir().unwrap();
     let m = measured(dir.path());
-    let fifo = dir.path().join("fifo.csv");
-    assert!(
-        Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
+    let fifo = fifo(dir.path(), "fifo.csv");
     let zero = dir.path().join("zero.csv");
     std::os::unix::fs::symlink("/dev/zero", &zero).unwrap();
     let out = dir.path().join("d");
@@ -174,13 +133,7 @@ fn diagnose_reads_only_regular_files() {
 fn tolerance_never_writes_through_a_link_nor_reads_a_fifo() {
     let dir = tempfile::tempdir().unwrap();
     let target = precious(dir.path());
-    let job = dir.path().join("job.json");
-    std::fs::write(
-        &job,
-        r#"{"model": {"prism": {"stages": 1}}, "seed": 1, "cases": [{"name": "c", "samples": 1000,
-  "length_errors": {"batten": {"normal": {"sigma": 0.01}}, "longeron": {"normal": {"sigma": 0.01}}}}]}"#,
-    )
-    .unwrap();
+    let job = crate::one_stage_job(dir.path());
     let out = dir.path().join("t");
     std::fs::create_dir(&out).unwrap();
     std::os::unix::fs::symlink(&target, out.join("tolerance.md")).unwrap();
@@ -213,16 +166,9 @@ fn tolerance_never_writes_through_a_link_nor_reads_a_fifo() {
         started.elapsed() < Duration::from_secs(5),
         "refused before the work"
     );
-    untouched(&target);
+    assert_untouched(&target);
     std::fs::remove_file(out.join("tolerance.md")).unwrap();
-    let fifo = dir.path().join("job.fifo");
-    assert!(
-        Command::new("mkfifo")
-            .arg(&fifo)
-            .status()
-            .unwrap()
-            .success()
-    );
+    let fifo = fifo(dir.path(), "job.fifo");
     let a = args(&fifo);
     let (status, stderr) = truss_bounded(&a.iter().map(String::as_str).collect::<Vec<_>>());
     assert_eq!(status, Some(3), "{stderr}");

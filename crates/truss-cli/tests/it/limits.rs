@@ -266,13 +266,7 @@ fn natural_lengths_beyond_the_strain_rule_are_refused() {
 #[test]
 fn repeated_costs_and_fixes_are_refused() {
     let dir = tempfile::tempdir().unwrap();
-    let job = dir.path().join("job.json");
-    std::fs::write(
-        &job,
-        r#"{"model": {"prism": {"stages": 1}}, "seed": 1, "cases": [{"name": "c", "samples": 1000,
-  "length_errors": {"batten": {"normal": {"sigma": 0.01}}, "longeron": {"normal": {"sigma": 0.01}}}}]}"#,
-    )
-    .unwrap();
+    let job = crate::one_stage_job(dir.path());
     for (flag, first, second) in [
         ("--cost", "batten=1", "batten=2"),
         ("--fix", "batten=0.01", "batten=0.05"),
