@@ -88,6 +88,8 @@ struct Columns {
     tan_y: Vec<f64>,
     /// 0: not recorded, 1: no loose joint, 2: at least one.
     loose: Vec<u8>,
+    /// 0: not recorded, 1: not floating, 2: floating.
+    floating: Vec<u8>,
 }
 
 fn zeroed<T: Clone>(n: usize, v: T) -> Result<Vec<T>, String> {
@@ -107,6 +109,7 @@ impl Columns {
             tan_x: zeroed(n, 0.0)?,
             tan_y: zeroed(n, 0.0)?,
             loose: zeroed(n, 0)?,
+            floating: zeroed(n, 0)?,
         })
     }
 }
@@ -195,18 +198,30 @@ impl CaseData {
     /// Loose-joint counts among converged samples: (samples recording the field, samples with
     /// at least one loose joint).
     pub fn loose_joints(&self) -> (u64, u64) {
+        self.flag_counts(|c| &c.loose)
+    }
+
+    /// Floating counts among converged samples: (samples recording the field, samples with a
+    /// floating stage).
+    pub fn floating(&self) -> (u64, u64) {
+        self.flag_counts(|c| &c.floating)
+    }
+
+    /// (converged samples whose flag column is recorded, those whose flag is set) for a
+    /// column of 0 (not recorded), 1 (not set), 2 (set).
+    fn flag_counts(&self, column: impl Fn(&Columns) -> &Vec<u8>) -> (u64, u64) {
         let Some(c) = &self.columns else {
             return (0, 0);
         };
         let mut recorded = 0;
-        let mut loose = 0;
-        for (s, l) in c.state.iter().zip(&c.loose) {
+        let mut set = 0;
+        for (s, l) in c.state.iter().zip(column(c)) {
             if *s == CONVERGED && *l > 0 {
                 recorded += 1;
-                loose += u64::from(*l == 2);
+                set += u64::from(*l == 2);
             }
         }
-        (recorded, loose)
+        (recorded, set)
     }
 }
 
@@ -378,6 +393,8 @@ struct Rec {
     tan_y: f64,
     /// 0: not recorded, 1: no loose joint, 2: at least one.
     loose: u8,
+    /// 0: not recorded, 1: not floating, 2: floating.
+    floating: u8,
     /// `Some` for a failed sample.
     reason: Option<Box<str>>,
 }
@@ -396,6 +413,11 @@ impl Rec {
                 None => 0,
                 Some(0) => 1,
                 Some(_) => 2,
+            },
+            floating: match s.floating {
+                None => 0,
+                Some(false) => 1,
+                Some(true) => 2,
             },
             reason: match a {
                 Some(_) => None,
@@ -460,6 +482,7 @@ impl Store {
         cols.tan_x[k] = r.tan_x;
         cols.tan_y[k] = r.tan_y;
         cols.loose[k] = r.loose;
+        cols.floating[k] = r.floating;
         match r.reason {
             None => cols.state[k] = CONVERGED,
             Some(why) => {

@@ -152,7 +152,8 @@ pub struct PrismArgs {
     /// Give the diagonals the exact face-diagonal length √(l² + h²) instead.
     #[arg(long)]
     pub exact_diagonals: bool,
-    /// Cables' compression stiffness / tension stiffness.
+    /// Cables' compression stiffness / tension stiffness: 0, the paper's, carries nothing
+    /// when slack (solved as the limit r → 0).
     #[arg(long, default_value_t = truss_core::DEFAULT_COMPRESSION_RATIO, allow_negative_numbers = true)]
     pub compression_ratio: f64,
     /// Model the batten–longeron pin joints with backlash (paper section 4): each longeron

@@ -81,7 +81,8 @@ pub struct PrismOptions {
     pub diagonal_modulus: f64,
     /// Diagonal natural length \[mm\]; `None` for the exact face diagonal √(l² + h²).
     pub diagonal_length: Option<f64>,
-    /// Diagonals' compression stiffness ratio (they are tension-only cables).
+    /// Diagonals' compression stiffness ratio (they are tension-only cables); 0, the
+    /// default, is the paper's: they carry nothing when slack (see [`crate::limit`]).
     pub compression_ratio: f64,
     /// Pin joints with backlash at every node (see the module doc); `None` for rigid nodes.
     pub backlash: Option<BacklashOptions>,

@@ -69,7 +69,7 @@ pub(super) fn evaluate_with(
 
 /// `r_i −= f`, `r_j += f` for an element from node `i` to node `j` (fixed rows skipped).
 #[inline(always)]
-fn scatter(r: &mut [f64], n: usize, c: &Link, fk: [f64; 3]) {
+pub(super) fn scatter(r: &mut [f64], n: usize, c: &Link, fk: [f64; 3]) {
     if c.masked {
         let dof = c.dofs;
         for k in 0..3 {
