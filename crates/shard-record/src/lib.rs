@@ -134,7 +134,7 @@ pub mod parameters {
         CABLE_COMPRESSION_RATIO,
     ];
 }
-pub use scan::{ScanError, ShardScan, Tail, parse_record, read_shard, scan_shard};
+pub use scan::{ScanError, ShardScan, Tail, parse_record, read_line, read_shard, scan_shard};
 
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -154,6 +154,16 @@ pub const CHECKPOINT_EVERY: u64 = 100;
 /// The largest `checkpoint_every` a reader accepts (it holds that many lines while it
 /// verifies them).
 pub const MAX_CHECKPOINT_EVERY: u64 = 100_000;
+
+/// The longest sample, checkpoint or end line a reader takes, 1 MiB \[bytes\]: a sample line
+/// is a few hundred bytes. A longer line (a file that is not a shard, a sparse file of
+/// zeros) is refused as corrupt before it is read into memory.
+pub const MAX_LINE_BYTES: u64 = 1 << 20;
+
+/// The longest begin line a reader takes, 256 MiB \[bytes\]: it lists every case of the job
+/// with its parameters, about a hundred bytes a case, so four times the largest job file
+/// (64 MiB) holds any job's.
+pub const MAX_BEGIN_LINE_BYTES: u64 = 256 << 20;
 
 /// One line of a shard file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

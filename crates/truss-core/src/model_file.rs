@@ -29,7 +29,7 @@
 //! | `members[].group` | group name (`batten`, `longeron`, `diagonal`, …); length-error distributions are given per group | |
 //! | `members[].area` | cross-sectional area, > 0 | mm² |
 //! | `members[].youngs_modulus` | Young's modulus, > 0 | MPa |
-//! | `members[].natural_length` | stress-free length, > 0; optional, defaults to the distance between its nodes | mm |
+//! | `members[].natural_length` | stress-free length, > 0; optional, defaults to the distance between its nodes; within [`MAX_LENGTH_ERROR_FRACTION`](crate::MAX_LENGTH_ERROR_FRACTION) of itself (plus the joints' clearances summed) of that distance ([`crate::model::initial_strain_fault`]) | mm |
 //! | `members[].behaviour` | `"bar"` (tension and compression) or `"cable"` (tension only) | |
 //! | `members[].compression_ratio` | cables only: compression stiffness / tension stiffness, in [0, 1); default 0, the paper's (slack cables carry nothing: solved as the limit `r → 0`, see [`crate::limit`]) | |
 //! | `supports[].node`, `supports[].fixed` | a node and the directions held fixed, any of `"x"`, `"y"`, `"z"` (`"xyz"` = pinned) | |

@@ -235,3 +235,22 @@ fn joint_layout_faults_are_named() {
         );
     }
 }
+
+/// A natural length further than 1 % of itself from the distance between its nodes sets an
+/// initial strain beyond the elastic range, as a length error that large would
+/// (`truss_core::MAX_LENGTH_ERROR_FRACTION`): refused naming the member and the field,
+/// before any solve. Within 1 % it is a pretension, and accepted.
+#[test]
+fn natural_lengths_beyond_the_strain_rule_are_named() {
+    let mut f = triangle();
+    f.members[0].natural_length = Some(126.0);
+    let m = message(f);
+    assert!(
+        m.contains("members[0]") && m.contains("\"ab\"") && m.contains("natural_length"),
+        "{m}"
+    );
+    assert!(m.contains("1%"), "{m}");
+    let mut f = triangle();
+    f.members[0].natural_length = Some(99.2);
+    Model::new(f).unwrap();
+}
