@@ -78,8 +78,9 @@ class Samples:
     order: ``index`` (global), ``case``, ``sample`` (within the case), ``status``
     (``"converged"``/``"failed"``), ``iterations``, ``theta_p`` [rad], ``tan_theta_x``,
     ``tan_theta_y``, ``residual`` [N], ``slack_cables``, ``loose_joints`` (float, NaN where a
-    record has none), ``reason`` (empty unless failed), and any field the format adds. Read
-    a field as an attribute (``samples.theta_p``) or an item (``samples["theta_p"]``)."""
+    record has none), ``reason`` (empty unless failed), and any other field the lines carry,
+    such as ``floating`` (a boolean: 1.0 or 0.0, NaN where a line has none). Read a field as
+    an attribute (``samples.theta_p``) or an item (``samples["theta_p"]``)."""
 
     def __init__(
         self,

@@ -17,9 +17,11 @@
 #
 # Environment: MC_SHARD, MC_MERGE (default <repo>/target/release/{mc-shard,mc-merge}).
 #
-# Exit status: mc-shard's (0 done or nothing to do; 2 usage, e.g. another
-# --shards count than the directory's pool; 5 a shard quarantined, the others
-# ran; 130/143 interrupted), then the audit's or the merge's.
+# Exit status: 5 when DIR/work.log, DIR/merge.lock or DIR/report is a symbolic
+# link (nothing is written through it); mc-shard's (0 done or nothing to do; 2
+# usage, e.g. another --shards count than the directory's pool; 5 a shard
+# quarantined, the others ran; 130/143 interrupted), then the audit's or the
+# merge's.
 set -uo pipefail
 
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd -P)"
@@ -34,6 +36,15 @@ JOB="$1" DIR="$2" K="$3"
 shift 3
 mkdir -p "$DIR" || exit 4
 LOG="$DIR/work.log"
+# Nothing is written through a link planted in the shared directory (the shell's > and >>
+# follow links): the round's log, its lock file and the report directory; exit 5, a file
+# in the way.
+for f in "$LOG" "$DIR/merge.lock" "$DIR/report"; do
+    if [[ -L "$f" ]]; then
+        echo "$0: $f: is a symbolic link; nothing is written through a link (remove it)" >&2
+        exit 5
+    fi
+done
 
 echo "# $(date -u +%Y-%m-%dT%H:%M:%SZ) $(hostname) pid $$: mc-shard work --shards $K" >> "$LOG"
 "$MC_SHARD" work --job "$JOB" --out "$DIR" --shards "$K" --quiet "$@" >> "$LOG" 2>&1
@@ -48,7 +59,7 @@ if [[ -n "$missing" || -e "$DIR/report/report.json" ]]; then
     exit 0
 fi
 # Every shard is complete: audit and merge, once.
-exec 9> "$DIR/merge.lock"
+exec 9>> "$DIR/merge.lock"
 flock -n 9 || exit 0
 [[ -e "$DIR/report/report.json" ]] && exit 0
 {

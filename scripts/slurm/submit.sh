@@ -92,6 +92,9 @@ for var in MC_SHARD MC_MERGE; do
 done
 command -v sbatch > /dev/null || die "sbatch not found (install Slurm, e.g. scripts/slurm/start-local-cluster.sh)"
 
+# The logs directory is created under --out: never a planted link (Slurm would write the
+# task logs wherever it points).
+[[ -L "$OUT/logs" ]] && die "'$OUT/logs' is a symbolic link; task logs are never written through a link (remove it)" 5
 mkdir -p "$OUT/logs" || die "cannot create '$OUT/logs'"
 OUT="$(cd "$OUT" && pwd -P)"
 JOB="$(cd "$(dirname "$JOB")" && pwd -P)/${JOB##*/}"

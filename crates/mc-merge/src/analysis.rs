@@ -24,9 +24,22 @@ pub struct CaseAnalysis {
     pub target_replicates: Vec<Option<f64>>,
 }
 
-/// The caveats every figure of a case carries.
-pub fn caveats(case: &CaseData) -> Vec<String> {
+/// The caveats every figure of a case carries; `tail` is the fraction of samples above the
+/// target percentile (0.05 for P95).
+pub fn caveats(case: &CaseData, tail: f64) -> Vec<String> {
     let mut out = vec![];
+    let (recorded, floating) = case.floating();
+    if recorded > 0 && floating as f64 > tail * recorded as f64 {
+        out.push(format!(
+            "floating stages in {floating} of {recorded} samples ({:.1} %, more than the {:.0} % \
+             tail the target percentile reads): some stage's tilt is held by pretension alone, \
+             so θ_P's upper percentiles depend on what the model leaves out (friction, the \
+             diagonals' bending stiffness, the assembly); more diagonal pretension or smaller \
+             clearances frame the stages",
+            100.0 * floating as f64 / recorded as f64,
+            100.0 * tail
+        ));
+    }
     if case.present < case.info.samples {
         out.push(format!(
             "partial: {} of {} samples of this case present ({:.1} %)",
@@ -83,7 +96,7 @@ fn component_report(stats: Option<ComponentStats>) -> ComponentReport {
 /// The Clopper–Pearson interval of a binomial fraction k/n (Clopper & Pearson 1934).
 pub fn clopper_pearson(k: u64, n: u64, confidence: f64) -> Figure {
     if n == 0 {
-        return Figure::null("no sample records loose_joints");
+        return Figure::null("no sample records the field");
     }
     let tail = (1.0 - confidence) / 2.0;
     let (kf, nf) = (k as f64, n as f64);
@@ -337,7 +350,7 @@ pub fn analyse_case(
     settings: &Settings,
     cache: &mut CalibrationCache,
 ) -> CaseAnalysis {
-    let caveats = caveats(case);
+    let caveats = caveats(case, 1.0 - settings.target_percentile / 100.0);
     let conf = settings.confidence;
     let sample = SortedSample::new(case.points().map(|p| (p.theta, p.index)).collect());
     let n = sample.len();
@@ -435,6 +448,7 @@ pub fn analyse_case(
     );
 
     let (recorded, with_loose) = case.loose_joints();
+    let (floating_recorded, floating) = case.floating();
     let failed_ranges = case.failed_ranges();
     let report = CaseReport {
         name: case.info.name.clone(),
@@ -468,6 +482,11 @@ pub fn analyse_case(
             recorded,
             with_loose,
             fraction: clopper_pearson(with_loose, recorded, conf),
+        },
+        floating: Floating {
+            recorded: floating_recorded,
+            floating,
+            fraction: clopper_pearson(floating, floating_recorded, conf),
         },
         bootstrap: BootstrapCase {
             replicates: if boot.is_some() {

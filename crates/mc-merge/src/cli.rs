@@ -49,9 +49,11 @@ const AFTER_HELP: &str = "\
 Exit codes (the scheme every truss-mc binary shares):
   0  the shards verified and the report was written
   1  internal error (a bug)
-  2  usage error (bad flag or value)
+  2  usage error (bad flag or value; an --export path among the shards)
+  3  a file named on the command line is not a regular file (a FIFO, a device)
   4  I/O error reading shards or writing the report
-  5  a file in the way: the report directory holds another job's report.json
+  5  a file in the way: the report directory holds another job's report.json, another
+     merge is writing it, or a symbolic link or a non-file stands at a name to be written
   6  verification failure: a torn, corrupt or incomplete shard, another job id, a wrong digest,
      a missing index range, or overlapping shards that disagree
   7  failed samples present (give --allow-failed to compute on the converged ones)
@@ -92,11 +94,16 @@ pub struct Args {
     pub quiet: bool,
 
     /// Percentiles of θ_P to estimate, in percent, comma separated, each strictly between 0 and 100.
-    #[arg(long, value_delimiter = ',', default_value = "50,90,95,99")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "50,90,95,99",
+        allow_negative_numbers = true
+    )]
     pub percentiles: Vec<f64>,
 
     /// Confidence level of every interval, a fraction in (0, 1).
-    #[arg(long, default_value_t = 0.95)]
+    #[arg(long, default_value_t = 0.95, allow_negative_numbers = true)]
     pub confidence: f64,
 
     /// Bootstrap replicates B, 10 to 100000.
@@ -112,15 +119,15 @@ pub struct Args {
     pub gof_replicates: u32,
 
     /// Significance level of the Rayleigh goodness-of-fit verdict.
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
     pub gof_level: f64,
 
     /// Target distortion angle in rad for the allowable σ (9.69e-5 rad = 20 arcsec).
-    #[arg(long, default_value_t = DEFAULT_TARGET_ANGLE)]
+    #[arg(long, default_value_t = DEFAULT_TARGET_ANGLE, allow_negative_numbers = true)]
     pub target_angle: f64,
 
     /// The percentile of θ_P that must meet the target angle (added to --percentiles if absent).
-    #[arg(long, default_value_t = 95.0)]
+    #[arg(long, default_value_t = 95.0, allow_negative_numbers = true)]
     pub target_percentile: f64,
 
     /// Worker threads, 1 to 1024 (results do not depend on it; default: all cores).
@@ -168,8 +175,10 @@ impl Helper {
         };
         match self {
             Helper::Completions { shell } => {
-                clap_complete::generate(*shell, &mut command, "mc-merge", out);
-                Ok(())
+                // Through memory: clap_complete panics when its writer fails.
+                let mut script = Vec::new();
+                clap_complete::generate(*shell, &mut command, "mc-merge", &mut script);
+                out.write_all(&script).map_err(stdout)
             }
             Helper::Man => clap_mangen::Man::new(command).render(out).map_err(stdout),
         }

@@ -37,6 +37,9 @@ pub const SWEEP: &str = "σ-series: cases whose parameters agree except sigma (>
 /// Loose joints.
 pub const LOOSE: &str = "fraction of converged samples that record loose_joints with loose_joints >= 1, Clopper-Pearson exact interval";
 
+/// Floating stages.
+pub const FLOATING: &str = "fraction of converged samples that record floating with floating = true (some stage's tilt held by pretension alone, not by the members that bear), Clopper-Pearson exact interval; where it exceeds the tail the target percentile reads (1 - target/100), a case caveat says so";
+
 /// The definitions block of the report.
 pub fn definitions(settings: &Settings) -> Definitions {
     Definitions {
@@ -57,5 +60,6 @@ pub fn definitions(settings: &Settings) -> Definitions {
         gof: GOF,
         sweep: SWEEP,
         loose_joints: LOOSE,
+        floating: FLOATING,
     }
 }

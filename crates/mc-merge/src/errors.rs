@@ -19,9 +19,12 @@ impl ExitCodes {
     pub const INTERNAL: u8 = truss_exit::INTERNAL;
     /// The command line is wrong (unknown flag, bad number, percentile outside 0..100).
     pub const USAGE: u8 = truss_exit::USAGE;
+    /// A file named on the command line is not a regular file (a FIFO, a device).
+    pub const INVALID_INPUT: u8 = truss_exit::INVALID_INPUT;
     /// A file or directory could not be read or written.
     pub const IO: u8 = truss_exit::IO;
-    /// The report directory holds another job's report (or a file that is not a report).
+    /// The report directory holds another job's report (or a file that is not a report), a
+    /// link or a non-file at an output's name, or another process is writing it.
     pub const IN_THE_WAY: u8 = truss_exit::IN_THE_WAY;
     /// The shards do not verify: torn, corrupt, incomplete, another job, a wrong digest,
     /// a missing range, or overlapping copies that disagree.
@@ -186,6 +189,11 @@ pub enum MergeError {
         /// What it is and what to do.
         message: String,
     },
+    /// A file of the report directory or the export is in the way (a planted link, something
+    /// that is not a file, another process writing the directory), or could not be written;
+    /// or a file named on the command line is not a regular file.
+    #[error(transparent)]
+    Files(#[from] run_dir::RunDirError),
     /// A plot could not be drawn.
     #[error("{}: cannot draw the plot: {message}", path.display())]
     Plot {
@@ -242,6 +250,7 @@ impl MergeError {
             MergeError::FailedSamples { .. } => ExitCodes::FAILED_SAMPLES,
             MergeError::Plot { .. } => ExitCodes::IO,
             MergeError::InTheWay { .. } => ExitCodes::IN_THE_WAY,
+            MergeError::Files(e) => e.exit_code(),
             MergeError::Internal { .. } => ExitCodes::INTERNAL,
         }
     }

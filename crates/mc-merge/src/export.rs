@@ -23,14 +23,18 @@
 //! (294,611 of 300,000 θ_P values of a test export, pandas 3.1). `pd.read_csv(path)` is exact
 //! from pandas 3 on; older versions need `float_precision="round_trip"`.
 //!
-//! The file is written beside its final path and renamed into place when complete, so a
-//! failed export leaves no partial file.
+//! The file is written to a temporary file with an unpredictable name beside its final path
+//! and renamed into place when complete (crate `run-dir`), so a failed export leaves no
+//! partial file, and a symbolic link at the final path is refused (exit 5), never followed.
+//! An export path that is one of the shard files read, or lies in a directory scanned for
+//! shards, is refused before anything is read (usage, exit 2): it would destroy a shard, or
+//! (a `.jsonl` file) be taken for one by the next merge.
 
 use crate::Settings;
 use crate::errors::MergeError;
 use crate::load::{LoadOptions, load, shard_files};
 use shard_record::Record;
-use std::io::{BufRead, BufWriter, Write};
+use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
 /// The exported columns, in order.
@@ -78,6 +82,7 @@ pub fn export(paths: &[PathBuf], settings: &Settings, to: &Path) -> Result<u64, 
     let format = Format::of(to)?;
     let settings = settings.validate()?;
     let files = shard_files(paths)?;
+    check_destination(paths, &files, to)?;
     let dataset = load(
         &files,
         LoadOptions {
@@ -97,13 +102,9 @@ pub fn export(paths: &[PathBuf], settings: &Settings, to: &Path) -> Result<u64, 
         let path = path.to_path_buf();
         move |source| MergeError::Io { path, source }
     };
-    let partial = to.with_extension(format!(
-        "{}.partial",
-        to.extension().and_then(|e| e.to_str()).unwrap_or("")
-    ));
-    let mut out = BufWriter::new(std::fs::File::create(&partial).map_err(io(&partial))?);
+    let mut out = run_dir::OutputFile::create(to)?;
     if format == Format::Csv {
-        writeln!(out, "{}", COLUMNS.join(",")).map_err(io(&partial))?;
+        writeln!(out, "{}", COLUMNS.join(",")).map_err(io(to))?;
     }
     let mut next = 0u64;
     let mut rows = 0u64;
@@ -132,14 +133,57 @@ pub fn export(paths: &[PathBuf], settings: &Settings, to: &Path) -> Result<u64, 
                 Format::Csv => csv_row(&fields, &mut row),
                 Format::JsonLines => json_row(&fields, &mut row),
             }
-            out.write_all(&row).map_err(io(&partial))?;
+            out.write_all(&row).map_err(io(to))?;
             rows += 1;
         }
     }
-    out.flush().map_err(io(&partial))?;
-    drop(out);
-    std::fs::rename(&partial, to).map_err(io(to))?;
+    out.commit()?;
     Ok(rows)
+}
+
+/// Refuses an export path `to` that is one of the shard `files` read, or lies in one of the
+/// directories among `paths` (scanned for shards). Paths are compared with links resolved,
+/// and files also by their device and inode (a hard link).
+fn check_destination(paths: &[PathBuf], files: &[PathBuf], to: &Path) -> Result<(), MergeError> {
+    use std::os::unix::fs::MetadataExt;
+    let parent = match to.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    // A missing directory: the write will say so.
+    let Ok(parent) = parent.canonicalize() else {
+        return Ok(());
+    };
+    let refuse = |why: String| MergeError::Usage {
+        message: format!(
+            "--export {}: {why}; give a path outside the shards' directories",
+            to.display()
+        ),
+    };
+    for dir in paths.iter().filter(|p| p.is_dir()) {
+        if dir.canonicalize().is_ok_and(|d| d == parent) {
+            return Err(refuse(format!(
+                "lies in {}, a directory read for shards (the next merge would take a .jsonl export for a shard)",
+                dir.display()
+            )));
+        }
+    }
+    let target = to.file_name().map(|name| parent.join(name));
+    let inode = std::fs::symlink_metadata(to)
+        .ok()
+        .map(|m| (m.dev(), m.ino()));
+    for file in files {
+        let same_path = file.canonicalize().ok() == target;
+        let same_inode =
+            inode.is_some() && std::fs::metadata(file).ok().map(|m| (m.dev(), m.ino())) == inode;
+        if same_path || same_inode {
+            return Err(refuse(format!(
+                "is the shard file {}, which this merge reads",
+                file.display()
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// `mc-merge … --export FILE`: verifies and exports, printing the row count to `out`; with

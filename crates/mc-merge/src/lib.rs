@@ -26,7 +26,8 @@
 //!
 //! ## 1. Verification (nothing is computed unless it passes)
 //!
-//! See [`load`]: one job id across all files, each shard's closing digest, every global index
+//! See [`load`]: only regular files named, one job id across all files, each shard's closing
+//! digest, every converged θ_P in [0, π/2], every global index
 //! `0..job_samples` exactly once (byte-identical duplicates and agreeing overlaps accepted,
 //! disagreeing overlaps refused naming both files and the first disagreeing index), no torn or
 //! corrupt line, no incomplete file. A missing range is refused naming the index ranges and their
@@ -70,8 +71,10 @@
 //! ## 4. Output
 //!
 //! With `--out REPORT_DIR`: `report.json` (schema in [`report`], summary below, and the
-//! standalone JSON Schema `docs/report.schema.json`), written atomically into a directory
-//! that holds no other job's report ([`report_dir`]), and SVG and PNG plots ([`plot`]).
+//! standalone JSON Schema `docs/report.schema.json`), and SVG and PNG plots ([`plot`]),
+//! each written atomically and never through a link into a directory that holds no other
+//! job's report and that no other merge is writing; a rerun removes only the files it listed
+//! in its manifest ([`report_dir`]).
 //! Unless `--quiet`: a table on stdout (angles in rad and arcsec). With `--export FILE`: every
 //! sample as a flat row ([`export`]; for pandas, `read_json(…, lines=True,
 //! precise_float=True)`).
@@ -126,9 +129,10 @@
 //! | --- | --- |
 //! | 0 | verified and reported |
 //! | 1 | internal error (a bug) |
-//! | 2 | usage error |
+//! | 2 | usage error (also: an `--export` path among the shards) |
+//! | 3 | a file named on the command line is not a regular file (a FIFO, a device) |
 //! | 4 | I/O error |
-//! | 5 | a file in the way: the report directory holds another job's `report.json` |
+//! | 5 | a file in the way: the report directory holds another job's `report.json`, another merge is writing it, or a link or a non-file stands at a name to be written |
 //! | 6 | verification failure: torn, corrupt or incomplete shard, other job id, wrong digest, missing range, disagreeing overlap |
 //! | 7 | failed samples present without `--allow-failed` |
 //!
@@ -246,22 +250,23 @@ pub fn report_json(report: &Report) -> Result<String, MergeError> {
 }
 
 /// Runs a merge as the command line asks: verify, compute, print the table to `out`, and with
-/// a report directory write `report.json` and the plots ([`report_dir`]: another job's report
-/// directory is refused, our own earlier files replaced, `report.json` written atomically).
+/// a report directory write `report.json` and the plots ([`report_dir`]: the directory is
+/// locked, another job's report directory is refused, every file written atomically and
+/// never through a link, only our own earlier files removed).
 pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError> {
     let merge = merge(&options.paths, &options.settings)?;
     let json = report_json(&merge.report)?;
     let mut text = table::render(&merge.report, merge.dataset.files.len());
     if let Some(dir) = &options.out {
-        report_dir::prepare(dir, &merge.report.job_id)?;
-        let path = dir.join(report_dir::REPORT_FILE);
-        report_dir::write_atomically(&path, json.as_bytes())?;
+        let mut files = report_dir::open(dir, &merge.report.job_id)?;
+        let path = files.write(report_dir::REPORT_FILE, json.as_bytes())?;
         text.push_str(&format!("\nwrote {}\n", path.display()));
         if options.plots {
-            for p in plot::draw_all(dir, &merge.dataset.cases, &merge.report)? {
+            for p in plot::draw_all(&mut files, &merge.dataset.cases, &merge.report)? {
                 text.push_str(&format!("wrote {}\n", p.display()));
             }
         }
+        files.finish()?;
     }
     out.write_all(text.as_bytes())
         .map_err(|source| MergeError::Io {

@@ -5,8 +5,10 @@
 //! Before anything is computed:
 //!
 //! 1. Every file is read strictly with [`shard_record::read_shard`]: a torn last line, a missing
-//!    end line, a corrupt line, an index out of order or a wrong closing digest is an error
-//!    naming the file and line.
+//!    end line, a corrupt line (or one longer than [`shard_record::MAX_LINE_BYTES`]), an index
+//!    out of order, a wrong closing digest, or a converged θ_P outside [0, π/2] rad is an
+//!    error naming the file and line. A file named on the command line must be a regular file
+//!    (a FIFO or a device is refused before it is opened).
 //! 2. All files carry the job id of the first file read, and the same cases.
 //! 3. Each global index `0..job_samples` is held at least once. Where shards overlap, every
 //!    overlapping sample must be identical, compared by a 64-bit fingerprint of the bytes of
@@ -34,7 +36,6 @@
 use crate::errors::{FailedCase, MergeError, MissingRange};
 use crate::rng::mix64;
 use shard_record::{Begin, CaseInfo, Sample, ScanError, ShardRange, read_shard};
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 /// How many failure reasons (the lowest indices) to keep per case.
@@ -87,6 +88,8 @@ struct Columns {
     tan_y: Vec<f64>,
     /// 0: not recorded, 1: no loose joint, 2: at least one.
     loose: Vec<u8>,
+    /// 0: not recorded, 1: not floating, 2: floating.
+    floating: Vec<u8>,
 }
 
 fn zeroed<T: Clone>(n: usize, v: T) -> Result<Vec<T>, String> {
@@ -106,6 +109,7 @@ impl Columns {
             tan_x: zeroed(n, 0.0)?,
             tan_y: zeroed(n, 0.0)?,
             loose: zeroed(n, 0)?,
+            floating: zeroed(n, 0)?,
         })
     }
 }
@@ -194,18 +198,30 @@ impl CaseData {
     /// Loose-joint counts among converged samples: (samples recording the field, samples with
     /// at least one loose joint).
     pub fn loose_joints(&self) -> (u64, u64) {
+        self.flag_counts(|c| &c.loose)
+    }
+
+    /// Floating counts among converged samples: (samples recording the field, samples with a
+    /// floating stage).
+    pub fn floating(&self) -> (u64, u64) {
+        self.flag_counts(|c| &c.floating)
+    }
+
+    /// (converged samples whose flag column is recorded, those whose flag is set) for a
+    /// column of 0 (not recorded), 1 (not set), 2 (set).
+    fn flag_counts(&self, column: impl Fn(&Columns) -> &Vec<u8>) -> (u64, u64) {
         let Some(c) = &self.columns else {
             return (0, 0);
         };
         let mut recorded = 0;
-        let mut loose = 0;
-        for (s, l) in c.state.iter().zip(&c.loose) {
+        let mut set = 0;
+        for (s, l) in c.state.iter().zip(column(c)) {
             if *s == CONVERGED && *l > 0 {
                 recorded += 1;
-                loose += u64::from(*l == 2);
+                set += u64::from(*l == 2);
             }
         }
-        (recorded, loose)
+        (recorded, set)
     }
 }
 
@@ -243,8 +259,9 @@ impl Dataset {
     }
 }
 
-/// The shard files among `paths`: each directory contributes its `*.jsonl` files (not
-/// recursively, sorted by name); each file is taken as given.
+/// The shard files among `paths`: each directory contributes its `*.jsonl` regular files
+/// (not recursively, sorted by name); each file is taken as given, if it is a regular file
+/// (links followed; a FIFO or a device is refused, [`run_dir::RunDirError::NotRegular`]).
 pub fn shard_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, MergeError> {
     let mut files = vec![];
     for path in paths {
@@ -253,6 +270,14 @@ pub fn shard_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, MergeError> {
             source,
         };
         let meta = std::fs::metadata(path).map_err(io)?;
+        if !meta.is_dir() && !meta.is_file() {
+            // A FIFO would block the open, a device (`/dev/zero`) never ends.
+            return Err(run_dir::RunDirError::NotRegular {
+                path: path.clone(),
+                kind: run_dir::errors::file_kind(&meta.file_type()),
+            }
+            .into());
+        }
         if meta.is_dir() {
             let mut found = vec![];
             for entry in std::fs::read_dir(path).map_err(io)? {
@@ -311,7 +336,12 @@ fn peek_header(path: &Path) -> Result<Option<Begin>, MergeError> {
     };
     let mut reader = std::io::BufReader::new(std::fs::File::open(path).map_err(io)?);
     let mut line = vec![];
-    reader.read_until(b'\n', &mut line).map_err(io)?;
+    if shard_record::read_line(&mut reader, &mut line, shard_record::MAX_BEGIN_LINE_BYTES)
+        .map_err(io)?
+        .is_none()
+    {
+        return Ok(None);
+    }
     Ok(match shard_record::parse_record(&line) {
         Ok(shard_record::Record::Begin(b)) if line.ends_with(b"\n") && b.check().is_ok() => Some(b),
         _ => None,
@@ -363,6 +393,8 @@ struct Rec {
     tan_y: f64,
     /// 0: not recorded, 1: no loose joint, 2: at least one.
     loose: u8,
+    /// 0: not recorded, 1: not floating, 2: floating.
+    floating: u8,
     /// `Some` for a failed sample.
     reason: Option<Box<str>>,
 }
@@ -381,6 +413,11 @@ impl Rec {
                 None => 0,
                 Some(0) => 1,
                 Some(_) => 2,
+            },
+            floating: match s.floating {
+                None => 0,
+                Some(false) => 1,
+                Some(true) => 2,
             },
             reason: match a {
                 Some(_) => None,
@@ -445,6 +482,7 @@ impl Store {
         cols.tan_x[k] = r.tan_x;
         cols.tan_y[k] = r.tan_y;
         cols.loose[k] = r.loose;
+        cols.floating[k] = r.floating;
         match r.reason {
             None => cols.state[k] = CONVERGED,
             Some(why) => {
@@ -472,6 +510,19 @@ enum Conflict {
     Memory(String),
 }
 
+/// Refuses a converged sample whose θ_P is not an angle between the surfaces, in
+/// [0, π/2] rad (the tangents are finite: [`Sample::angles`]). Its digests may well verify
+/// (a line rewritten with fresh ones): a θ_P of 1e308 would otherwise wreck every statistic.
+fn check_angles(sample: &Sample) -> Result<(), String> {
+    match sample.angles() {
+        Some(a) if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&a.theta_p) => Err(format!(
+            "theta_p {} rad is not a distortion angle (it lies in [0, π/2])",
+            a.theta_p
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// Reads one file in a worker thread, sending its samples in batches.
 fn read_one(
     file: usize,
@@ -487,6 +538,7 @@ fn read_one(
             stopped = true;
             return Err("stopped: another file failed".into());
         }
+        check_angles(sample)?;
         batch.push(Rec::new(line, sample, bytes));
         if batch.len() == BATCH {
             let recs = std::mem::replace(&mut batch, Vec::with_capacity(BATCH));

@@ -3,7 +3,7 @@
 //! [`mc_merge::ExitCodes`].
 
 use clap::Parser;
-use mc_merge::{Args, ExitCodes};
+use mc_merge::Args;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -12,7 +12,7 @@ fn main() -> ExitCode {
     let mut out = truss_exit::Stdout::lock();
     // A helper command, an export or a merge (see `Args::execute`).
     match args.execute(&mut out) {
-        Ok(()) => ExitCode::from(ExitCodes::OK),
+        Ok(()) => truss_exit::success("mc-merge", &mut out),
         Err(e) => truss_exit::finish("mc-merge", &e, e.exit_code(), &out),
     }
 }

@@ -215,6 +215,8 @@ pub struct Definitions {
     pub sweep: &'static str,
     /// The loose-joint fraction.
     pub loose_joints: &'static str,
+    /// How the floating fraction is computed.
+    pub floating: &'static str,
 }
 
 /// The bootstrap's definition and parameters.
@@ -257,6 +259,8 @@ pub struct CaseReport {
     pub caveats: Vec<String>,
     /// Fraction of samples with at least one loose backlash joint.
     pub loose_joints: LooseJoints,
+    /// Fraction of samples with a floating stage.
+    pub floating: Floating,
     /// Bootstrap bookkeeping.
     pub bootstrap: BootstrapCase,
     /// Empirical percentiles of θ_P with intervals.
@@ -295,6 +299,18 @@ pub struct LooseJoints {
     /// Of those, samples with at least one loose joint.
     pub with_loose: u64,
     /// `with_loose / recorded` with its Clopper–Pearson interval.
+    pub fraction: Figure,
+}
+
+/// Floating stages: samples in which some stage's tilt is held by pretension alone.
+#[derive(Debug, Clone, Serialize)]
+pub struct Floating {
+    /// Converged samples that record `floating` (those of models whose bars do not frame the
+    /// top surface's tilt).
+    pub recorded: u64,
+    /// Of those, samples with a floating stage.
+    pub floating: u64,
+    /// `floating / recorded` with its Clopper–Pearson interval.
     pub fraction: Figure,
 }
 

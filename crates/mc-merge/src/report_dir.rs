@@ -1,70 +1,67 @@
-//! The report directory (`--out`): written safely, and never mixed with another job's files.
+//! The report directory (`--out`): one merge at a time, written safely, never mixed with
+//! another job's files, and only our own files removed. The rules are the workspace's, in
+//! the crate `run-dir`:
 //!
-//! - `report.json` is written to a temporary file in the same directory (`.report.json.tmp-PID`),
-//!   flushed to disk, then renamed over the old one: a reader, a crash or a full disk sees the
-//!   old report or the new one, never a torn file.
-//! - A directory is reused only for the same job. If it holds a `report.json` of another job,
-//!   or a `report.json` that is not an mc-merge report, the merge is refused (exit 5, a file in
-//!   the way) and nothing in it is touched: give another `--out`, or remove the old report.
-//! - Before the new files are written, our own earlier files are removed: beside the same
-//!   job's `report.json` (which is written before the plots), plot files by their
-//!   names ([`crate::plot::is_plot_file`]: `theta_p-*`, `tan-*`, `qq-*`, `exceedance-*`,
-//!   `running-*` and the two sweeps, `.svg` or `.png`) and stale temporary reports. So no plot
-//!   of an earlier run (a renamed case, a run with plots when this one has `--no-plots`) stays
-//!   beside a report it does not belong to. Other files are left alone, and so are files named
-//!   like plots in a directory without a report (a diagnosis's `theta_p-ecdf-before.svg`).
+//! - **Locked.** The directory is locked while a merge writes it (an OS advisory lock on
+//!   `.truss-mc.lock`, the kind the shards use); a second merge into it is refused at once
+//!   (exit 5), naming the holder's pid: wait for the first, then run again.
+//! - **Never through a link.** Every file (`report.json`, each plot) is written to a
+//!   temporary file with an unpredictable name in the directory, flushed to disk and renamed
+//!   over the old one: a reader, a crash or a full disk sees the old file or the new one,
+//!   never a torn file. A symbolic link, or anything but a regular file, at a name we write
+//!   is refused (exit 5), naming it; the file it points at is not touched.
+//! - **Reused only for the same job.** If the directory holds a `report.json` of another
+//!   job, or one that is not an mc-merge report, the merge is refused (exit 5) and nothing
+//!   in it is touched: give another `--out`, or remove the old report.
+//! - **Only our files removed.** mc-merge lists what it wrote in `.mc-merge.manifest`; a
+//!   rerun removes the files listed there that it does not write again (a renamed case's
+//!   plots, the plots of a run with plots when this one has `--no-plots`) after writing the
+//!   new ones. Every other file stays: a user's `theta_p-annotated.svg`, a diagnosis's
+//!   `theta_p-ecdf-before.svg`.
 
 use crate::errors::MergeError;
 use crate::report::REPORT_FORMAT;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use run_dir::{OutputDir, RunDirError};
+use std::io::Read;
+use std::path::Path;
 
 /// The report's file name.
 pub const REPORT_FILE: &str = "report.json";
 
-/// The prefix of temporary report files.
-const TEMP_PREFIX: &str = ".report.json.tmp-";
+/// The writer's name in the directory's manifest.
+pub const WRITER: &str = "mc-merge";
 
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> MergeError + '_ {
-    move |source| MergeError::Io {
-        path: path.to_path_buf(),
-        source,
-    }
+/// The longest `report.json` read to check its owner \[bytes\].
+pub const MAX_REPORT_BYTES: u64 = 256 << 20;
+
+/// Opens (creating if needed) and locks the report directory `dir`, refusing it if it
+/// holds another job's (or a foreign) report. A refused directory is left as it was: its
+/// report is checked before the lock file is created, and again under the lock.
+pub fn open(dir: &Path, job_id: &str) -> Result<OutputDir, MergeError> {
+    check_report(dir, job_id)?;
+    let out = OutputDir::open(dir, WRITER)?;
+    check_report(dir, job_id)?;
+    Ok(out)
 }
 
-/// Creates `dir` if needed, refuses it if it holds another job's (or a foreign) report, and
-/// removes our own earlier plots and temporary files from it.
-pub fn prepare(dir: &Path, job_id: &str) -> Result<(), MergeError> {
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
+/// Refuses `dir` if its `report.json` (not followed if a link) is not this job's report.
+fn check_report(dir: &Path, job_id: &str) -> Result<(), MergeError> {
     let report = dir.join(REPORT_FILE);
-    let ours_before = match std::fs::read(&report) {
-        Ok(bytes) => {
-            check_owner(&report, &bytes, job_id)?;
-            true
+    let file = match run_dir::input::open_own(&report, std::fs::OpenOptions::new().read(true)) {
+        Ok(file) => file,
+        Err(RunDirError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
+            return Ok(());
         }
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
-        Err(source) => {
-            return Err(MergeError::Io {
-                path: report,
-                source,
-            });
-        }
+        Err(e) => return Err(e.into()),
     };
-    for entry in std::fs::read_dir(dir).map_err(io(dir))? {
-        let entry = entry.map_err(io(dir))?;
-        let name = entry.file_name();
-        let Some(name) = name.to_str() else { continue };
-        // Plots are ours only beside our report (written before them): in a directory
-        // without one, a file named like a plot (`theta_p-ecdf-before.svg` of a diagnosis)
-        // is someone else's.
-        let ours =
-            (ours_before && crate::plot::is_plot_file(name)) || name.starts_with(TEMP_PREFIX);
-        if ours && entry.file_type().map_err(io(dir))?.is_file() {
-            let path = entry.path();
-            std::fs::remove_file(&path).map_err(io(&path))?;
-        }
-    }
-    Ok(())
+    let mut bytes = Vec::new();
+    file.take(MAX_REPORT_BYTES)
+        .read_to_end(&mut bytes)
+        .map_err(|source| MergeError::Io {
+            path: report.clone(),
+            source,
+        })?;
+    check_owner(&report, &bytes, job_id)
 }
 
 fn check_owner(report: &Path, bytes: &[u8], job_id: &str) -> Result<(), MergeError> {
@@ -89,24 +86,4 @@ fn check_owner(report: &Path, bytes: &[u8], job_id: &str) -> Result<(), MergeErr
             old.unwrap_or("(none)")
         ))),
     }
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same directory, flushed to disk
-/// and renamed over `path`; the temporary file is removed if anything fails.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), MergeError> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let temp: PathBuf = dir.join(format!("{TEMP_PREFIX}{}", std::process::id()));
-    let result = (|| {
-        let mut file = std::fs::File::create(&temp)?;
-        file.write_all(bytes)?;
-        file.sync_all()?;
-        std::fs::rename(&temp, path)
-    })();
-    result.map_err(|source| {
-        let _ = std::fs::remove_file(&temp);
-        MergeError::Io {
-            path: path.to_path_buf(),
-            source,
-        }
-    })
 }

@@ -159,6 +159,16 @@ pub fn render(report: &Report, files: usize) -> String {
                 plain(&case.loose_joints.fraction, 2)
             );
         }
+        if case.floating.recorded > 0 {
+            let _ = writeln!(
+                s,
+                "{}: floating stages in {} of {} samples ({})",
+                case.name,
+                case.floating.floating,
+                case.floating.recorded,
+                plain(&case.floating.fraction, 2)
+            );
+        }
         for c in &case.caveats {
             let _ = writeln!(s, "{}: CAVEAT {c}", case.name);
         }

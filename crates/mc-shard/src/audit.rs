@@ -22,7 +22,7 @@
 //!    compared with the file's, byte for byte.
 //!
 //! The result goes to `audit.json` beside the shards (the first directory given, or the
-//! first file's directory): `job_id`, `seed`, `samples_requested`, `samples_checked`,
+//! first file's directory; written through a temporary file, never through a link): `job_id`, `seed`, `samples_requested`, `samples_checked`,
 //! `lines_in_shards`, `files`, `seconds`, and `mismatches` (each with `file`, `line` (from
 //! 1), `index`, `case`, `sample`, `found` and `expected` lines). A mismatch or a file that
 //! does not verify exits with the verification code (6); another job's shard with 5.
@@ -122,6 +122,10 @@ pub enum AuditError {
     /// `--samples` out of bounds.
     #[error("--samples must be 1 to {MAX_AUDIT_SAMPLES}, not {0}")]
     Samples(u64),
+    /// A file named is not a regular file, or `audit.json` is a link or could not be
+    /// written.
+    #[error(transparent)]
+    Files(#[from] run_dir::RunDirError),
 }
 
 impl AuditError {
@@ -132,11 +136,13 @@ impl AuditError {
             AuditError::Scan(_) | AuditError::NoShards(_) => truss_exit::VERIFICATION,
             AuditError::OtherJob { .. } => truss_exit::IN_THE_WAY,
             AuditError::Samples(_) => truss_exit::USAGE,
+            AuditError::Files(e) => e.exit_code(),
         }
     }
 }
 
-/// The shard files of `paths`: `*.jsonl` files of directories (name order), and files.
+/// The shard files of `paths`: `*.jsonl` regular files of directories (name order), and
+/// files, which must be regular files (a FIFO or a device is refused before it is opened).
 pub fn shard_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, AuditError> {
     let mut files = Vec::new();
     for p in paths {
@@ -153,6 +159,7 @@ pub fn shard_files(paths: &[PathBuf]) -> Result<Vec<PathBuf>, AuditError> {
             found.sort();
             files.extend(found);
         } else {
+            run_dir::input::check_regular(p)?;
             files.push(p.clone());
         }
     }
@@ -238,13 +245,7 @@ pub fn audit(
     };
     report.seconds = started.elapsed().as_secs_f64();
     let text = serde_json::to_string_pretty(&report).expect("the report serialises") + "\n";
-    let tmp = dir.join(format!("audit.json.tmp-{}", std::process::id()));
-    let io = |source| AuditError::Io {
-        path: report.written_to.clone(),
-        source,
-    };
-    std::fs::write(&tmp, text).map_err(io)?;
-    std::fs::rename(&tmp, &report.written_to).map_err(io)?;
+    run_dir::write_file(&report.written_to, text.as_bytes())?;
     Ok(report)
 }
 

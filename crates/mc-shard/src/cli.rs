@@ -150,10 +150,10 @@ pub struct WorkArgs {
     pub threads: Option<usize>,
     /// Seconds between heartbeats of a claim (more than 0, at most a week, less than
     /// --stale-after).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, allow_negative_numbers = true)]
     pub heartbeat: f64,
     /// Seconds after which an untouched claim is stale and taken over (at most a week).
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long, default_value_t = 60.0, allow_negative_numbers = true)]
     pub stale_after: f64,
     /// Show no progress.
     #[arg(long, short = 'q')]
@@ -300,14 +300,10 @@ impl CliError {
 pub fn run_exit_code(e: &RunError) -> u8 {
     match e {
         RunError::Usage(_) => exit::USAGE,
-        RunError::Job(JobError::Io { .. }) => exit::IO,
-        RunError::Job(JobError::InFile { source, .. })
-            if matches!(**source, JobError::Io { .. }) =>
-        {
-            exit::IO
-        }
+        RunError::Job(e) if e.is_io() => exit::IO,
         RunError::Job(_) => exit::INVALID_INPUT,
         RunError::Shard(ShardError::Io { .. }) => exit::IO,
+        RunError::Shard(ShardError::Files(e)) => e.exit_code(),
         RunError::Shard(_) => exit::IN_THE_WAY,
     }
 }
@@ -322,13 +318,29 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Command::Status(a) => status_command(a, out),
         Command::Audit(a) => audit_command(a, out),
         Command::Inputs(a) => inputs_command(a, out),
-        Command::Completions(a) => {
-            let mut cmd = <Cli as clap::CommandFactory>::command();
-            clap_complete::generate(a.shell, &mut cmd, "mc-shard", out);
-            Ok(())
-        }
+        Command::Completions(a) => completions(
+            a.shell,
+            <Cli as clap::CommandFactory>::command(),
+            "mc-shard",
+            out,
+        ),
         Command::Man => man_page(<Cli as clap::CommandFactory>::command(), out),
     }
+}
+
+/// Writes `cmd`'s completion script for `shell` to `out`, through memory first:
+/// `clap_complete` panics when its writer fails (a full disk), and a failed write is an
+/// I/O error like any other.
+pub fn completions(
+    shell: clap_complete::Shell,
+    mut cmd: clap::Command,
+    name: &str,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let mut script = Vec::new();
+    clap_complete::generate(shell, &mut cmd, name, &mut script);
+    out.write_all(&script)?;
+    Ok(())
 }
 
 /// Writes `cmd`'s man page (roff), with a section per subcommand, to `out`.
@@ -397,10 +409,11 @@ fn inputs_command(a: InputsArgs, out: &mut dyn Write) -> Result<(), CliError> {
             source,
         }))
     };
-    let file = std::fs::File::create(&a.out).map_err(io)?;
-    let mut w = std::io::BufWriter::new(file);
+    // Written whole or not at all: a full disk leaves the old file at its name.
+    let files = |e: run_dir::RunDirError| CliError::Run(RunError::Shard(e.into()));
+    let mut w = run_dir::OutputFile::create(&a.out).map_err(files)?;
     let rows = crate::inputs::write_inputs(&job, case, range, &mut w).map_err(io)?;
-    w.flush().map_err(io)?;
+    w.commit().map_err(files)?;
     writeln!(out, "{}: {rows} samples' inputs (mm)", a.out.display())?;
     Ok(())
 }

@@ -52,15 +52,50 @@ pub enum ShardError {
         /// What is wrong.
         message: String,
     },
-    /// Another process holds the file's lock: it is writing this shard now.
-    #[error("{}: another process is writing this shard (its lock is held)", path.display())]
+    /// Another process holds the file's lock: it is writing this shard now. (Locks are never
+    /// stale: the operating system releases one when its holder exits, however it ends.)
+    #[error("{}: {LOCKED} ({}): wait for it or stop it", path.display(), run_dir::errors::holder_words(*holder))]
     Locked {
         /// The file.
         path: PathBuf,
+        /// The holder's pid, when this machine can see it.
+        holder: Option<u32>,
     },
+    /// A file at the shard's name that does not begin with a begin record: not a shard, so
+    /// it is neither truncated nor appended to.
+    #[error("{}: does not begin with a shard's begin line: it is not a shard file, and is never truncated or appended to (move it away, or use another --out)", path.display())]
+    NotAShard {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A symbolic link or a non-file at a name to be written (the shard, a quarantine
+    /// marker, the claims or quarantine directory), or an output that could not be written.
+    #[error(transparent)]
+    Files(#[from] run_dir::RunDirError),
     /// The file is damaged in a way no crash produces (a bad line before the end).
     #[error(transparent)]
     Corrupt(shard_record::ScanError),
+}
+
+/// What a live shard lock's message says; `truss-mc run-all` recognises it in a child's
+/// error, to advise waiting rather than moving the file away.
+pub const LOCKED: &str = "another process is writing this shard";
+
+impl ShardError {
+    /// Whether the file is in the way in a way a rerun does not cure (damaged, another job's,
+    /// not a shard, a link or a non-file at its name): a cron worker sets such a shard aside.
+    pub fn is_damage(&self) -> bool {
+        use run_dir::RunDirError;
+        matches!(
+            self,
+            ShardError::Corrupt(_)
+                | ShardError::OtherJob { .. }
+                | ShardError::HeaderMismatch { .. }
+                | ShardError::OldFormat { .. }
+                | ShardError::NotAShard { .. }
+                | ShardError::Files(RunDirError::Link { .. } | RunDirError::NotAFile { .. })
+        )
+    }
 }
 
 /// Why a run could not start or finish.

@@ -21,6 +21,9 @@
 //! values are the *drawn* errors, before effects (gravity, temperature) add to them. The
 //! draws are those of [`crate::sampler::draw_sample`], so they are the very numbers the
 //! shards' samples were solved with.
+//!
+//! The file is written to a temporary file beside `--out` and renamed when complete (crate
+//! `run-dir`): a full disk leaves the old file at its name, and a link there is refused.
 
 use crate::job::Job;
 use crate::sampler::{draw_sample, stream_key};

@@ -57,9 +57,10 @@
 //!
 //! The scheme every truss-mc binary shares (`truss-exit`): 0 success, 1 internal error, 2
 //! usage error or a range outside the job, 3 invalid job (the message gives the JSON path of
-//! the fault), 4 a file could not be read or written, 5 the shard file is in the way
-//! (another job's, locked by another process, damaged, a changed header; for `work`: a
-//! shard quarantined), 6 an audit found a line that differs from its re-solve or a shard
+//! the fault) or a file named for `audit` that is not a regular file, 4 a file could not be
+//! read or written, 5 the shard file is in the way (another job's, locked by another
+//! process, damaged, not a shard, a changed header, a symbolic link at its name or at
+//! `claims/` or `quarantine/`; for `work`: a shard quarantined), 6 an audit found a line that differs from its re-solve or a shard
 //! that does not verify, 130 / 143 `run` or `work` stopped by SIGINT / SIGTERM, every
 //! finished sample kept ([`interrupt`]).
 

@@ -6,7 +6,7 @@ fn main() -> std::process::ExitCode {
     let cli = mc_shard::cli::Cli::parse();
     let mut out = truss_exit::Stdout::lock();
     match mc_shard::cli::run(cli, &mut out) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
+        Ok(()) => truss_exit::success("mc-shard", &mut out),
         // "interrupted: N samples kept; rerun …" is a notice, not an error.
         Err(e @ mc_shard::cli::CliError::Interrupted { .. }) => {
             eprintln!("{e}");

@@ -1,9 +1,15 @@
 //! One shard file: created, or found and verified, then appended to line by line.
 //!
 //! Opening a shard:
+//! - a new shard file is created whole with its begin line: written to a temporary file with
+//!   an unpredictable name beside it and linked into place only if the name is still free
+//!   (crate `run-dir`); a symbolic link or a non-file at the shard's name is refused, and an
+//!   existing file is opened without following a link ([`ShardError::Files`]);
 //! - takes an exclusive lock on the file (an OS file lock, `flock`), so two processes never
-//!   write one shard; a second gets [`ShardError::Locked`];
-//! - an empty file, or one torn while its header was written, starts afresh;
+//!   write one shard; a second gets [`ShardError::Locked`], naming the holder's pid;
+//! - an empty file, or one torn while its header was written (its bytes a beginning of a
+//!   begin record), starts afresh; a file that does not begin with a begin record is not a
+//!   shard and is left untouched ([`ShardError::NotAShard`]);
 //! - a file of another job id or range, or whose header differs from the job's in any case
 //!   or parameter, is an error and is left untouched;
 //! - a complete file is verified (every line, every checkpoint, the closing digests, which
@@ -20,6 +26,7 @@
 //! order, so a crash loses at most the lines not yet written.
 
 use crate::errors::ShardError;
+use run_dir::lock::Lock;
 use shard_record::{
     Begin, CHECKPOINT_EVERY, ScanError, ShardEncoder, ShardRange, ShardScan, Tail, scan_shard,
 };
@@ -67,18 +74,11 @@ impl ShardWriter {
             path: path.clone(),
             source,
         };
-        let file = OpenOptions::new()
-            .read(true)
-            .append(true)
-            .create(true)
-            .open(&path)
-            .map_err(io)?;
-        match file.try_lock() {
-            Ok(()) => {}
-            Err(std::fs::TryLockError::WouldBlock) => {
-                return Err(ShardError::Locked { path });
-            }
-            Err(std::fs::TryLockError::Error(e)) => return Err(io(e)),
+        create(&path, begin)?;
+        let file = run_dir::input::open_own(&path, OpenOptions::new().read(true).append(true))?;
+        match run_dir::lock::try_lock(&file).map_err(io)? {
+            Lock::Taken => {}
+            Lock::Held { holder } => return Err(ShardError::Locked { path, holder }),
         }
         let fresh = |file: File| -> Result<Opened, ShardError> {
             file.set_len(0).map_err(io)?;
@@ -98,7 +98,10 @@ impl ShardWriter {
         }
         let scan = match scan_shard(&path, |_, _, _| Ok(())) {
             Ok(scan) => scan,
-            Err(ScanError::NoHeader { .. }) => return fresh(file),
+            Err(ScanError::NoHeader { .. }) if torn_header(&file).map_err(io)? => {
+                return fresh(file);
+            }
+            Err(ScanError::NoHeader { .. }) => return Err(ShardError::NotAShard { path }),
             Err(e) => return Err(ShardError::Corrupt(e)),
         };
         if scan.begin.job_id != begin.job_id || scan.begin.range != range {
@@ -205,6 +208,40 @@ impl ShardWriter {
             source,
         })
     }
+}
+
+/// How every begin line starts (the record's tag is written first).
+const BEGIN_PREFIX: &[u8] = br#"{"record":"begin""#;
+
+/// Creates the shard file `path` holding `begin`'s line, unless something is at that name
+/// already; refuses a link or a non-file there.
+fn create(path: &Path, begin: &Begin) -> Result<(), ShardError> {
+    run_dir::output::check_final(path)?;
+    if std::fs::symlink_metadata(path).is_ok() {
+        return Ok(());
+    }
+    let mut out = run_dir::OutputFile::create(path)?;
+    let (_, header) = ShardEncoder::new(begin);
+    out.write_all(&header).map_err(|source| ShardError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    // Another process may have created it meanwhile: then that file is opened and checked.
+    out.commit_new()?;
+    Ok(())
+}
+
+/// Whether a file without a complete first line holds the beginning of a begin record (a
+/// writer stopped while writing its header), read from its start.
+fn torn_header(file: &File) -> std::io::Result<bool> {
+    use std::io::Read;
+    let mut head = Vec::with_capacity(BEGIN_PREFIX.len());
+    let mut reader = file;
+    std::io::Seek::seek(&mut reader, std::io::SeekFrom::Start(0))?;
+    reader
+        .take(BEGIN_PREFIX.len() as u64)
+        .read_to_end(&mut head)?;
+    Ok(BEGIN_PREFIX.starts_with(&head))
 }
 
 /// The header of `range` of `job`.

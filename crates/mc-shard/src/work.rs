@@ -28,12 +28,18 @@
 //!   not of this split (left by `mc-shard run` with another K) refuse the worker the same way.
 //! - **A damaged shard is set aside, not a stop.** A shard file that cannot be resumed or
 //!   skipped (a line that breaks the format or its checkpoint, a changed header, another
-//!   job's file, an old format) is quarantined: `DIR/quarantine/shard-i-of-K.json` records
+//!   job's file, an old format, a file that is not a shard, a link or a non-file at its
+//!   name) is quarantined: `DIR/quarantine/shard-i-of-K.json` records
 //!   the reason, host, pid and time, the claim is released, the file is left untouched for
 //!   inspection, and the worker goes on with the other shards. Later workers skip a
 //!   quarantined shard. When no shard is left, a worker exits with the file-in-the-way code
 //!   (5) if any shard is quarantined, naming them; `mc-shard status` lists them. To retry a
 //!   shard: move its file away (or repair it), delete its marker, and run again.
+//!
+//! - **Nothing through a link.** `claims/` and `quarantine/` are refused (exit 5) when they
+//!   are symbolic links, `pool.json` and the markers are written through temporary files
+//!   with unpredictable names, and claims and markers are opened without following links
+//!   (crate `run-dir`).
 //!
 //! Claims and locks need a shared filesystem with atomic `O_EXCL` create and working file
 //! locks across machines (a local disk, NFSv4, CephFS, Lustre).
@@ -45,7 +51,7 @@ use crate::errors::{RunError, ShardError};
 use crate::job::Job;
 use crate::runner::{RunOptions, run_shard};
 use shard_record::ShardRange;
-use std::fs::{File, OpenOptions};
+use std::fs::OpenOptions;
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -94,9 +100,16 @@ pub fn quarantine_path(dir: &Path, i: u64, k: u64) -> PathBuf {
         .join(format!("shard-{i}-of-{k}.json"))
 }
 
-/// The reason recorded in shard `i` of `k`'s quarantine marker, if it has one.
+/// The longest quarantine marker read \[bytes\].
+const MAX_MARKER_BYTES: u64 = 1 << 20;
+
+/// The reason recorded in shard `i` of `k`'s quarantine marker, if it has one (a marker
+/// that is a link or not a regular file is not read).
 pub fn quarantined(dir: &Path, i: u64, k: u64) -> Option<String> {
-    let text = std::fs::read_to_string(quarantine_path(dir, i, k)).ok()?;
+    let file = run_dir::input::open_own(&quarantine_path(dir, i, k), OpenOptions::new().read(true))
+        .ok()?;
+    let mut text = String::new();
+    file.take(MAX_MARKER_BYTES).read_to_string(&mut text).ok()?;
     Some(
         serde_json::from_str::<serde_json::Value>(&text)
             .ok()
@@ -116,13 +129,8 @@ fn quarantine(
     pid: u32,
 ) -> Result<(), RunError> {
     let path = quarantine_path(dir, i, k);
-    let io = |source| {
-        RunError::Shard(ShardError::Io {
-            path: path.clone(),
-            source,
-        })
-    };
-    std::fs::create_dir_all(path.parent().expect("a marker has a directory")).map_err(io)?;
+    run_dir::create_dir(path.parent().expect("a marker has a directory"))
+        .map_err(|e| RunError::Shard(e.into()))?;
     let since = SystemTime::now()
         .duration_since(SystemTime::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());
@@ -130,9 +138,8 @@ fn quarantine(
         "shard": i, "shards": k, "range": range, "file": range.file_name(),
         "reason": reason, "host": host, "pid": pid, "quarantined_at_unix": since,
     });
-    let tmp = path.with_extension(format!("json.tmp-{pid}"));
-    std::fs::write(&tmp, format!("{marker}\n")).map_err(io)?;
-    std::fs::rename(&tmp, &path).map_err(io)
+    run_dir::write_file(&path, format!("{marker}\n").as_bytes())
+        .map_err(|e| RunError::Shard(e.into()))
 }
 
 /// Checks that the directory's worker pool is of this job and split (see the module doc),
@@ -160,19 +167,20 @@ fn check_pool(job: &Job, dir: &Path, claims: &Path, ranges: &[ShardRange]) -> Re
                 )));
             }
         }
-        let pid = std::process::id();
-        let tmp = claims.join(format!("pool.json.tmp-{}-{pid}", host_name()));
         let text = serde_json::json!({"job_id": job.id, "shards": shards});
-        std::fs::write(&tmp, format!("{text}\n")).map_err(|e| io(&tmp, e))?;
-        let linked = std::fs::hard_link(&tmp, &pool);
-        let _ = std::fs::remove_file(&tmp);
-        match linked {
-            Ok(()) => return Ok(()),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
-            Err(e) => return Err(io(&pool, e)),
+        let files = |e: run_dir::RunDirError| RunError::Shard(e.into());
+        let mut out = run_dir::OutputFile::create(&pool).map_err(files)?;
+        writeln!(out, "{text}").map_err(|e| io(&pool, e))?;
+        if out.commit_new().map_err(files)? {
+            return Ok(());
         }
     }
-    let text = std::fs::read_to_string(&pool).map_err(|e| io(&pool, e))?;
+    let mut text = String::new();
+    run_dir::input::open_own(&pool, OpenOptions::new().read(true))
+        .map_err(|e| RunError::Shard(e.into()))?
+        .take(MAX_MARKER_BYTES)
+        .read_to_string(&mut text)
+        .map_err(|e| io(&pool, e))?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| {
         RunError::Shard(ShardError::Pool {
             path: pool.clone(),
@@ -221,11 +229,12 @@ pub fn work(
 ) -> Result<Vec<Action>, RunError> {
     let ranges = ShardRange::partition(options.shards, job.samples())
         .map_err(|e| RunError::Usage(e.to_string()))?;
-    let claims = dir.join("claims");
-    std::fs::create_dir_all(&claims).map_err(|source| ShardError::Io {
-        path: claims.clone(),
+    std::fs::create_dir_all(dir).map_err(|source| ShardError::Io {
+        path: dir.to_path_buf(),
         source,
     })?;
+    let claims = dir.join("claims");
+    run_dir::create_dir(&claims).map_err(ShardError::from)?;
     check_pool(job, dir, &claims, &ranges)?;
     let host = host_name();
     let pid = std::process::id();
@@ -297,12 +306,7 @@ pub fn work(
                 let _ = std::fs::remove_file(&claim);
                 act(i, "locked-elsewhere", 0, 0, None);
             }
-            Err(RunError::Shard(
-                e @ (ShardError::Corrupt(_)
-                | ShardError::OtherJob { .. }
-                | ShardError::HeaderMismatch { .. }
-                | ShardError::OldFormat { .. }),
-            )) => {
+            Err(RunError::Shard(e)) if e.is_damage() => {
                 let reason = e.to_string();
                 let marked = quarantine(dir, i, options.shards, *range, &reason, &host, pid);
                 let _ = std::fs::remove_file(&claim);
@@ -321,12 +325,13 @@ pub fn work(
 /// Whether a shard file's header is `begin`'s and it ends with an end line (a cheap look;
 /// running it verifies every line).
 fn looks_complete(path: &Path, begin: &shard_record::Begin) -> bool {
-    let Ok(mut f) = File::open(path) else {
+    let Ok(mut f) = run_dir::input::open_own(path, OpenOptions::new().read(true)) else {
         return false;
     };
     let mut header = Vec::new();
-    let same = std::io::BufRead::read_until(&mut std::io::BufReader::new(&f), b'\n', &mut header)
-        .is_ok()
+    let max = shard_record::MAX_BEGIN_LINE_BYTES;
+    let same = shard_record::read_line(&mut std::io::BufReader::new(&f), &mut header, max)
+        .is_ok_and(|n| n.is_some())
         && matches!(shard_record::parse_record(&header),
                     Ok(shard_record::Record::Begin(b)) if b.same_shard(begin));
     if !same {
@@ -415,7 +420,7 @@ fn is_stale(path: &Path, stale_after: Duration) -> bool {
 }
 
 /// Runs `f` while a thread touches `claim` every `every`.
-fn with_heartbeat<T>(claim: &PathBuf, every: Duration, f: impl FnOnce() -> T) -> T {
+fn with_heartbeat<T>(claim: &Path, every: Duration, f: impl FnOnce() -> T) -> T {
     let done = AtomicBool::new(false);
     std::thread::scope(|s| {
         s.spawn(|| {
@@ -426,7 +431,8 @@ fn with_heartbeat<T>(claim: &PathBuf, every: Duration, f: impl FnOnce() -> T) ->
                 since += step;
                 if since >= every {
                     since = Duration::ZERO;
-                    if let Ok(f) = OpenOptions::new().append(true).open(claim) {
+                    if let Ok(f) = run_dir::input::open_own(claim, OpenOptions::new().append(true))
+                    {
                         let _ = f.set_modified(SystemTime::now());
                     }
                 }

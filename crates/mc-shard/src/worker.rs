@@ -65,6 +65,7 @@ pub fn record(job: &Job, r: &SampleResult) -> Sample {
         residual: None,
         slack_cables: None,
         loose_joints: None,
+        floating: None,
         reason: None,
     };
     match &r.outcome {
@@ -75,6 +76,7 @@ pub fn record(job: &Job, r: &SampleResult) -> Sample {
             residual: Some(c.residual),
             slack_cables: Some(c.slack_cables),
             loose_joints: c.loose_joints,
+            floating: c.floating,
             ..base
         },
         Outcome::Failed(reason) => Sample {

@@ -28,8 +28,10 @@
 //!    `status` (`"converged"` or `"failed"`), `iterations` (Newton iterations), and
 //!    - when converged: `theta_p`, `tan_theta_x`, `tan_theta_y` (rad and dimensionless, paper
 //!      eqs. 2, 8, 9), `residual` (final out-of-balance force, N), optionally `slack_cables`
-//!      (how many tension-only members ended slack) and `loose_joints` (backlash joints whose
-//!      virtual cable ended slack);
+//!      (how many tension-only members ended slack), `loose_joints` (backlash joints whose
+//!      virtual cable ended slack) and `floating` (`true` when some stage's tilt is held by
+//!      pretension alone, not by the members that bear; written for models whose bars do
+//!      not frame the top surface's tilt, such as the prism with pin joints in free play);
 //!    - when failed: `reason`, a sentence saying why.
 //!
 //!    A failed solve is a line with its status, never a missing line.
@@ -120,7 +122,7 @@ pub mod parameters {
     /// The joints' regularisation `k_c/k_t` (cases differing in it form their own series).
     pub const JOINT_COMPRESSION_RATIO: &str = "joint_compression_ratio";
     /// The cables' compression stiffness over their tension stiffness, written only where it
-    /// is not the default 1e-4 (cases differing in it form their own series).
+    /// is not the default 0 (the limit; cases differing in it form their own series).
     pub const CABLE_COMPRESSION_RATIO: &str = "cable_compression_ratio";
     /// Every key, in the order above.
     pub const ALL: [&str; 6] = [
@@ -132,7 +134,7 @@ pub mod parameters {
         CABLE_COMPRESSION_RATIO,
     ];
 }
-pub use scan::{ScanError, ShardScan, Tail, parse_record, read_shard, scan_shard};
+pub use scan::{ScanError, ShardScan, Tail, parse_record, read_line, read_shard, scan_shard};
 
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
@@ -152,6 +154,16 @@ pub const CHECKPOINT_EVERY: u64 = 100;
 /// The largest `checkpoint_every` a reader accepts (it holds that many lines while it
 /// verifies them).
 pub const MAX_CHECKPOINT_EVERY: u64 = 100_000;
+
+/// The longest sample, checkpoint or end line a reader takes, 1 MiB \[bytes\]: a sample line
+/// is a few hundred bytes. A longer line (a file that is not a shard, a sparse file of
+/// zeros) is refused as corrupt before it is read into memory.
+pub const MAX_LINE_BYTES: u64 = 1 << 20;
+
+/// The longest begin line a reader takes, 256 MiB \[bytes\]: it lists every case of the job
+/// with its parameters, about a hundred bytes a case, so four times the largest job file
+/// (64 MiB) holds any job's.
+pub const MAX_BEGIN_LINE_BYTES: u64 = 256 << 20;
 
 /// One line of a shard file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -264,6 +276,10 @@ pub struct Sample {
     /// Number of backlash joints whose virtual cable ended slack (the joint is loose).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub loose_joints: Option<u32>,
+    /// Whether some stage's tilt is held by pretension alone, not by the members that bear
+    /// (a floating stage); written for models whose bars do not frame the tilt.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floating: Option<bool>,
     /// Why the solve failed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,

@@ -9,9 +9,11 @@
 //! line) verifies them: only then are they passed to `visit` and counted in the scan's
 //! digest and valid prefix (see the crate doc, "What is verified").
 
-use crate::{Begin, End, Record, Sample, SampleDigest, sha256_hex};
+use crate::{
+    Begin, End, MAX_BEGIN_LINE_BYTES, MAX_LINE_BYTES, Record, Sample, SampleDigest, sha256_hex,
+};
 use std::fs::File;
-use std::io::{self, BufRead, BufReader};
+use std::io::{self, BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
 
 /// What went wrong reading a shard file. Every variant names the file, and the line where
@@ -127,11 +129,27 @@ pub fn scan_shard(
         line,
         message,
     };
+    // Only a regular file: opening a FIFO would wait for a writer, a device never ends.
+    let meta = std::fs::metadata(path).map_err(io_err)?;
+    if !meta.is_file() {
+        return Err(io_err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "not a regular file",
+        )));
+    }
     let mut reader = BufReader::with_capacity(1 << 16, File::open(path).map_err(io_err)?);
     let mut buf = Vec::with_capacity(256);
+    let too_long = |line: u64, max: u64| {
+        corrupt(
+            line,
+            format!("a line longer than {max} bytes: not a shard line"),
+        )
+    };
 
     // The header.
-    let n = reader.read_until(b'\n', &mut buf).map_err(io_err)?;
+    let n = read_line(&mut reader, &mut buf, MAX_BEGIN_LINE_BYTES)
+        .map_err(io_err)?
+        .ok_or_else(|| too_long(1, MAX_BEGIN_LINE_BYTES))?;
     if n == 0 || buf.last() != Some(&b'\n') {
         return Err(ScanError::NoHeader {
             path: path.to_path_buf(),
@@ -164,11 +182,13 @@ pub fn scan_shard(
 
     loop {
         buf.clear();
-        let n = reader.read_until(b'\n', &mut buf).map_err(io_err)?;
+        line_no += 1;
+        let n = read_line(&mut reader, &mut buf, MAX_LINE_BYTES)
+            .map_err(io_err)?
+            .ok_or_else(|| too_long(line_no, MAX_LINE_BYTES))?;
         if n == 0 {
             return Ok(open(begin, digest, valid_len, pending.len(), Tail::Open));
         }
-        line_no += 1;
         if buf.last() != Some(&b'\n') {
             let tail = Tail::Torn { line: line_no };
             return Ok(open(begin, digest, valid_len, pending.len(), tail));
@@ -235,7 +255,10 @@ pub fn scan_shard(
                     // writer cuts off so the finished file has only scheduled checkpoints.
                     valid_len += pending_len;
                     buf.clear();
-                    if reader.read_until(b'\n', &mut buf).map_err(io_err)? != 0 {
+                    if read_line(&mut reader, &mut buf, MAX_LINE_BYTES)
+                        .map_err(io_err)?
+                        .is_none_or(|n| n != 0)
+                    {
                         return Err(corrupt(
                             line_no,
                             format!(
@@ -287,7 +310,10 @@ pub fn scan_shard(
                 digest = pending_digest;
                 valid_len += pending_len + n as u64;
                 buf.clear();
-                if reader.read_until(b'\n', &mut buf).map_err(io_err)? != 0 {
+                if read_line(&mut reader, &mut buf, MAX_LINE_BYTES)
+                    .map_err(io_err)?
+                    .is_none_or(|n| n != 0)
+                {
                     return Err(corrupt(line_no + 1, "data after the end line".into()));
                 }
                 return Ok(open(begin, digest, valid_len, 0, Tail::Complete(end)));
@@ -373,6 +399,18 @@ pub fn read_shard(
             expected: scan.begin.range.len(),
         }),
     }
+}
+
+/// Reads one line, with its `\n` if it has one, into `buf`: its length (0 at the end of the
+/// file), or `None` if the line is longer than `max` bytes (then more than `max` bytes of it
+/// are in `buf`, and no more).
+pub fn read_line(
+    reader: &mut impl BufRead,
+    buf: &mut Vec<u8>,
+    max: u64,
+) -> io::Result<Option<usize>> {
+    let n = reader.by_ref().take(max + 1).read_until(b'\n', buf)?;
+    Ok((n as u64 <= max).then_some(n))
 }
 
 /// Parses one line (with or without its `\n`) as a record.

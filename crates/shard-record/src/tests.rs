@@ -47,6 +47,7 @@ fn sample(index: u64, theta: f64) -> Sample {
         residual: Some(1e-12),
         slack_cables: Some(2),
         loose_joints: None,
+        floating: None,
         reason: None,
     }
 }

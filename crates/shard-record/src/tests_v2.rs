@@ -42,6 +42,7 @@ fn sample(index: u64) -> Sample {
         residual: (index != 3).then_some(1e-12),
         slack_cables: None,
         loose_joints: None,
+        floating: None,
         reason: (index == 3).then(|| "Newton did not converge".to_string()),
     }
 }

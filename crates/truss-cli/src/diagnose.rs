@@ -23,7 +23,7 @@ pub struct DiagnoseArgs {
     #[arg(long)]
     pub measured_members: Option<PathBuf>,
     /// The instrument's standard deviation per coordinate (mm).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub measurement_sigma: f64,
     /// Simulated samples per evaluation, 100 to 10 000 (default max(2000, 20 × specimens),
     /// at most 10 000).
@@ -64,7 +64,7 @@ pub struct SynthArgs {
     #[arg(long)]
     pub effect: String,
     /// The instrument's standard deviation per coordinate (mm).
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub measurement_sigma: f64,
     /// Write every node, not only the top surface.
     #[arg(long)]
@@ -76,6 +76,9 @@ pub struct SynthArgs {
 
 /// The exit code of a diagnosis error (see the crate doc).
 pub fn exit_code(e: &DiagnoseError) -> u8 {
+    if let DiagnoseError::Files(e) = e {
+        return e.exit_code();
+    }
     if e.is_io() {
         return EXIT_IO;
     }

@@ -37,8 +37,9 @@
 //! | 0 | success |
 //! | 1 | internal error (a bug) |
 //! | 2 | usage error (bad arguments) |
-//! | 3 | the model file, job or measured data is invalid (the message names the item or line) |
+//! | 3 | the model file, job or measured data is invalid (the message names the item or line), or a file named is not a regular file |
 //! | 4 | a file could not be read or written |
+//! | 5 | a file in the way: a symbolic link or a non-file at an output's name, or an output directory another process is writing |
 //! | 6 | a tolerance allocation did not verify (its files are written) |
 //! | 7 | the solve failed (not converged, mechanism; the JSON result says why), or a diagnosis's simulation failed |
 
@@ -122,51 +123,52 @@ pub struct PrismArgs {
     #[arg(long, default_value_t = table1().stages)]
     pub stages: usize,
     /// Batten length l, the triangle's side (mm).
-    #[arg(long, default_value_t = table1().side)]
+    #[arg(long, default_value_t = table1().side, allow_negative_numbers = true)]
     pub side: f64,
     /// Stage height h, the longeron length (mm).
-    #[arg(long, default_value_t = table1().height)]
+    #[arg(long, default_value_t = table1().height, allow_negative_numbers = true)]
     pub height: f64,
     /// Batten cross-section (mm²).
-    #[arg(long, default_value_t = table1().batten_area)]
+    #[arg(long, default_value_t = table1().batten_area, allow_negative_numbers = true)]
     pub batten_area: f64,
     /// Batten Young's modulus (MPa).
-    #[arg(long, default_value_t = table1().batten_modulus)]
+    #[arg(long, default_value_t = table1().batten_modulus, allow_negative_numbers = true)]
     pub batten_modulus: f64,
     /// Longeron cross-section (mm²).
-    #[arg(long, default_value_t = table1().longeron_area)]
+    #[arg(long, default_value_t = table1().longeron_area, allow_negative_numbers = true)]
     pub longeron_area: f64,
     /// Longeron Young's modulus (MPa).
-    #[arg(long, default_value_t = table1().longeron_modulus)]
+    #[arg(long, default_value_t = table1().longeron_modulus, allow_negative_numbers = true)]
     pub longeron_modulus: f64,
     /// Diagonal cable cross-section (mm²).
-    #[arg(long, default_value_t = table1().diagonal_area)]
+    #[arg(long, default_value_t = table1().diagonal_area, allow_negative_numbers = true)]
     pub diagonal_area: f64,
     /// Diagonal cable Young's modulus (MPa).
-    #[arg(long, default_value_t = table1().diagonal_modulus)]
+    #[arg(long, default_value_t = table1().diagonal_modulus, allow_negative_numbers = true)]
     pub diagonal_modulus: f64,
     /// Diagonal natural length (mm; Table 1: 537.4).
-    #[arg(long, default_value_t = TABLE1_DIAGONAL_LENGTH, conflicts_with = "exact_diagonals")]
+    #[arg(long, default_value_t = TABLE1_DIAGONAL_LENGTH, conflicts_with = "exact_diagonals", allow_negative_numbers = true)]
     pub diagonal_length: f64,
     /// Give the diagonals the exact face-diagonal length √(l² + h²) instead.
     #[arg(long)]
     pub exact_diagonals: bool,
-    /// Cables' compression stiffness / tension stiffness.
-    #[arg(long, default_value_t = truss_core::DEFAULT_COMPRESSION_RATIO)]
+    /// Cables' compression stiffness / tension stiffness: 0, the paper's, carries nothing
+    /// when slack (solved as the limit r → 0).
+    #[arg(long, default_value_t = truss_core::DEFAULT_COMPRESSION_RATIO, allow_negative_numbers = true)]
     pub compression_ratio: f64,
     /// Model the batten–longeron pin joints with backlash (paper section 4): each longeron
     /// end gets its own hole on the batten's shaft, with free play.
     #[arg(long)]
     pub backlash: bool,
     /// Clearance of every joint (mm; with `--backlash`).
-    #[arg(long, default_value_t = truss_core::prism::PAPER_CLEARANCE, requires = "backlash")]
+    #[arg(long, default_value_t = truss_core::prism::PAPER_CLEARANCE, requires = "backlash", allow_negative_numbers = true)]
     pub clearance: f64,
     /// Joint contact stiffness over a longeron's axial stiffness E·A/h (with `--backlash`).
-    #[arg(long, default_value_t = truss_core::joint::DEFAULT_JOINT_TENSION_FACTOR, requires = "backlash")]
+    #[arg(long, default_value_t = truss_core::joint::DEFAULT_JOINT_TENSION_FACTOR, requires = "backlash", allow_negative_numbers = true)]
     pub joint_tension_factor: f64,
     /// Loose joint's regularising stiffness over its contact stiffness, in [0, 1e-5]; 0 for
     /// none, the physical limit (with `--backlash`).
-    #[arg(long, default_value_t = truss_core::joint::DEFAULT_JOINT_COMPRESSION_RATIO, requires = "backlash")]
+    #[arg(long, default_value_t = truss_core::joint::DEFAULT_JOINT_COMPRESSION_RATIO, requires = "backlash", allow_negative_numbers = true)]
     pub joint_compression_ratio: f64,
 }
 

@@ -6,7 +6,7 @@ fn main() -> std::process::ExitCode {
     let cli = truss_cli::Cli::parse();
     let mut out = truss_exit::Stdout::lock();
     match truss_cli::run(cli, &mut out) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
+        Ok(()) => truss_exit::success("truss", &mut out),
         Err(e) => truss_exit::finish("truss", &*e, truss_cli::exit_code(&e), &out),
     }
 }

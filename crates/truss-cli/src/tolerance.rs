@@ -17,10 +17,10 @@ pub struct ToleranceArgs {
     #[arg(long)]
     pub case: String,
     /// The budget: θ_P at the percentile must not exceed this angle (arcsec).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub target_arcsec: f64,
     /// The percentile of θ_P the budget applies to (%).
-    #[arg(long, default_value_t = 95.0)]
+    #[arg(long, default_value_t = 95.0, allow_negative_numbers = true)]
     pub percentile: f64,
     /// A group's cost weight, `GROUP=WEIGHT` (default 1: cost = members / σ); repeatable.
     #[arg(long = "cost", value_name = "GROUP=WEIGHT")]
@@ -51,9 +51,9 @@ pub struct ToleranceArgs {
 /// The exit code of a tolerance error (see the crate doc).
 pub fn exit_code(e: &ToleranceError) -> u8 {
     match e {
-        ToleranceError::Job(truss_job::JobError::Io { .. })
-        | ToleranceError::Write { .. }
-        | ToleranceError::Plot { .. } => EXIT_IO,
+        ToleranceError::Job(e) if e.is_io() => EXIT_IO,
+        ToleranceError::Files(e) => e.exit_code(),
+        ToleranceError::Write { .. } | ToleranceError::Plot { .. } => EXIT_IO,
         e if e.is_usage() => EXIT_USAGE,
         ToleranceError::FailedSamples { .. } => EXIT_SOLVE_FAILED,
         ToleranceError::Verification { .. } => truss_exit::VERIFICATION,

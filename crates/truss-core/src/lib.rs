@@ -75,6 +75,7 @@ mod capacitance;
 pub mod element;
 mod errors;
 pub mod joint;
+pub mod limit;
 mod linearised;
 pub mod measure;
 pub mod model;
@@ -93,30 +94,16 @@ pub use model_file::ModelFile;
 pub use solver::{Equilibrium, IterationRecord, SolveOptions, SolveReport, Solver};
 pub use structure::Structure;
 
-/// Default compression stiffness ratio of a cable: its stiffness in compression is this
-/// fraction of its stiffness in tension.
+/// Default compression stiffness ratio of a cable: 0, the paper's (Table 1: a diagonal
+/// carries nothing in compression).
 ///
-/// The paper's Table 1 says zero, but a side face whose two diagonals are both slack is then
-/// a mechanism whose position is undetermined. A small ratio fixes it. How small: θ_P
-/// statistics of the paper's truss do not move for ratios from 1e-7 to 1e-3 (50th, 95th
-/// percentile and RMS within 1e-4 relative, tested), and single samples stay within
-/// 0.16 % of the 1e-7 limit at 1e-4 (0.024 % at 1e-5). Below about 1e-4, though, a slack
-/// panel's compressed frame (whose geometric stiffness is about −N/L ≈ −0.05 N/mm at
-/// σ = 6.3 µm) outweighs its cables' `r·k` and must rack until a diagonal engages, which the
-/// solver resolves with extra factorisations: at 1e-5 a solve costs about twice the instructions
-/// of one at 1e-4 (295k against 152k, 5-stage prism). 1e-4 keeps the physics and the speed
-/// of the rigid truss.
-///
-/// Not of a truss with backlash joints in free play: there a stage whose longerons float in
-/// their holes is held by its slack diagonals' `r·k` (0.04 N/mm at 1e-4) and the geometric
-/// stiffness of what pretension is left, and the first wins. In the paper's Fig. 16 study at
-/// σ = 6.7 µm, θ_P95 is 5.6 % lower at 1e-8 than at 1e-4 (the same 10,000 draws; 4.4 % with
-/// independent draws, beyond both intervals), and within 0.3 % of that from 1e-7 to 1e-10
-/// (the limit exists; a slow test checks it). Solves at 1e-8 take about twice the time. A
-/// job can set the ratio per case (`"compression_ratio": 1e-8` in its prism); whether the
-/// default should change for backlash models is an open modelling decision (REPRODUCTION.md,
-/// "Backlash").
-pub const DEFAULT_COMPRESSION_RATIO: f64 = 1e-4;
+/// A cable of ratio 0 is solved as the limit `r → 0`: at a small working ratio chosen per
+/// model by what holds the top surface's tilt, where the answer is the limit's (see
+/// [`limit`], which says how and what is tested). Where some stage's tilt is held by
+/// pretension alone in that limit, the sample is reported *floating*
+/// ([`SolveReport::floating`]). A ratio above 0 in a model file or job is a model choice and
+/// is used as it is.
+pub const DEFAULT_COMPRESSION_RATIO: f64 = 0.0;
 
 /// The largest length error this model answers for, as a fraction of the member's natural
 /// length: `|e| ≤ 0.01·L₀` (3.8 mm on the paper's 380 mm members).

@@ -220,6 +220,20 @@ impl Model {
             &loads,
             top_surface.as_ref(),
         )?;
+        let play: f64 = joints.iter().map(|j| j.clearance).sum();
+        for (i, m) in members.iter().enumerate() {
+            let length = distance(nodes[m.nodes[0]].xyz, nodes[m.nodes[1]].xyz);
+            let what = "the distance between its nodes";
+            if let Some(fault) = initial_strain_fault(m.natural_length, length, play, what) {
+                return Err(ModelError::Invalid {
+                    item: format!("members[{i}] (id {:?})", m.id),
+                    message: format!(
+                        "natural_length {fault}; a member that long is another design, to be \
+                         drawn with its own node positions"
+                    ),
+                });
+            }
+        }
         Ok(Self {
             nodes,
             members,
@@ -537,6 +551,40 @@ fn check_member(
         natural_length,
         behaviour,
     })
+}
+
+/// Why a natural length `natural` \[mm\] cannot start within the elastic range between
+/// points `length` \[mm\] apart (`what` says which: `the distance between its nodes`), or
+/// `None` if it can: it can when `|length − natural| ≤ natural ×`
+/// [`MAX_LENGTH_ERROR_FRACTION`] `+ play`, the bound a length error has
+/// ([`Model::max_length_error`]) widened by `play` \[mm\], the model's joint clearances
+/// summed. Free play moves each hole by at most its clearance from its shaft, so the
+/// distance between any two nodes once it is taken up is within that sum of the nominal one
+/// (0 without joints: the bound is then exact). Beyond it the initial strain
+/// `(length − natural)/natural` could only be taken up by yielding, which the model does not
+/// represent.
+pub fn initial_strain_fault(natural: f64, length: f64, play: f64, what: &str) -> Option<String> {
+    let max = natural / MAX_LENGTH_ERROR_FRACTION.recip() + play;
+    if (natural - length).abs() <= max {
+        return None;
+    }
+    let free_play = if play > 0.0 {
+        format!(
+            " and the joints' summed clearance {} mm",
+            crate::readable(play)
+        )
+    } else {
+        String::new()
+    };
+    Some(format!(
+        "{} mm is more than {}% of itself{free_play} ({} mm) from {what}, {} mm: an initial \
+         strain beyond the elastic range, where the model means nothing (see \
+         truss_core::MAX_LENGTH_ERROR_FRACTION)",
+        crate::readable(natural),
+        100.0 * MAX_LENGTH_ERROR_FRACTION,
+        crate::readable(max),
+        crate::readable(length)
+    ))
 }
 
 fn parse_fixed(item: &str, s: &SupportSpec) -> Result<Vec<usize>, ModelError> {

@@ -10,7 +10,7 @@
 //!                "behaviour": "bar"},
 //!               {"id": "diagonal.1.0.a", "nodes": ["n0.0", "n1.1"], "group": "diagonal",
 //!                "area": 3.1, "youngs_modulus": 70000.0, "natural_length": 537.4,
-//!                "behaviour": "cable", "compression_ratio": 1e-4}, …],
+//!                "behaviour": "cable"}, …],
 //!   "supports": [{"node": "n0.0", "fixed": "xyz"}, …],
 //!   "loads":    [{"node": "n5.0", "force": [0.0, 0.0, -1.0]}],
 //!   "top_surface": {"nodes": ["n5.0", "n5.1", "n5.2"], "reference_normal": [0.0, 0.0, 1.0]},
@@ -29,9 +29,9 @@
 //! | `members[].group` | group name (`batten`, `longeron`, `diagonal`, …); length-error distributions are given per group | |
 //! | `members[].area` | cross-sectional area, > 0 | mm² |
 //! | `members[].youngs_modulus` | Young's modulus, > 0 | MPa |
-//! | `members[].natural_length` | stress-free length, > 0; optional, defaults to the distance between its nodes | mm |
+//! | `members[].natural_length` | stress-free length, > 0; optional, defaults to the distance between its nodes; within [`MAX_LENGTH_ERROR_FRACTION`](crate::MAX_LENGTH_ERROR_FRACTION) of itself (plus the joints' clearances summed) of that distance ([`crate::model::initial_strain_fault`]) | mm |
 //! | `members[].behaviour` | `"bar"` (tension and compression) or `"cable"` (tension only) | |
-//! | `members[].compression_ratio` | cables only: compression stiffness / tension stiffness, in [0, 1); default 1e-4 | |
+//! | `members[].compression_ratio` | cables only: compression stiffness / tension stiffness, in [0, 1); default 0, the paper's (slack cables carry nothing: solved as the limit `r → 0`, see [`crate::limit`]) | |
 //! | `supports[].node`, `supports[].fixed` | a node and the directions held fixed, any of `"x"`, `"y"`, `"z"` (`"xyz"` = pinned) | |
 //! | `loads[].node`, `loads[].force` | a nodal force | N |
 //! | `top_surface.nodes` | three nodes whose plane is measured (paper Fig. 5 order 1, 2, 3); optional | |

@@ -81,7 +81,8 @@ pub struct PrismOptions {
     pub diagonal_modulus: f64,
     /// Diagonal natural length \[mm\]; `None` for the exact face diagonal √(l² + h²).
     pub diagonal_length: Option<f64>,
-    /// Diagonals' compression stiffness ratio (they are tension-only cables).
+    /// Diagonals' compression stiffness ratio (they are tension-only cables); 0, the
+    /// default, is the paper's: they carry nothing when slack (see [`crate::limit`]).
     pub compression_ratio: f64,
     /// Pin joints with backlash at every node (see the module doc); `None` for rigid nodes.
     pub backlash: Option<BacklashOptions>,
@@ -158,7 +159,10 @@ impl PrismOptions {
     /// writes it (`stages`, `backlash.clearance`, …) and what is wrong. Limits: `1 ≤ stages ≤`
     /// [`MAX_STAGES`]; lengths in (0, [`MAX_COORDINATE`]] mm; areas in (0, [`MAX_AREA`]] mm²;
     /// moduli in (0, [`MAX_MODULUS`]] MPa; cable compression ratio in [0, 1); the diagonal's
-    /// natural length in (0, [`MAX_COORDINATE`]] mm; a clearance in
+    /// natural length in (0, [`MAX_COORDINATE`]] mm and within
+    /// [`MAX_LENGTH_ERROR_FRACTION`](crate::MAX_LENGTH_ERROR_FRACTION) of itself (plus the
+    /// joints' summed clearance) of the face diagonal, an initial strain within the elastic
+    /// range ([`crate::model::initial_strain_fault`]); a clearance in
     /// [0, [`MAX_CLEARANCE_FRACTION`] × the shorter of side and height]; joint tension
     /// factor in (0, 10⁹]; joint compression ratio in [0, [`MAX_JOINT_COMPRESSION_RATIO`]].
     pub fn check(&self) -> Result<(), (&'static str, String)> {
@@ -210,6 +214,16 @@ impl PrismOptions {
         }
         if let Some(d) = self.diagonal_length {
             within("diagonal_length", d, MAX_COORDINATE, "mm")?;
+            let face = self.side.hypot(self.height);
+            // Each stage has six joints (a hole at each end of its three longerons).
+            let play = self
+                .backlash
+                .as_ref()
+                .map_or(0.0, |b| 6.0 * self.stages as f64 * b.clearance);
+            let what = "the face diagonal √(side² + height²)";
+            if let Some(fault) = crate::model::initial_strain_fault(d, face, play, what) {
+                return Err(("diagonal_length", fault));
+            }
         }
         if let Some(b) = &self.backlash {
             let max = MAX_CLEARANCE_FRACTION * self.side.min(self.height);

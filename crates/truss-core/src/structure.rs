@@ -45,8 +45,11 @@ pub(crate) struct CompiledMember {
     pub rigidity: f64,
     /// Nominal axial stiffness `k = E·A/L₀` \[N/mm\].
     pub stiffness: f64,
-    /// 1 for bars; the compression ratio for cables (and a half's slack-side ratio).
+    /// 1 for bars; the compression ratio for cables (and a half's slack-side ratio); for a
+    /// cable of ratio 0, the working ratio that stands for the limit (see [`crate::limit`]).
     pub compression_ratio: f64,
+    /// A cable of model ratio 0: the solver answers for the limit `r → 0`.
+    pub limit: bool,
     /// Whether the member is one-sided: a cable, or a half of a member with a dead band.
     pub is_cable: bool,
     /// `σ`: +1 for bars and tension-only members, −1 for a compression-only half.
@@ -143,6 +146,9 @@ pub struct Structure {
     /// Woodbury data over the cables, for models with few enough cables.
     pub(crate) basis: Option<CableBasis>,
     pub(crate) top_surface: Option<TopSurface>,
+    /// Whether the model's bars frame the top surface's tilt by themselves (see
+    /// [`crate::limit::tilt_framed_by_bars`]): then no sample floats.
+    pub(crate) tilt_framed: bool,
 }
 
 impl Structure {
@@ -224,6 +230,8 @@ impl Structure {
                 Behaviour::Bar => (false, 1.0),
                 Behaviour::Cable { compression_ratio } => (true, compression_ratio),
             };
+            // A cable of ratio 0 gets its working ratio once the model's framing is known.
+            let limit = is_cable && compression_ratio == 0.0;
             let rigidity = member.youngs_modulus * member.area;
             let mut compiled = CompiledMember {
                 link: link(attach(i), attach(j)),
@@ -235,6 +243,7 @@ impl Structure {
                 rigidity,
                 stiffness: rigidity / member.natural_length,
                 compression_ratio,
+                limit,
                 is_cable,
                 sense: 1.0,
                 model_member: m,
@@ -268,6 +277,7 @@ impl Structure {
                 compiled.rigidity = series * member.natural_length;
                 compiled.stiffness = series;
                 compiled.compression_ratio = ratio;
+                compiled.limit = false;
                 compiled.is_cable = true;
                 compiled.band = Some(Band {
                     joints: ends,
@@ -339,6 +349,7 @@ impl Structure {
             nominal: BlockBandMatrix::new(0, 0),
             basis: None,
             top_surface: model.top_surface().cloned(),
+            tilt_framed: false,
         };
         structure.assemble_material(&mut k, |_| 1.0);
         k.factor().map_err(|e| {
@@ -346,6 +357,15 @@ impl Structure {
             ModelError::Mechanism { node, dof }
         })?;
         structure.nominal = k;
+        structure.tilt_framed = crate::limit::tilt_framed_by_bars(&structure);
+        let working = if structure.tilt_framed {
+            crate::limit::FRAMED_RATIO
+        } else {
+            crate::limit::LIMIT_RATIO
+        };
+        for c in structure.members.iter_mut().filter(|c| c.limit) {
+            c.compression_ratio = working;
+        }
         let cables = structure.members.iter().filter(|m| m.is_cable).count();
         if cables > 0 && cables <= MAX_WOODBURY_CABLES {
             structure.basis = Some(CableBasis::new(&structure));
@@ -510,6 +530,13 @@ impl Structure {
                 })
                 .sum()
         })
+    }
+
+    /// Whether the model's bars frame the top surface's tilt by themselves (see
+    /// [`crate::limit`]): its samples never float, and a cable of ratio 0 works at
+    /// [`crate::limit::FRAMED_RATIO`].
+    pub fn tilt_framed(&self) -> bool {
+        self.tilt_framed
     }
 
     /// Number of rows of the stiffness matrix (3 per node with a free direction).

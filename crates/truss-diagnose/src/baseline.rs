@@ -68,7 +68,6 @@ impl Baseline {
     /// Reads the job file and finds the case.
     pub fn read(path: &Path, case: &str) -> Result<Self, DiagnoseError> {
         let job = Job::read(path)?;
-        let text = std::fs::read_to_string(path).map_err(|e| DiagnoseError::io(path, e))?;
         let base = path
             .parent()
             .filter(|p| !p.as_os_str().is_empty())
@@ -76,7 +75,7 @@ impl Baseline {
         let base = base
             .canonicalize()
             .map_err(|e| DiagnoseError::io(base, e))?;
-        let mut spec = JobSpec::from_json(&text).map_err(|e| e.in_file(path))?;
+        let mut spec = JobSpec::read(path)?;
         spec.model = spec.model.absolute(&base);
         for c in &mut spec.cases {
             c.model = c.model.take().map(|m| m.absolute(&base));

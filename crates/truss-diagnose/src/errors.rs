@@ -54,6 +54,10 @@ pub enum DiagnoseError {
         /// What went wrong.
         message: String,
     },
+    /// An output is in the way (a link or a non-file at its name, another process writing
+    /// the directory) or could not be written.
+    #[error(transparent)]
+    Files(#[from] run_dir::RunDirError),
     /// A plot could not be drawn.
     #[error("plot {}: {message}", path.display())]
     Plot {
@@ -71,8 +75,8 @@ impl DiagnoseError {
             self,
             DiagnoseError::Io { .. }
                 | DiagnoseError::Plot { .. }
-                | DiagnoseError::Job(truss_job::JobError::Io { .. })
-        )
+                | DiagnoseError::Files(run_dir::RunDirError::Io { .. })
+        ) || matches!(self, DiagnoseError::Job(e) if e.is_io())
     }
 
     /// An I/O error on `path`.

@@ -77,7 +77,11 @@
 //!    against the final model's, statistic by statistic.
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
-//! plots of [`plot`]. Progress goes to stderr.
+//! plots of [`plot`], each written through a temporary file and never through a link (a
+//! link or a non-file at any of [`OUTPUTS`] is refused before the work), with the directory
+//! locked while they are written and listed in `.truss-diagnose.manifest` (crate
+//! `run-dir`). The measured files are read only if they are regular files of at most
+//! 64 MiB (`/dev/zero` or a FIFO is refused at once). Progress goes to stderr.
 //!
 //! ## Candidate effects
 //!
@@ -161,6 +165,21 @@ pub struct Summary {
     pub files: Vec<PathBuf>,
 }
 
+/// The writer's name in its output directory's manifest (crate `run-dir`: a rerun removes
+/// only the files it listed there, such as the `after` plots of a run that found an effect).
+pub const WRITER: &str = "truss-diagnose";
+
+/// Every file a diagnosis may write into its output directory.
+pub const OUTPUTS: [&str; 7] = [
+    "diagnosis.json",
+    "diagnosis.md",
+    "updated-job.json",
+    "theta_p-ecdf-before.svg",
+    "theta_p-ecdf-after.svg",
+    "top-scatter-before.svg",
+    "top-scatter-after.svg",
+];
+
 /// Fewest specimens accepted.
 pub const MIN_SPECIMENS: usize = 5;
 
@@ -168,7 +187,9 @@ pub const MIN_SPECIMENS: usize = 5;
 pub const MAX_SAMPLES: usize = 10_000;
 
 /// Runs the diagnosis and writes `diagnosis.json`, `diagnosis.md`, `updated-job.json` and
-/// the plots into the output directory. What was left out of the data (outliers, unknown
+/// the plots into the output directory: each through a temporary file, never through a
+/// link (a link or a non-file at any of [`OUTPUTS`] is refused before the work), with the
+/// directory locked while they are written and a manifest of them kept ([`WRITER`]). What was left out of the data (outliers, unknown
 /// nodes and members) is reported on stderr (even with `quiet`) and in `diagnosis.json`.
 pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     let s = &options.settings;
@@ -184,6 +205,8 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
             "--samples {n}: must be from 100 to {MAX_SAMPLES}"
         )));
     }
+    // Before any work: no output may go through a link.
+    run_dir::OutputDir::check(&options.out, &OUTPUTS)?;
     let progress = diagnose::Progress::new(s.quiet);
     let base = baseline::Baseline::read(&options.job, &options.case)?;
     let data = measured::read(
@@ -195,12 +218,11 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     warn_left_out(&data.report);
     let d = diagnose::diagnose(&base, &data, s, &progress)?;
     let dir = &options.out;
-    std::fs::create_dir_all(dir).map_err(|e| DiagnoseError::io(dir, e))?;
-    let mut files = Vec::new();
+    let mut out = run_dir::OutputDir::open(dir, WRITER)?;
     let mut plots = Vec::new();
     if options.plots {
         plots.extend(plot::draw(
-            dir,
+            &mut out,
             "before",
             &data,
             &d.simulations.0,
@@ -209,31 +231,25 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
         )?);
         if let Some(sim) = &d.simulations.1 {
             let label = format!("with {}", d.named_effects().join(" and "));
-            plots.extend(plot::draw(dir, "after", &data, sim, d.top, &label)?);
+            plots.extend(plot::draw(&mut out, "after", &data, sim, d.top, &label)?);
         }
     }
-    let write = |name: &str, text: &str, files: &mut Vec<PathBuf>| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).map_err(|e| DiagnoseError::io(&p, e))?;
-        files.push(p);
-        Ok::<(), DiagnoseError>(())
-    };
-    write(
-        "diagnosis.json",
-        &report::json(&base, &data, &d, s.measurement_sigma),
-        &mut files,
-    )?;
-    write(
-        "diagnosis.md",
-        &report::markdown(&base, &data, &d, &plots),
-        &mut files,
-    )?;
-    write(
-        "updated-job.json",
-        &base.updated_job_json(&d.updated),
-        &mut files,
-    )?;
+    let mut files = vec![
+        out.write(
+            "diagnosis.json",
+            report::json(&base, &data, &d, s.measurement_sigma).as_bytes(),
+        )?,
+        out.write(
+            "diagnosis.md",
+            report::markdown(&base, &data, &d, &plots).as_bytes(),
+        )?,
+        out.write(
+            "updated-job.json",
+            base.updated_job_json(&d.updated).as_bytes(),
+        )?,
+    ];
     files.extend(plots.iter().map(|p| dir.join(p)));
+    out.finish()?;
     progress.note(&format!("wrote {}", dir.display()));
     Ok(Summary {
         verdict: d.verdict,

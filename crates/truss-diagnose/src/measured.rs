@@ -202,8 +202,17 @@ impl Measured {
 
 /// Data rows of a CSV file with the named columns, as (line, fields in the order asked).
 fn read_table(path: &Path, columns: &[&str]) -> Result<Vec<(u64, Vec<String>)>, DiagnoseError> {
-    let bytes = std::fs::read(path).map_err(|e| DiagnoseError::io(path, e))?;
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
+    // A regular file of at most 64 MiB in UTF-8 (a FIFO or /dev/zero is refused before it
+    // is opened), as every input file is read; a byte-order mark is dropped.
+    use truss_core::model_file::{ReadFailure, read_input};
+    let text = read_input(path).map_err(|e| match e {
+        ReadFailure::Io(e) => DiagnoseError::io(path, e),
+        ReadFailure::Refused(reason) => DiagnoseError::Measured {
+            path: path.to_path_buf(),
+            message: reason.to_string(),
+        },
+    })?;
+    let bytes = text.as_bytes();
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .flexible(true)

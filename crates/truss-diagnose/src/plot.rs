@@ -10,7 +10,7 @@ use crate::errors::DiagnoseError;
 use crate::measured::Measured;
 use crate::simulate::Simulation;
 use plotters::prelude::*;
-use std::path::Path;
+use run_dir::OutputDir;
 
 const SIM: RGBColor = RGBColor(30, 90, 200);
 const MEAS: RGBColor = RGBColor(200, 30, 30);
@@ -31,8 +31,8 @@ fn ecdf(v: &[f64]) -> Vec<(f64, f64)> {
     out
 }
 
-fn ecdf_plot(path: &Path, measured: &Measured, sim: &Simulation, title: &str) -> PlotResult {
-    let root = SVGBackend::new(path, (800, 560)).into_drawing_area();
+fn ecdf_plot(svg: &mut String, measured: &Measured, sim: &Simulation, title: &str) -> PlotResult {
+    let root = SVGBackend::with_string(svg, (800, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let hi = measured
         .theta_p
@@ -74,13 +74,13 @@ fn ecdf_plot(path: &Path, measured: &Measured, sim: &Simulation, title: &str) ->
 }
 
 fn scatter_plot(
-    path: &Path,
+    svg: &mut String,
     measured: &Measured,
     sim: &Simulation,
     top: [[usize; 3]; 3],
     title: &str,
 ) -> PlotResult {
-    let root = SVGBackend::new(path, (1200, 800)).into_drawing_area();
+    let root = SVGBackend::with_string(svg, (1200, 800)).into_drawing_area();
     root.fill(&WHITE)?;
     let (upper, panels) = root.split_vertically(40);
     upper.titled(title, (FONT, 20))?;
@@ -130,42 +130,39 @@ fn scatter_plot(
     Ok(())
 }
 
-/// Draws the before (`suffix = "before"`) or after plots into `dir`; returns the file names.
+/// Draws the before (`suffix = "before"`) or after plots into `out`; returns the file names.
 pub fn draw(
-    dir: &Path,
+    out: &mut OutputDir,
     suffix: &str,
     measured: &Measured,
     sim: &Simulation,
     top: [[usize; 3]; 3],
     label: &str,
 ) -> Result<Vec<String>, DiagnoseError> {
-    let mut out = Vec::new();
+    let plot_error = |name: &str, err: Box<dyn std::error::Error>| DiagnoseError::Plot {
+        path: out.path().join(name),
+        message: err.to_string(),
+    };
     let e = format!("theta_p-ecdf-{suffix}.svg");
-    let path = dir.join(&e);
+    let mut ecdf = String::new();
     ecdf_plot(
-        &path,
+        &mut ecdf,
         measured,
         sim,
         &format!("θ_P: measured (red) and {label} (blue)"),
     )
-    .map_err(|err| DiagnoseError::Plot {
-        path: path.clone(),
-        message: err.to_string(),
-    })?;
-    out.push(e);
+    .map_err(|err| plot_error(&e, err))?;
     let s = format!("top-scatter-{suffix}.svg");
-    let path = dir.join(&s);
+    let mut scatter = String::new();
     scatter_plot(
-        &path,
+        &mut scatter,
         measured,
         sim,
         top,
         &format!("Top-node displacements: measured (red) and {label} (blue)"),
     )
-    .map_err(|err| DiagnoseError::Plot {
-        path: path.clone(),
-        message: err.to_string(),
-    })?;
-    out.push(s);
-    Ok(out)
+    .map_err(|err| plot_error(&s, err))?;
+    out.write(&e, ecdf.as_bytes())?;
+    out.write(&s, scatter.as_bytes())?;
+    Ok(vec![e, s])
 }

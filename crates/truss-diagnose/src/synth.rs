@@ -118,7 +118,7 @@ pub fn synth(options: &SynthOptions, out: &mut dyn Write) -> Result<usize, Diagn
                 }
             }
         }
-        std::fs::write(path, text).map_err(|e| DiagnoseError::io(path, e))?;
+        run_dir::write_file(path, text.as_bytes())?;
     }
     Ok(sim.n)
 }

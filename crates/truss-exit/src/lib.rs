@@ -29,7 +29,13 @@
 //!   the binary quietly with code 0, as `ripgrep` and other command-line tools do: the
 //!   reader asked for no more, so nothing failed. stdout is wrapped in a [`Stdout`], which
 //!   notes the broken pipe, so that only a broken pipe *on stdout* is quiet; one on any other
-//!   file or child process is an error like any other.
+//!   file or child process is an error like any other;
+//! - output that cannot be written (a full disk, `/dev/full`) is an I/O error ([`IO`]),
+//!   also when it is found only as the binary ends: [`success`] flushes what stdout still
+//!   buffers and reports a failure there, so a result that cannot be written is never a
+//!   success. (A stdout *closed* when the binary starts, `>&-`, cannot be told from
+//!   `/dev/null`: before `main` runs, Rust's runtime opens `/dev/null` in place of a closed
+//!   standard descriptor, as `subprocess.DEVNULL` does in Python, so writes to it succeed.)
 
 /// Success.
 pub const OK: u8 = 0;
@@ -103,6 +109,16 @@ impl<W: std::io::Write> std::io::Write for Stdout<W> {
     fn flush(&mut self) -> std::io::Result<()> {
         let r = self.inner.flush();
         self.note(r)
+    }
+}
+
+/// Ends the binary `binary` after success: flushes `stdout` (what is still buffered), and
+/// ends with [`OK`], or like [`finish`] with [`IO`] if the flush fails.
+pub fn success<W: std::io::Write>(binary: &str, stdout: &mut Stdout<W>) -> std::process::ExitCode {
+    use std::io::Write;
+    match stdout.flush() {
+        Ok(()) => std::process::ExitCode::from(OK),
+        Err(e) => finish(binary, &e, IO, stdout),
     }
 }
 
@@ -232,6 +248,28 @@ mod tests {
         assert_eq!(quiet, std::process::ExitCode::from(super::OK));
         let loud = super::finish("t", &e, super::IO, &fresh);
         assert_eq!(loud, std::process::ExitCode::from(super::IO));
+    }
+
+    /// A flush that fails at the end is an I/O error, not a success.
+    #[test]
+    fn a_failed_final_flush_is_an_io_error() {
+        struct Full;
+        impl Write for Full {
+            fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+                Ok(buf.len())
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Err(std::io::ErrorKind::StorageFull.into())
+            }
+        }
+        let mut full = super::Stdout::new(Full);
+        let code = super::success("t", &mut full);
+        assert_eq!(code, std::process::ExitCode::from(super::IO));
+        let mut fine = super::Stdout::new(Vec::new());
+        assert_eq!(
+            super::success("t", &mut fine),
+            std::process::ExitCode::from(super::OK)
+        );
     }
 
     /// The codes are distinct, and the summary states each.

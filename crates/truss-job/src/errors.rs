@@ -22,6 +22,17 @@ pub enum JobError {
         /// Why.
         reason: truss_core::InputRefusal,
     },
+    /// A model file the job names could not be read (missing, no permission): an I/O
+    /// failure, as the job file's own is.
+    #[error("{at}: cannot read model file {}: {source}", path.display())]
+    ModelIo {
+        /// JSON path of the model in the job (`model`, `cases[1].model`).
+        at: String,
+        /// The model file.
+        path: PathBuf,
+        /// The operating system's error.
+        source: std::io::Error,
+    },
     /// A value is invalid; `path` is its JSON path (`cases[2].length_errors.longeron`).
     #[error("{}{message}", if path.is_empty() { String::new() } else { format!("{path}: ") })]
     Invalid {
@@ -46,6 +57,16 @@ impl JobError {
         JobError::Invalid {
             path: path.to_string(),
             message: message.to_string(),
+        }
+    }
+
+    /// Whether a file could not be read (the job file, or a model file it names): an I/O
+    /// failure (exit code 4), not an invalid job (3).
+    pub fn is_io(&self) -> bool {
+        match self {
+            JobError::Io { .. } | JobError::ModelIo { .. } => true,
+            JobError::InFile { source, .. } => source.is_io(),
+            JobError::Refused { .. } | JobError::Invalid { .. } => false,
         }
     }
 

@@ -21,7 +21,7 @@
 //! |---|---|
 //! | `model` | `{"prism": {...}}` (the paper's truss: `stages` and any of `side`, `height`, `batten_area`, `batten_modulus`, `longeron_area`, `longeron_modulus`, `diagonal_area`, `diagonal_modulus`, `diagonal_length` (mm, or `"exact"`), `compression_ratio`, `backlash`: `true` or `{"clearance", "tension_factor", "compression_ratio"}` for pin joints with clearance, see [`truss_core::prism::BacklashOptions`]), or a model file: `"path.json"` or `{"file": "path.json"}`, relative to the job file |
 //! | `seed` | a u64; with the case name and sample index it keys every random draw |
-//! | `cases[].name` | unique; names the case in shard files and reports |
+//! | `cases[].name` | unique, at most [`MAX_CASE_NAME_BYTES`] bytes, no control characters; names the case in shard files, reports and plot file names |
 //! | `cases[].samples` | ≥ 1 |
 //! | `cases[].model` | optional: this case's own model, same forms as `model` |
 //! | `cases[].length_errors` | per member group, a distribution of the length error (natural length minus nominal, mm): `{"normal": {"sigma": s}}` (optional `"mean"`), `{"uniform": {"low": a, "high": b}}`, `{"constant": {"value": v}}`. Groups not named get none. |
@@ -46,7 +46,10 @@
 //! alone or with a thermal effect's `α·ΔT·L`; a clearance can exceed
 //! [`MAX_CLEARANCE_FRACTION`](truss_core::model::MAX_CLEARANCE_FRACTION) of a jointed
 //! member's length; an effect's value is implausible (see [`crate::effects`]); a group is
-//! named twice, or given two distributions.
+//! named twice, or given two distributions; a case name is longer than
+//! [`MAX_CASE_NAME_BYTES`] or holds a control character ([`check_case_name`]). A model file
+//! the job names that cannot be read (missing, no permission) is an I/O failure
+//! ([`JobError::ModelIo`]), as the job file's own is; one that is not a model is invalid.
 //!
 //! ## Job id
 //!
@@ -71,7 +74,7 @@ use truss_core::{Model, Structure};
 
 /// Version of the numerics: bumped whenever the solver or the sampling would give different
 /// numbers for the same job, so that the job id changes and old and new shards never mix.
-pub const NUMERICS_VERSION: u32 = 5;
+pub const NUMERICS_VERSION: u32 = 6;
 
 /// The most samples a case may have, 10⁸. At 10⁸ samples the 95th percentile's relative
 /// standard error is about 10⁻⁴, far finer than any input of the model is known; and the
@@ -233,6 +236,24 @@ pub fn parse_prism(value: &serde_json::Value, at: &str) -> Result<PrismOptions, 
 }
 
 impl JobSpec {
+    /// Reads a job file (a regular file of at most
+    /// [`MAX_INPUT_BYTES`](truss_core::model_file::MAX_INPUT_BYTES) in UTF-8: a FIFO or a
+    /// device is refused before it is opened) and parses it, naming the file in any fault.
+    pub fn read(path: &Path) -> Result<Self, JobError> {
+        use truss_core::model_file::{ReadFailure, read_input};
+        let text = read_input(path).map_err(|e| match e {
+            ReadFailure::Io(source) => JobError::Io {
+                path: path.to_path_buf(),
+                source,
+            },
+            ReadFailure::Refused(reason) => JobError::Refused {
+                path: path.to_path_buf(),
+                reason,
+            },
+        })?;
+        Self::from_json(&text).map_err(|e| e.in_file(path))
+    }
+
     /// Parses a job's text, naming faults by their JSON path.
     /// A leading UTF-8 byte-order mark is accepted and dropped.
     pub fn from_json(text: &str) -> Result<Self, JobError> {
@@ -333,19 +354,9 @@ pub struct Job {
 impl Job {
     /// Reads and validates a job file.
     pub fn read(path: &Path) -> Result<Self, JobError> {
-        use truss_core::model_file::{ReadFailure, read_input};
-        let text = read_input(path).map_err(|e| match e {
-            ReadFailure::Io(source) => JobError::Io {
-                path: path.to_path_buf(),
-                source,
-            },
-            ReadFailure::Refused(reason) => JobError::Refused {
-                path: path.to_path_buf(),
-                reason,
-            },
-        })?;
+        let spec = JobSpec::read(path)?;
         let base = path.parent().unwrap_or(Path::new("."));
-        let mut job = Self::from_json(&text, base).map_err(|e| e.in_file(path))?;
+        let mut job = Self::new(&spec, base).map_err(|e| e.in_file(path))?;
         job.path = Some(path.to_path_buf());
         Ok(job)
     }
@@ -365,9 +376,7 @@ impl Job {
         let mut start = 0u64;
         for (i, c) in spec.cases.iter().enumerate() {
             let at = |field: &str| format!("cases[{i}].{field}");
-            if c.name.is_empty() {
-                return Err(JobError::at(&at("name"), "must not be empty"));
-            }
+            check_case_name(&c.name).map_err(|m| JobError::at(&at("name"), &m))?;
             if let Some(j) = cases.iter().position(|o| o.name == c.name) {
                 return Err(JobError::at(
                     &at("name"),
@@ -519,6 +528,47 @@ impl Job {
     }
 }
 
+/// The longest case name \[bytes\]. A case's name becomes part of file names (the merge's
+/// plots, `exceedance-NAME.png`, with `~K` appended where the name is not plain, see
+/// mc-merge's `file_stems`), and file systems take at most 255 bytes a name.
+pub const MAX_CASE_NAME_BYTES: usize = 200;
+
+/// Checks a case name: not empty, at most [`MAX_CASE_NAME_BYTES`], and no control characters
+/// (a terminal escape sequence printed by `plan`, a NUL or a line break in a file name or
+/// the merge's SVG, which XML does not allow) nor the XML non-characters U+FFFE and U+FFFF.
+/// The message shows the name escaped and shortened, never its raw characters. (Plot file
+/// names stay unique however names are sanitised: mc-merge appends a name's position to any
+/// name that is not plain.)
+pub fn check_case_name(name: &str) -> Result<(), String> {
+    let shown = || {
+        let head: String = name.chars().take(40).collect();
+        if head.len() < name.len() {
+            format!("{head:?}… ({} bytes)", name.len())
+        } else {
+            format!("{head:?}")
+        }
+    };
+    if name.is_empty() {
+        return Err("must not be empty".into());
+    }
+    if name.len() > MAX_CASE_NAME_BYTES {
+        return Err(format!(
+            "{} is longer than {MAX_CASE_NAME_BYTES} bytes: case names become part of the merge's file names",
+            shown()
+        ));
+    }
+    if let Some(c) = name
+        .chars()
+        .find(|c| c.is_control() || matches!(c, '\u{fffe}' | '\u{ffff}'))
+    {
+        return Err(format!(
+            "{} holds the control character {c:?}: case names are printed and become file names and SVG text; use letters, digits and punctuation",
+            shown()
+        ));
+    }
+    Ok(())
+}
+
 /// Refuses length errors that can reach beyond
 /// [`MAX_LENGTH_ERROR_FRACTION`](truss_core::MAX_LENGTH_ERROR_FRACTION) of a member's
 /// natural length ([`Model::max_length_error`]): a group's distribution alone (its
@@ -644,15 +694,16 @@ fn resolve_model(spec: &ModelSpec, path: &str, base: &Path) -> Result<Resolved, 
 
 fn read_model(file: &Path, path: &str, base: &Path) -> Result<Model, JobError> {
     let full = base.join(file);
-    let text = truss_core::model_file::read_input(&full).map_err(|e| {
-        let why = match e {
-            truss_core::model_file::ReadFailure::Io(e) => e.to_string(),
-            truss_core::model_file::ReadFailure::Refused(r) => r.to_string(),
-        };
-        JobError::at(
+    let text = truss_core::model_file::read_input(&full).map_err(|e| match e {
+        truss_core::model_file::ReadFailure::Io(source) => JobError::ModelIo {
+            at: path.to_string(),
+            path: full.clone(),
+            source,
+        },
+        truss_core::model_file::ReadFailure::Refused(r) => JobError::at(
             path,
-            &format!("cannot read model file {}: {why}", full.display()),
-        )
+            &format!("cannot read model file {}: {r}", full.display()),
+        ),
     })?;
     Model::from_json(&text, &full.display().to_string())
         .map_err(|e| JobError::at(path, &e.to_string()))
@@ -869,6 +920,60 @@ mod tests {
         assert_eq!(
             e.to_string(),
             "/dev/zero: not a regular file (a character device); give the path of a file"
+        );
+    }
+
+    /// Case names are checked when the job is read: too long (10,000 characters, which the
+    /// merge could not make a file name of), or holding a NUL, an escape sequence or a line
+    /// break, are refused naming `cases[i].name`, and the message shows the name escaped
+    /// and shortened, never its raw characters.
+    #[test]
+    fn case_names_are_checked_when_the_job_is_read() {
+        let named = |name: &str| {
+            format!(
+                r#"{{"model": {{"prism": {{"stages": 1}}}}, "seed": 1,
+                    "cases": [{{"name": {}, "samples": 10}}]}}"#,
+                serde_json::to_string(name).unwrap()
+            )
+        };
+        let long = "x".repeat(10_000);
+        let m = refusal(&named(&long));
+        assert!(m.starts_with("cases[0].name: "), "{m}");
+        assert!(m.contains("longer than 200 bytes") && m.len() < 300, "{m}");
+        for bad in ["a\0b", "\u{1b}[31mred", "two\nlines", "tab\there"] {
+            let m = refusal(&named(bad));
+            assert!(m.starts_with("cases[0].name: "), "{bad:?}: {m}");
+            assert!(m.contains("control character"), "{m}");
+            assert!(!m.chars().any(|c| c.is_control()), "raw in {m:?}");
+        }
+        let ok = "σ-0.0063 (batten & longeron) / 5 stages";
+        Job::from_json(&named(ok), Path::new(".")).unwrap();
+        Job::from_json(&named(&"y".repeat(200)), Path::new(".")).unwrap();
+    }
+
+    /// A model file the job names that is missing is an I/O failure (exit 4, as a missing
+    /// job file is), said with the job file, the JSON path and the model file's path.
+    #[test]
+    fn a_missing_model_file_is_an_io_failure() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("job.json");
+        std::fs::write(
+            &path,
+            r#"{"model": "absent.json", "seed": 1, "cases": [{"name": "a", "samples": 1}]}"#,
+        )
+        .unwrap();
+        let e = Job::read(&path).unwrap_err();
+        assert!(e.is_io(), "{e:?}");
+        let m = e.to_string();
+        assert!(
+            m.contains("job.json: model: cannot read model file") && m.contains("absent.json"),
+            "{m}"
+        );
+        assert!(!Job::read(Path::new("/dev/zero")).unwrap_err().is_io());
+        assert!(
+            Job::read(&dir.path().join("none.json"))
+                .unwrap_err()
+                .is_io()
         );
     }
 }

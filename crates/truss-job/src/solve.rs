@@ -20,6 +20,9 @@ pub struct Converged {
     pub slack_cables: u32,
     /// Number of loose backlash joints, for a model with joints.
     pub loose_joints: Option<u32>,
+    /// Whether some stage's tilt is held by pretension alone (see
+    /// [`truss_core::limit`]), for a model whose bars do not frame the tilt.
+    pub floating: Option<bool>,
 }
 
 /// How a sample ended.
@@ -119,6 +122,7 @@ impl<'j> SampleSolver<'j> {
                         residual: report.residual,
                         slack_cables: report.slack_cables,
                         loose_joints: has_joints.then_some(report.loose_joints),
+                        floating: (!case.structure.tilt_framed()).then_some(report.floating),
                     }),
                     Some(_) => Outcome::Failed("the top surface's angles are not finite".into()),
                     None => Outcome::Failed("the model names no top surface to measure".into()),

@@ -100,12 +100,16 @@ impl Error {
 
 /// Runs a command, writing its report to `out`; progress goes to stderr.
 pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
+    if let Command::Shard(mc_shard::cli::Command::Run(_)) = &cli.command {
+        crate::run_all::die_with_parent();
+    }
     match cli.command {
-        Command::Shard(mc_shard::cli::Command::Completions(a)) => {
-            let mut cmd = <Cli as clap::CommandFactory>::command();
-            clap_complete::generate(a.shell, &mut cmd, "truss-mc", out);
-            Ok(())
-        }
+        Command::Shard(mc_shard::cli::Command::Completions(a)) => Ok(mc_shard::cli::completions(
+            a.shell,
+            <Cli as clap::CommandFactory>::command(),
+            "truss-mc",
+            out,
+        )?),
         Command::Shard(mc_shard::cli::Command::Man) => Ok(mc_shard::cli::man_page(
             <Cli as clap::CommandFactory>::command(),
             out,

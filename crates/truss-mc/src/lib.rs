@@ -19,7 +19,9 @@
 //!
 //! The scheme every truss-mc binary shares (`truss-exit`); `run-all` exits with 2 for bad
 //! arguments (`--shards 0`, `--workers 0`) before anything starts, with 5 when a shard
-//! process met a file in the way (another job's shard, a damaged file: move it away), with
+//! process met a file in the way (another job's shard, a damaged file: move it away; a shard
+//! another live process writes: wait for it or stop it) or `DIR/report` is a symbolic link,
+//! with
 //! the verification code (6) when a shard process failed otherwise or the audit before the
 //! merge found a line that differs from its re-solve, with the merge's code when the merge
 //! failed (7 for failed samples: rerun with `--allow-failed`), and with 130 / 143 when

@@ -6,7 +6,7 @@ fn main() -> std::process::ExitCode {
     let cli = truss_mc::cli::Cli::parse();
     let mut out = truss_exit::Stdout::lock();
     match truss_mc::cli::run(cli, &mut out) {
-        Ok(()) => std::process::ExitCode::SUCCESS,
+        Ok(()) => truss_exit::success("truss-mc", &mut out),
         // "interrupted: N samples kept; rerun …" is a notice, not an error.
         Err(e) if e.interrupted().is_some() => {
             eprintln!("{e}");

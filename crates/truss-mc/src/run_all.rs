@@ -12,9 +12,18 @@
 //! on).
 //!
 //! **Failed shard processes** map to one exit code and advice ([`worker_failure`]): a file
-//! in the way (another job's shard, a damaged or locked file: 5) is named with the advice to
-//! move it away, since a rerun would meet it again; otherwise 6 and "run the same command
-//! again to resume".
+//! in the way (another job's shard, a damaged file: 5) is named with the advice to move it
+//! away, since a rerun would meet it again; a shard another live process is writing (5) with
+//! the advice to wait for it or stop it; otherwise 6 and "run the same command again to
+//! resume".
+//!
+//! **No shard process outlives `run-all`.** Each child asks the kernel for SIGTERM when
+//! `run-all` ends, however it ends (`kill -9`, the out-of-memory killer): a parent-death
+//! signal (Linux `prctl(PR_SET_PDEATHSIG)`, [`die_with_parent`]). The child then stops as
+//! on any SIGTERM, keeping every finished line, and its shard's lock is released.
+//!
+//! **The report directory** `DIR/report` is refused before any shard runs when it is a
+//! symbolic link (exit 5): the merge would write wherever it points.
 //!
 //! **Interrupts.** On SIGINT or SIGTERM sent to `run-all` alone (`kill PID`, a supervisor, a
 //! batch system's time limit) or to its whole process group (Ctrl-C), no further shard
@@ -61,11 +70,26 @@ pub enum RunAllError {
 }
 
 /// The exit code and advice for failed shard processes: a file in the way (5: another
-/// job's shard, a damaged or locked file) when any child says so, which a rerun does not
-/// cure; the children's own code when they agree on another (a usage or input error);
+/// job's shard, a damaged file) when any child says so, which a rerun does not cure (only
+/// shards locked by live processes: wait for them); the children's own code when they agree on another (a usage or input error);
 /// otherwise the verification code (6), which a rerun resumes.
 pub fn worker_failure(failures: &[(u8, String)]) -> (u8, &'static str) {
-    if failures.iter().any(|(c, _)| *c == truss_exit::IN_THE_WAY) {
+    let in_the_way: Vec<&str> = failures
+        .iter()
+        .filter(|(c, _)| *c == truss_exit::IN_THE_WAY)
+        .map(|(_, m)| m.as_str())
+        .collect();
+    if !in_the_way.is_empty()
+        && in_the_way
+            .iter()
+            .all(|m| m.contains(mc_shard::errors::LOCKED))
+    {
+        return (
+            truss_exit::IN_THE_WAY,
+            "a shard is being written by another process: wait for it or stop it, then run the same command again; the other shards are kept",
+        );
+    }
+    if !in_the_way.is_empty() {
         return (
             truss_exit::IN_THE_WAY,
             "a file is in the way: move it away (or use another --out), then run the same command again; the other shards are kept",
@@ -141,6 +165,10 @@ pub fn run_all(
             source,
         })
     })?;
+    if !options.no_merge {
+        // Before any work: the merge must not write through a link.
+        run_dir::create_dir(&options.out.join("report")).map_err(|e| RunError::Shard(e.into()))?;
+    }
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
@@ -250,6 +278,33 @@ async fn run_and_merge(
     }
 }
 
+/// The environment variable through which `run-all` gives its shard processes its pid.
+pub const PARENT_PID_ENV: &str = "TRUSS_MC_RUN_ALL_PID";
+
+/// In a shard process of `run-all` ([`PARENT_PID_ENV`] set): asks the kernel to send this
+/// process SIGTERM when `run-all` ends, however it ends, and sends it now if `run-all` is
+/// already gone (it died before the request was made). Elsewhere, or on a system without
+/// parent-death signals, nothing.
+pub fn die_with_parent() {
+    let Some(parent) = std::env::var(PARENT_PID_ENV)
+        .ok()
+        .and_then(|p| p.parse::<i32>().ok())
+    else {
+        return;
+    };
+    #[cfg(target_os = "linux")]
+    {
+        use rustix::process::{Pid, Signal, getpid, getppid, kill_process};
+        if rustix::process::set_parent_process_death_signal(Some(Signal::TERM)).is_ok()
+            && Pid::as_raw(getppid()) != parent
+        {
+            let _ = kill_process(getpid(), Signal::TERM);
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = parent;
+}
+
 /// How long a child may take to stop after SIGTERM before it is killed.
 pub const GRACE: Duration = Duration::from_secs(10);
 
@@ -278,7 +333,8 @@ async fn run_children(
         let limit = Arc::clone(&limit);
         let mut cancel = cancel_rx.clone();
         let mut cmd = tokio::process::Command::new(exe);
-        cmd.args(["run", "--job"])
+        cmd.env(PARENT_PID_ENV, std::process::id().to_string())
+            .args(["run", "--job"])
             .arg(&options.job_path)
             .arg("--out")
             .arg(&options.out)
@@ -362,7 +418,7 @@ async fn run_children(
 /// lines not counted, at most `max` in all), advancing `offset`; returns how many are new.
 fn count_new_lines(path: &Path, offset: &mut u64, lines: &mut u64, max: u64) -> u64 {
     use std::io::{Read, Seek, SeekFrom};
-    let Ok(mut f) = std::fs::File::open(path) else {
+    let Ok(mut f) = run_dir::input::open_own(path, std::fs::OpenOptions::new().read(true)) else {
         return 0;
     };
     let len = f.metadata().map_or(0, |m| m.len());

@@ -5,6 +5,8 @@
 // The job builders of mc-shard's tests: the same small job, shard-file reader and writer.
 #[path = "../../mc-shard/tests/it/common/mod.rs"]
 mod common;
+#[path = "../../run-dir/tests/support/hostile.rs"]
+mod hostile;
 
 use common::{sample_lines, small_job, write};
 use std::path::Path;
@@ -273,21 +275,46 @@ fn alive(pid: u32) -> bool {
     })
 }
 
+/// A job of one case of `samples` samples of the 30-stage prism (about 150 µs a sample).
+fn thirty_stage_job(dir: &Path, seed: u64, samples: u64) -> std::path::PathBuf {
+    write(
+        dir,
+        "job.json",
+        &format!(
+            r#"{{"model": {{"prism": {{"stages": 30}}}}, "seed": {seed}, "cases": [
+  {{"name": "normal", "samples": {samples},
+   "length_errors": {{"batten": {{"normal": {{"sigma": 0.0063}}}},
+                     "longeron": {{"normal": {{"sigma": 0.0063}}}}}}}}]}}"#
+        ),
+    )
+}
+
+/// Waits (polling, not timing) until `run-all` (`child`) runs two workers and its shard
+/// files in `out` hold more than `lines` sample lines; returns the workers' pids.
+fn two_workers_running(child: &mut std::process::Child, out: &Path, lines: usize) -> Vec<u32> {
+    use std::time::{Duration, Instant};
+    let started = Instant::now();
+    loop {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "run-all ended too soon"
+        );
+        let workers = children_of(child.id());
+        if workers.len() == 2 && sample_lines(out).len() > lines {
+            return workers;
+        }
+        assert!(started.elapsed() < Duration::from_secs(120), "no workers");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
 /// SIGTERM to `run-all`'s pid alone (`kill PID`, as a supervisor or Slurm's time limit
 /// sends it): it stops its workers (none survives it), prints the "interrupted" line, exits
 /// 143; running the same command again resumes to the sample lines of an uninterrupted run.
 #[test]
 fn run_all_stops_its_workers_on_sigterm_and_resumes() {
-    use std::time::{Duration, Instant};
     let dir = tempfile::tempdir().unwrap();
-    let job = write(
-        dir.path(),
-        "job.json",
-        r#"{"model": {"prism": {"stages": 30}}, "seed": 11, "cases": [
-  {"name": "normal", "samples": 12000,
-   "length_errors": {"batten": {"normal": {"sigma": 0.0063}},
-                     "longeron": {"normal": {"sigma": 0.0063}}}}]}"#,
-    );
+    let job = thirty_stage_job(dir.path(), 11, 12000);
     let out = dir.path().join("all");
     let args = [
         "run-all",
@@ -309,27 +336,7 @@ fn run_all_stops_its_workers_on_sigterm_and_resumes() {
         .spawn()
         .unwrap();
     let pid = child.id();
-    // Wait (polling, not timing) until both workers run and lines are written.
-    let started = Instant::now();
-    let workers = loop {
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "run-all ended too soon"
-        );
-        let workers = children_of(pid);
-        let written: u64 = std::fs::read_dir(&out)
-            .map(|d| {
-                d.flatten()
-                    .map(|e| e.metadata().map_or(0, |m| m.len()))
-                    .sum()
-            })
-            .unwrap_or(0);
-        if workers.len() == 2 && written > 4000 {
-            break workers;
-        }
-        assert!(started.elapsed() < Duration::from_secs(120), "no workers");
-        std::thread::sleep(Duration::from_millis(20));
-    };
+    let workers = two_workers_running(&mut child, &out, 20);
     let s = Command::new("kill").arg(pid.to_string()).status().unwrap();
     assert!(s.success());
     let o = child.wait_with_output().unwrap();
@@ -351,4 +358,121 @@ fn run_all_stops_its_workers_on_sigterm_and_resumes() {
         sample_lines(&out) == sample_lines(&single),
         "resumed lines differ"
     );
+}
+
+/// `kill -9` of `run-all` (as the out-of-memory killer sends it): its shard processes stop
+/// too (a parent-death signal gives them SIGTERM, so each keeps its finished lines), and
+/// no shard stays locked, so a rerun is not told a file is in the way.
+#[test]
+fn run_all_killed_leaves_no_worker_running() {
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    // 100,000 samples of a 30-stage truss per shard: far longer than the test waits.
+    let job = thirty_stage_job(dir.path(), 12, 200_000);
+    let out = dir.path().join("all");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_truss-mc"))
+        .args(["run-all", "--job", job.to_str().unwrap(), "--out"])
+        .arg(&out)
+        .args(["--shards", "2", "--workers", "2", "--quiet", "--no-merge"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let workers = two_workers_running(&mut child, &out, 200);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while workers.iter().any(|w| alive(*w)) && Instant::now() < deadline {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let survivors: Vec<u32> = workers.iter().copied().filter(|w| alive(*w)).collect();
+    for w in &survivors {
+        let _ = Command::new("kill").args(["-9", &w.to_string()]).status();
+    }
+    assert!(
+        survivors.is_empty(),
+        "workers {survivors:?} outlived run-all"
+    );
+    // Every shard's lock is free, and each kept its lines (a stop checkpoint).
+    for entry in std::fs::read_dir(&out).unwrap().flatten() {
+        let f = std::fs::File::open(entry.path()).unwrap();
+        f.try_lock().expect("no shard stays locked");
+    }
+    let status = truss_mc(
+        &[
+            "status",
+            "--job",
+            job.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--shards",
+            "2",
+        ],
+        &[],
+    );
+    let text = String::from_utf8_lossy(&status.stdout);
+    assert_eq!(text.matches(": partial (").count(), 2, "{text}");
+}
+
+/// `truss-mc run-all --job JOB -o OUT -q EXTRA…`.
+fn run_all_quiet(job: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["run-all", "--job", job.to_str().unwrap()];
+    args.extend(["-o", out.to_str().unwrap(), "-q"]);
+    args.extend_from_slice(extra);
+    truss_mc(&args, &[])
+}
+
+/// A shard locked by a live process: `run-all` says to wait for it or stop it, with its pid,
+/// not to move the file away (exit 5).
+#[test]
+fn run_all_advice_for_a_live_lock_is_to_wait() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "job.json", &small_job(10));
+    let out = dir.path().join("o");
+    std::fs::create_dir_all(&out).unwrap();
+    let held = std::fs::File::create(out.join("shard-0000000000-0000000020.jsonl")).unwrap();
+    held.lock().unwrap();
+    let r = run_all_quiet(&job, &out, &["--shards", "1"]);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(5), "{stderr}");
+    assert!(
+        stderr.contains(&format!(
+            "another process is writing this shard (pid {}): wait for it or stop it",
+            std::process::id()
+        )),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("move it away"), "{stderr}");
+}
+
+/// `DIR/report` a symbolic link: refused before any shard runs (exit 5), naming it; where
+/// it points stays empty.
+#[test]
+fn run_all_refuses_a_linked_report_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "job.json", &small_job(10));
+    let out = dir.path().join("o");
+    std::fs::create_dir_all(&out).unwrap();
+    let elsewhere = dir.path().join("elsewhere");
+    std::fs::create_dir(&elsewhere).unwrap();
+    std::os::unix::fs::symlink(&elsewhere, out.join("report")).unwrap();
+    let r = run_all_quiet(&job, &out, &[]);
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(5), "{stderr}");
+    assert!(
+        stderr.contains(&out.join("report").display().to_string()),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_dir(&elsewhere).unwrap().count(), 0);
+    assert!(sample_lines(&out).is_empty(), "nothing ran");
+}
+
+/// A completion script that cannot be written (`/dev/full`) is an I/O error (exit 4), not
+/// a panic (clap's generator panics when its writer fails).
+#[test]
+fn unwritable_output_is_an_io_error() {
+    let truss_mc = Path::new(env!("CARGO_BIN_EXE_truss-mc"));
+    let (status, stderr) = hostile::run_into_full(truss_mc, &["completions", "bash"]);
+    assert_eq!(status, Some(4), "{stderr}");
+    assert!(stderr.starts_with("truss-mc: error: "), "{stderr}");
 }

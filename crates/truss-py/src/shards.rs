@@ -9,18 +9,18 @@ use crate::columns::Table;
 use crate::errors::{Failure, Kind};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use shard_record::{Begin, Record, parse_record, read_shard, scan_shard};
+use shard_record::{
+    Begin, MAX_BEGIN_LINE_BYTES, Record, parse_record, read_line, read_shard, scan_shard,
+};
 use std::hash::{DefaultHasher, Hasher};
-use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 /// The begin line of `path`, if it reads and parses (the full read reports any fault).
 fn header(path: &Path) -> Option<Begin> {
     let mut line = Vec::new();
     let file = std::fs::File::open(path).ok()?;
-    std::io::BufReader::new(file)
-        .read_until(b'\n', &mut line)
-        .ok()?;
+    let mut reader = std::io::BufReader::new(file);
+    read_line(&mut reader, &mut line, MAX_BEGIN_LINE_BYTES).ok()??;
     match parse_record(&line) {
         Ok(Record::Begin(b)) => Some(b),
         _ => None,

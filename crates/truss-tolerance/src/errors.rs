@@ -135,6 +135,10 @@ pub enum ToleranceError {
         /// The operating system's error.
         source: std::io::Error,
     },
+    /// An output is in the way (a link or a non-file at its name, another process writing
+    /// the directory) or could not be written.
+    #[error(transparent)]
+    Files(#[from] run_dir::RunDirError),
     /// A plot could not be drawn.
     #[error("{}: cannot draw: {message}", path.display())]
     Plot {

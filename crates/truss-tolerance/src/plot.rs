@@ -13,7 +13,8 @@
 use crate::errors::ToleranceError;
 use crate::study::Tolerance;
 use plotters::prelude::*;
-use std::path::{Path, PathBuf};
+use run_dir::OutputDir;
+use std::path::PathBuf;
 
 type PlotResult = Result<(), Box<dyn std::error::Error>>;
 
@@ -40,8 +41,8 @@ fn whisker(x: f64, lo: f64, hi: f64, half: f64, c: RGBColor) -> Vec<PathElement<
     ]
 }
 
-fn groups_plot(path: &Path, t: &Tolerance) -> PlotResult {
-    let root = SVGBackend::new(path, SIZE).into_drawing_area();
+fn groups_plot(svg: &mut String, t: &Tolerance) -> PlotResult {
+    let root = SVGBackend::with_string(svg, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
     let nl = t.sensitivity.nonlinear;
     let mut bars: Vec<(String, f64, (f64, f64))> = t
@@ -118,8 +119,8 @@ fn stage_position(id: &str) -> Option<(f64, f64)> {
     Some((stage, position))
 }
 
-fn members_plot(path: &Path, t: &Tolerance) -> PlotResult {
-    let root = SVGBackend::new(path, SIZE).into_drawing_area();
+fn members_plot(svg: &mut String, t: &Tolerance) -> PlotResult {
+    let root = SVGBackend::with_string(svg, SIZE).into_drawing_area();
     root.fill(&WHITE)?;
     let share = &t.sensitivity.fit.share;
     let intervals = &t.sensitivity.share_interval;
@@ -205,21 +206,21 @@ fn members_plot(path: &Path, t: &Tolerance) -> PlotResult {
     Ok(())
 }
 
+/// The plots' file names.
+pub const PLOTS: [&str; 2] = ["shares-groups.svg", "shares-members.svg"];
+
 /// Draws both plots into `out`; returns their paths.
-pub fn draw_all(t: &Tolerance, out: &Path) -> Result<Vec<PathBuf>, ToleranceError> {
+pub fn draw_all(t: &Tolerance, out: &mut OutputDir) -> Result<Vec<PathBuf>, ToleranceError> {
     let mut files = Vec::new();
-    type Draw = fn(&Path, &Tolerance) -> PlotResult;
-    let plots: [(&str, Draw); 2] = [
-        ("shares-groups.svg", groups_plot),
-        ("shares-members.svg", members_plot),
-    ];
+    type Draw = fn(&mut String, &Tolerance) -> PlotResult;
+    let plots: [(&str, Draw); 2] = [(PLOTS[0], groups_plot), (PLOTS[1], members_plot)];
     for (name, draw) in plots {
-        let path = out.join(name);
-        draw(&path, t).map_err(|e| ToleranceError::Plot {
-            path: path.clone(),
+        let mut svg = String::new();
+        draw(&mut svg, t).map_err(|e| ToleranceError::Plot {
+            path: out.path().join(name),
             message: e.to_string(),
         })?;
-        files.push(path);
+        files.push(out.write(name, svg.as_bytes())?);
     }
     Ok(files)
 }

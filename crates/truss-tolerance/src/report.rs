@@ -26,16 +26,10 @@ use crate::errors::ToleranceError;
 use crate::setup::Study;
 use crate::study::Tolerance;
 use crate::{ARCSEC_PER_RAD, plot};
+use run_dir::OutputDir;
 use serde_json::{Map, Value, json};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
-
-fn write(path: &Path, text: &str) -> Result<(), ToleranceError> {
-    std::fs::write(path, text).map_err(|source| ToleranceError::Write {
-        path: path.to_path_buf(),
-        source,
-    })
-}
+use std::path::PathBuf;
 
 /// A finite number, or null.
 fn num(x: f64) -> Value {
@@ -248,30 +242,24 @@ pub fn markdown(t: &Tolerance) -> String {
     s
 }
 
-/// Writes every file into `out` (created if missing); returns their paths.
+/// The files the study writes besides its plots.
+pub const FILES: [&str; 3] = ["allocated-job.json", "tolerance.json", "tolerance.md"];
+
+/// Writes every file into the output directory `out`; returns their paths.
 pub fn write_all(
     study: &Study,
     t: &Tolerance,
-    out: &Path,
+    out: &mut OutputDir,
     plots: bool,
 ) -> Result<Vec<PathBuf>, ToleranceError> {
-    std::fs::create_dir_all(out).map_err(|source| ToleranceError::Write {
-        path: out.to_path_buf(),
-        source,
-    })?;
-    let mut files = Vec::new();
     let (sigmas, _, _) = t.verified_run();
-    let job = out.join("allocated-job.json");
-    write(&job, &study.allocated_spec(sigmas).to_json())?;
-    files.push(job);
-    let path = out.join("tolerance.json");
-    let mut text = serde_json::to_string_pretty(&json(t)).expect("a JSON value serialises");
-    text.push('\n');
-    write(&path, &text)?;
-    files.push(path);
-    let path = out.join("tolerance.md");
-    write(&path, &markdown(t))?;
-    files.push(path);
+    let mut json_text = serde_json::to_string_pretty(&json(t)).expect("a JSON value serialises");
+    json_text.push('\n');
+    let mut files = vec![
+        out.write(FILES[0], study.allocated_spec(sigmas).to_json().as_bytes())?,
+        out.write(FILES[1], json_text.as_bytes())?,
+        out.write(FILES[2], markdown(t).as_bytes())?,
+    ];
     if plots {
         files.extend(plot::draw_all(t, out)?);
     }

@@ -82,12 +82,8 @@ impl Study {
         costs: &[String],
         fixes: &[String],
     ) -> Result<Self, ToleranceError> {
-        let text = std::fs::read_to_string(path).map_err(|source| truss_job::JobError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let spec = JobSpec::read(path)?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        let spec = JobSpec::from_json(&text).map_err(|e| e.in_file(path))?;
         // Validate the whole job as given (names the file and JSON path of any fault).
         let job = Job::new(&spec, &base).map_err(|e| e.in_file(path))?;
         Self::new(spec, &job, base, case, costs, fixes)
@@ -188,7 +184,11 @@ impl Study {
             .map(|g| g.name.as_str())
             .collect::<Vec<_>>()
             .join(", ");
-        let find = |flag: &str, text: &str| -> Result<(usize, f64), ToleranceError> {
+        // Each group at most once per flag: a repeat is refused, not "the last one wins".
+        let find = |flag: &str,
+                    text: &str,
+                    given: &mut Vec<Option<String>>|
+         -> Result<(usize, f64), ToleranceError> {
             let (group, value) = parse_pair(flag, text)?;
             let i = groups.iter().position(|g| g.name == group).ok_or_else(|| {
                 ToleranceError::UnknownGroup {
@@ -197,11 +197,21 @@ impl Study {
                     known: known.clone(),
                 }
             })?;
+            if let Some(first) = &given[i] {
+                return Err(ToleranceError::BadValue {
+                    flag: format!("{flag} {text}"),
+                    message: format!(
+                        "group {group:?} is given twice ({flag} {first} before): give each group once"
+                    ),
+                });
+            }
+            given[i] = Some(text.to_string());
             Ok((i, value))
         };
         let mut weights = Vec::new();
+        let mut given = vec![None; groups.len()];
         for c in costs {
-            let (i, w) = find("--cost", c)?;
+            let (i, w) = find("--cost", c, &mut given)?;
             if w <= 0.0 {
                 return Err(ToleranceError::BadValue {
                     flag: "--cost".into(),
@@ -211,8 +221,9 @@ impl Study {
             weights.push((i, w));
         }
         let mut pins = Vec::new();
+        let mut given = vec![None; groups.len()];
         for f in fixes {
-            let (i, s) = find("--fix", f)?;
+            let (i, s) = find("--fix", f, &mut given)?;
             if s < 0.0 {
                 return Err(ToleranceError::BadValue {
                     flag: "--fix".into(),

@@ -7,7 +7,7 @@ use crate::sensitivity::{Sensitivity, sensitivity};
 use crate::setup::Study;
 use crate::simulate::{run_case, threads};
 use crate::verify::{Percentile, percentile};
-use crate::{ARCSEC_PER_RAD, report};
+use crate::{ARCSEC_PER_RAD, plot, report};
 use std::path::PathBuf;
 
 /// The target's margin: the rescale aims the interval's upper end at θ*(1 − MARGIN), so that
@@ -178,9 +178,14 @@ fn meet_target(
     }
 }
 
-/// Runs the study and writes its files (see the crate doc). Returns
-/// [`ToleranceError::Verification`] (after writing the files) if the allocation does not
-/// verify.
+/// The writer's name in its output directory's manifest (crate `run-dir`).
+pub const WRITER: &str = "truss-tolerance";
+
+/// Runs the study and writes its files (see the crate doc): each through a temporary file,
+/// never through a link (a link or a non-file at any of their names is refused before the
+/// work), with the directory locked while they are written and a manifest of them kept.
+/// Returns [`ToleranceError::Verification`] (after writing the files) if the allocation
+/// does not verify.
 pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
     let o = options;
     if !(o.target_arcsec.is_finite() && o.target_arcsec > 0.0 && o.target_arcsec < 324_000.0) {
@@ -201,6 +206,9 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
             format!("{} verification samples: need at least 1000", o.samples),
         ));
     }
+    // Before any work: no output may go through a link.
+    let outputs: Vec<&str> = report::FILES.iter().chain(&plot::PLOTS).copied().collect();
+    run_dir::OutputDir::check(&o.out, &outputs)?;
     let study = Study::read(&o.job, &o.case, &o.costs, &o.fixes)?;
     let job_id = truss_job::Job::new(&study.spec, &study.base)?.id;
     let target = o.target_arcsec / ARCSEC_PER_RAD;
@@ -375,7 +383,9 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
         verified: last.verifies(target),
         files: Vec::new(),
     };
-    result.files = report::write_all(&study, &result, &o.out, o.plots)?;
+    let mut out = run_dir::OutputDir::open(&o.out, WRITER)?;
+    result.files = report::write_all(&study, &result, &mut out, o.plots)?;
+    out.finish()?;
     if !result.verified {
         return Err(ToleranceError::Verification {
             percentile: o.percentile,

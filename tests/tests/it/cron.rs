@@ -76,3 +76,38 @@ fn cron_rounds_quarantine_damage_then_finish_audit_and_merge_once() {
         &log[before..]
     );
 }
+
+/// A link planted at the round's own files (`work.log`, `merge.lock`) or at `report` in the
+/// shared directory: the round refuses it (exit 5), naming it, and writes nothing through
+/// it (the shell's `>>` and `>` follow links; `merge.lock` used to truncate its target).
+#[test]
+fn cron_rounds_write_nothing_through_a_link() {
+    let tmp = tempfile::tempdir().unwrap();
+    let job = tmp.path().join("job.json");
+    std::fs::write(
+        &job,
+        r#"{"model": {"prism": {"stages": 1}}, "seed": 5, "cases": [
+  {"name": "a", "samples": 6,
+   "length_errors": {"batten": {"normal": {"sigma": 0.0063}}}}]}"#,
+    )
+    .unwrap();
+    let target = tmp.path().join("precious.txt");
+    for name in ["work.log", "merge.lock", "report"] {
+        std::fs::write(&target, "the user's own file").unwrap();
+        let dir = tmp.path().join(format!("shared-{name}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        std::os::unix::fs::symlink(&target, dir.join(name)).unwrap();
+        let o = round(&job, &dir);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(5), "{name}: {stderr}");
+        assert!(
+            stderr.contains(name) && stderr.contains("symbolic link"),
+            "{stderr}"
+        );
+        assert_eq!(
+            std::fs::read_to_string(&target).unwrap(),
+            "the user's own file",
+            "{name}"
+        );
+    }
+}

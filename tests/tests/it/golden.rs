@@ -89,11 +89,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "2cd28355e13dce46cf01da3c847e0efa913e64a8ee803ea045aca77b75ed2cff",
+        "62b7ba44d8cf23420c8d8b1236bbd72d0115787cdb32f970c3d839743400426e",
         "250ebc35d731f68192faca6b4669b8f390d78b9f27cebefb5b7b50bee177ec38",
-        "fcefaf52b48048f8232c4dadbfd9ee3356159c08f8de3797e318273796d73bee",
+        "45ae317fcd3f2c30de3de463854d13b33db21beceae65d44bfeb56ca9df061d8",
         "7f95eed1a842b547589bf84637c37505cc0c2cfdc91b76242878045a89080f26",
-        "008c35935ddad3e6c2e650af02e97c4f1dcc6c17617c4e416a3241190a53a258",
+        "359730580b0421a9ff472d1e789583d2187a43b1cb3f11d1ed2409dfa04d95bf",
     ];
     for (what, (g, w)) in [
         "job id",

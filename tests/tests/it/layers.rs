@@ -5,8 +5,11 @@
 //! - the runner (`mc-shard`) never links the merge (`mc-merge`) nor an async runtime;
 //! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
 //! - the solver links nothing of ours; nor do the statistics and the wire format;
+//! - the run directory's file rules (`run-dir`) link only the exit codes, so every writer,
+//!   however low, can share them;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
-//! - the tolerance study links the solver, the job and the statistics, and nothing else of ours;
+//! - the tolerance study links the solver, the job, the statistics and the file rules, and
+//!   nothing else of ours;
 //! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
 //!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
 
@@ -74,6 +77,7 @@ fn dependencies_point_one_way() {
         "mc-shard",
         "mc-merge",
         "truss-tolerance",
+        "run-dir",
         "truss-py",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
@@ -119,17 +123,32 @@ fn dependencies_point_one_way() {
             );
         }
     }
+    // run-dir sits on the exit codes alone.
+    let files: Vec<String> = closure(&graph, "run-dir")
+        .intersection(&ours)
+        .cloned()
+        .collect();
+    assert_eq!(files, ["truss-exit"]);
     // truss-job sits directly on the solver and on nothing else of ours.
     let job: Vec<String> = closure(&graph, "truss-job")
         .intersection(&ours)
         .cloned()
         .collect();
     assert_eq!(job, ["truss-core"]);
-    // truss-tolerance sits on the job, the solver and the statistics: not the runner, the
-    // merge, the wire format or the diagnosis.
+    // truss-tolerance sits on the job, the solver, the statistics and the run directory's
+    // file rules: not the runner, the merge, the wire format or the diagnosis.
     let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
         .intersection(&ours)
         .cloned()
         .collect();
-    assert_eq!(tolerance, ["truss-core", "truss-job", "truss-stats"]);
+    assert_eq!(
+        tolerance,
+        [
+            "run-dir",
+            "truss-core",
+            "truss-exit",
+            "truss-job",
+            "truss-stats"
+        ]
+    );
 }

@@ -275,7 +275,7 @@ fn readme_commands_run() {
     assert!(names_flag("--shard I/K", "--shard") && !names_flag("--shards K", "--shard"));
     // The README's merge and export ran on what its runs wrote.
     assert!(scratch.path().join("runs/p31/report/report.json").exists());
-    assert!(scratch.path().join("runs/p31/samples.csv").exists());
+    assert!(scratch.path().join("runs/p31-samples.csv").exists());
     assert!(
         scratch
             .path()

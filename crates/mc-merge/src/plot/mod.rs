@@ -31,6 +31,7 @@ pub use distribution::{axis_end, bin_count, histogram};
 use crate::errors::MergeError;
 use crate::load::CaseData;
 use crate::report::Report;
+use run_dir::OutputDir;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -42,20 +43,6 @@ pub const JOB_PLOTS: [&str; 2] = ["sigma-sweep", "stages-sweep"];
 
 /// The file extensions of plots.
 pub const EXTENSIONS: [&str; 2] = ["svg", "png"];
-
-/// Whether a file name is one mc-merge's plots could have (so it may be replaced).
-pub fn is_plot_file(name: &str) -> bool {
-    let Some((stem, ext)) = name.rsplit_once('.') else {
-        return false;
-    };
-    EXTENSIONS.contains(&ext)
-        && (JOB_PLOTS.contains(&stem)
-            || CASE_PLOTS.iter().any(|p| {
-                stem.strip_prefix(p)
-                    .and_then(|rest| rest.strip_prefix('-'))
-                    .is_some_and(|case| !case.is_empty())
-            }))
-}
 
 fn is_safe(c: char) -> bool {
     c.is_ascii_alphanumeric() || c == '.' || c == '-' || c == '_'
@@ -114,53 +101,62 @@ impl Writer {
         })
     }
 
-    fn write(&mut self, path: PathBuf, drawn: Drawn) -> Result<(), MergeError> {
-        let plot_error = |path: &Path, message: String| MergeError::Plot {
-            path: path.to_path_buf(),
+    /// Writes the plot `stem` (`.svg`, and `.png` with the feature) into `out`.
+    fn write(&mut self, out: &mut OutputDir, stem: &str, drawn: Drawn) -> Result<(), MergeError> {
+        let dir = out.path().to_path_buf();
+        let plot_error = |name: &str, message: String| MergeError::Plot {
+            path: dir.join(name),
             message,
         };
-        let Some(svg) = drawn.map_err(|e| plot_error(&path, e.to_string()))? else {
+        let svg_name = format!("{stem}.svg");
+        let Some(svg) = drawn.map_err(|e| plot_error(&svg_name, e.to_string()))? else {
             return Ok(());
         };
         let svg = style::subscript_svg(&svg);
-        std::fs::write(&path, &svg).map_err(|source| MergeError::Io {
-            path: path.clone(),
-            source,
-        })?;
-        self.written.push(path.clone());
+        self.written.push(out.write(&svg_name, svg.as_bytes())?);
         #[cfg(feature = "png")]
         {
-            let png = path.with_extension("png");
-            self.png
-                .write(&svg, &png)
-                .map_err(|message| plot_error(&png, message))?;
-            self.written.push(png);
+            let png_name = format!("{stem}.png");
+            let png = self
+                .png
+                .png(&svg)
+                .map_err(|message| plot_error(&png_name, message))?;
+            self.written.push(out.write(&png_name, &png)?);
         }
         Ok(())
     }
 }
 
-/// Draws every plot into `dir`; returns the files written.
+/// Draws every plot into the report directory `out`; returns the files written.
 pub fn draw_all(
-    dir: &Path,
+    out: &mut OutputDir,
     cases: &[CaseData],
     report: &Report,
 ) -> Result<Vec<PathBuf>, MergeError> {
-    let mut w = Writer::new(dir)?;
+    let mut w = Writer::new(out.path())?;
     let names: Vec<&str> = report.cases.iter().map(|c| c.name.as_str()).collect();
     for ((case, rep), stem) in cases.iter().zip(&report.cases).zip(file_stems(&names)) {
-        let path = |prefix: &str| dir.join(format!("{prefix}-{stem}.svg"));
-        w.write(path("theta_p"), distribution::theta(case, rep, report))?;
-        w.write(path("tan"), distribution::tan(case, rep))?;
-        w.write(path("qq"), distribution::qq(case, rep, report))?;
+        let name = |prefix: &str| format!("{prefix}-{stem}");
         w.write(
-            path("exceedance"),
+            out,
+            &name("theta_p"),
+            distribution::theta(case, rep, report),
+        )?;
+        w.write(out, &name("tan"), distribution::tan(case, rep))?;
+        w.write(out, &name("qq"), distribution::qq(case, rep, report))?;
+        w.write(
+            out,
+            &name("exceedance"),
             distribution::exceedance(case, rep, report),
         )?;
-        w.write(path("running"), distribution::running(case, rep, report))?;
+        w.write(
+            out,
+            &name("running"),
+            distribution::running(case, rep, report),
+        )?;
     }
-    w.write(dir.join("sigma-sweep.svg"), series::sigma(report))?;
-    w.write(dir.join("stages-sweep.svg"), series::stages(report))?;
+    w.write(out, "sigma-sweep", series::sigma(report))?;
+    w.write(out, "stages-sweep", series::stages(report))?;
     Ok(w.written)
 }
 
@@ -183,26 +179,5 @@ mod tests {
         unique.sort();
         unique.dedup();
         assert_eq!(unique.len(), many.len(), "{stems:?}");
-    }
-
-    #[test]
-    fn plot_files_are_recognised() {
-        for ours in [
-            "theta_p-a.svg",
-            "tan-_~1.png",
-            "sigma-sweep.svg",
-            "running-x.png",
-        ] {
-            assert!(is_plot_file(ours), "{ours}");
-        }
-        for theirs in [
-            "report.json",
-            "notes.svg",
-            "theta_p-.svg",
-            "tan-a.pdf",
-            "qq.svg",
-        ] {
-            assert!(!is_plot_file(theirs), "{theirs}");
-        }
     }
 }

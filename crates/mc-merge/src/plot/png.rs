@@ -7,8 +7,6 @@
 //! family found. With no font at all the PNGs are refused with an error that says so, rather
 //! than written without their labels.
 
-use std::path::Path;
-
 /// The PNG's pixels per SVG unit: 2 gives 1920 × 1280 for a 960 × 640 plot, sharp on slides.
 pub const SCALE: f32 = 2.0;
 
@@ -80,12 +78,6 @@ impl Rasteriser {
             &mut pixmap.as_mut(),
         );
         pixmap.encode_png().map_err(|e| e.to_string())
-    }
-
-    /// Rasterises `svg` into the file `path`.
-    pub fn write(&self, svg: &str, path: &Path) -> Result<(), String> {
-        let bytes = self.png(svg)?;
-        std::fs::write(path, bytes).map_err(|e| e.to_string())
     }
 }
 

@@ -508,3 +508,57 @@ fn completions_and_man_page() {
         "{help}"
     );
 }
+
+/// The fraction of samples with a floating stage, per case, with its Clopper–Pearson
+/// interval; where it exceeds the 5 % tail that θ_P95 reads, a caveat says that the upper
+/// percentiles rest on what the model leaves out and names the lever. Cases whose lines do
+/// not record `floating` (models framed by bars) report none recorded and no caveat.
+#[test]
+fn floating_stages_are_counted_and_a_heavy_tail_is_named() {
+    let mut heavy = SynthCase::rayleigh("heavy", 400, 2e-5, &[("sigma", 0.0067)]);
+    heavy.floating_every = Some(10);
+    let mut light = SynthCase::rayleigh("light", 400, 2e-5, &[("sigma", 0.033)]);
+    light.floating_every = Some(50);
+    let framed = SynthCase::rayleigh("framed", 400, 2e-5, &[("sigma", 0.05)]);
+    let job = SynthJob::new(9, vec![heavy, light, framed]);
+    let dir = tempfile::tempdir().unwrap();
+    job.write_split(dir.path(), 2);
+    let out = dir.path().join("report");
+    let run = mc_merge(
+        &["--out", out.to_str().unwrap()],
+        &[dir.path().to_path_buf()],
+    );
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let v: Value = serde_json::from_str(&report(&out)).unwrap();
+    let case = |i: usize| &v["cases"][i];
+    assert_eq!(case(0)["floating"]["recorded"], 400);
+    assert_eq!(case(0)["floating"]["floating"], 40);
+    assert_eq!(case(0)["floating"]["fraction"]["value"], 0.1);
+    let lower = case(0)["floating"]["fraction"]["lower"].as_f64().unwrap();
+    assert!(lower > 0.07 && lower < 0.1, "{lower}");
+    let caveat = |i: usize| {
+        case(i)["caveats"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c.as_str().unwrap().starts_with("floating stages in"))
+    };
+    assert!(caveat(0));
+    assert!(
+        run.stdout
+            .contains("heavy: floating stages in 40 of 400 samples"),
+        "{}",
+        run.stdout
+    );
+    assert!(
+        run.stdout
+            .contains("more diagonal pretension or smaller clearances"),
+        "{}",
+        run.stdout
+    );
+    assert_eq!(case(1)["floating"]["floating"], 8);
+    assert!(!caveat(1));
+    assert_eq!(case(2)["floating"]["recorded"], 0);
+    assert!(case(2)["floating"]["fraction"]["value"].is_null());
+    assert!(!caveat(2));
+}

@@ -4,8 +4,11 @@
 mod cli;
 mod common;
 mod export;
+#[path = "../../../run-dir/tests/support/hostile.rs"]
+mod hostile;
 mod plots;
 mod report_dir;
 mod schema;
+mod shared_dir;
 mod statistics;
 mod sweep;

@@ -163,6 +163,7 @@ fn real_reports_match_the_schema() {
     let mut failing = SynthCase::rayleigh("failing", 300, 2e-5, &[("sigma", 0.01)]);
     failing.fail_every = Some(7);
     failing.loose = true;
+    failing.floating_every = Some(10);
     let degenerate = SynthJob::new(
         6,
         vec![

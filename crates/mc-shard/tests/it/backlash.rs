@@ -146,11 +146,11 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "b5c603105f8b32c927bb71ea35348917b5497e830073e8f12d7988a3dbd6ad53"
+        "2c8241470acad2f26673cfd172c5a0faf03528e4c36c7eb12483af57bc53e98e"
     );
     assert_eq!(
         digest,
-        "7d812d9ca77f5faa6ae7dfe3c174ab1e951a142eb3f6292b27aeff0ca50918fb"
+        "81ca9febb6d271fec822e422055fdf74ae8d7a042732d7a64e9e7dda75415b74"
     );
 }
 

@@ -143,3 +143,51 @@ fn case_parameters_describe_the_case_for_sweeps() {
     assert!((p["sigma"] - 0.04 / 12f64.sqrt()).abs() < 1e-15);
     assert_eq!(p["uniform"], 1.0);
 }
+
+/// `plan` refuses before any work what the job reader refuses: a prism whose
+/// `diagonal_length` would start the cables 25 % strained (3), a model file that is missing
+/// (an I/O failure, 4, as the README's exit-code table says), and a case name holding an
+/// escape sequence (3), whose refusal shows it escaped: no raw control character reaches
+/// the terminal.
+#[test]
+fn plan_refuses_before_any_work() {
+    use crate::binary::mc_shard;
+    let dir = tempfile::tempdir().unwrap();
+    let plan = |text: &str| {
+        let job = write(dir.path(), "job.json", text);
+        mc_shard(&["plan", "--job", job.to_str().unwrap()])
+    };
+    let o = plan(
+        r#"{"model": {"prism": {"stages": 5, "diagonal_length": 400}}, "seed": 1,
+           "cases": [{"name": "a", "samples": 10}]}"#,
+    );
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(3), "{stderr}");
+    assert!(
+        stderr.contains("model.prism.diagonal_length: 400 mm is more than 1%"),
+        "{stderr}"
+    );
+    let o = plan(r#"{"model": "absent.json", "seed": 1, "cases": [{"name": "a", "samples": 10}]}"#);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(4), "{stderr}");
+    assert!(
+        stderr.contains("cannot read model file") && stderr.contains("absent.json"),
+        "{stderr}"
+    );
+    let o = plan(
+        "{\"model\": {\"prism\": {\"stages\": 1}}, \"seed\": 1, \
+         \"cases\": [{\"name\": \"\\u001b]0;owned\\u0007\\u001b[2J\", \"samples\": 10}]}",
+    );
+    assert_eq!(o.status.code(), Some(3));
+    assert!(o.stdout.is_empty());
+    assert!(
+        !o.stderr.iter().any(|&b| b == 0x1b || b == 0x07),
+        "raw escape in {:?}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("cases[0].name: \"\\u{1b}]0;owned"),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}

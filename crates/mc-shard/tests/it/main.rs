@@ -6,11 +6,14 @@ mod binary;
 mod cli;
 mod common;
 mod determinism;
+#[path = "../../../run-dir/tests/support/hostile.rs"]
+mod hostile;
 mod interrupt;
 mod job;
 mod pool;
 mod sampling;
 mod schedulers;
 mod schema;
+mod shared_dir;
 mod verify;
 mod work;

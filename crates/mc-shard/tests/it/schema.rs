@@ -53,6 +53,7 @@ fn validate(root: &Value, node: &Value, value: &Value, at: &str) -> Vec<String> 
                     "string" => value.is_string(),
                     "number" => value.is_number(),
                     "integer" => value.is_u64() || value.is_i64(),
+                    "boolean" => value.is_boolean(),
                     other => panic!("type {other}"),
                 };
                 if !ok {
@@ -207,6 +208,11 @@ fn real_shard_lines_validate_against_the_schema() {
     }
     // begin, end, checkpoint; converged with and without loose_joints; failed.
     assert_eq!(kinds.len(), 6, "{kinds:?}");
+    // Lines of the backlash case say whether a stage floats.
+    assert!(
+        lines.iter().any(|l| l.contains("\"floating\":")),
+        "no line says floating"
+    );
 
     // Lines that break the format are refused.
     let sample = lines.iter().find(|l| l.contains("\"converged\"")).unwrap();

@@ -226,3 +226,128 @@ fn help_has_no_escaped_brackets() {
         assert!(!help.contains("\\["), "{args:?}: {help}");
     }
 }
+
+/// A model file whose natural length sets an initial strain beyond 1 % (480 mm on a 380 mm
+/// longeron), or a prism whose diagonals would (400 mm on a 537.4 mm face diagonal), is
+/// refused before any solve, naming the member or the flag.
+#[test]
+fn natural_lengths_beyond_the_strain_rule_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = prism_file(dir.path());
+    let mut model: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let longeron = model["members"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|m| m["id"] == "longeron.1.0")
+        .unwrap();
+    longeron["natural_length"] = serde_json::json!(480.0);
+    std::fs::write(&path, model.to_string()).unwrap();
+    let out = truss(&["solve", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("longeron.1.0") && err.contains("natural_length 480 mm"),
+        "{err}"
+    );
+    assert!(out.stdout.is_empty(), "nothing solved");
+    let out = truss(&["model", "prism", "--diagonal-length", "400"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).starts_with("truss: error: --diagonal-length: 400 mm is more than 1%"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+/// `--cost` or `--fix` given twice for one group is refused naming the flag (usage, 2), as
+/// `--length-error` twice for one member is; not "the last one wins".
+#[test]
+fn repeated_costs_and_fixes_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = crate::one_stage_job(dir.path());
+    for (flag, first, second) in [
+        ("--cost", "batten=1", "batten=2"),
+        ("--fix", "batten=0.01", "batten=0.05"),
+    ] {
+        let out = truss(&[
+            "tolerance",
+            "--job",
+            job.to_str().unwrap(),
+            "--case",
+            "c",
+            "--target-arcsec",
+            "20",
+            "--out",
+            dir.path().join("t").to_str().unwrap(),
+            flag,
+            first,
+            flag,
+            second,
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{flag}: {}", stderr(&out));
+        let err = stderr(&out);
+        assert!(
+            err.contains(&format!("{flag} {second}")) && err.contains("given twice"),
+            "{err}"
+        );
+    }
+}
+
+/// `--measurement-sigma -0.001` reaches the command, which refuses it with the flag's own
+/// message (usage, 2), not clap's "unexpected argument '-0'"; other numeric flags take a
+/// negative value to refuse it themselves too.
+#[test]
+fn negative_numbers_reach_their_flags_check() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../jobs/diagnose-baseline.json"
+    );
+    let measured = dir.path().join("m.csv");
+    std::fs::write(&measured, "specimen,node,x,y,z\n").unwrap();
+    let out = truss(&[
+        "diagnose",
+        "--job",
+        job,
+        "--case",
+        "as-built",
+        "--measured",
+        measured.to_str().unwrap(),
+        "--measurement-sigma",
+        "-0.001",
+        "--out",
+        dir.path().join("d").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--measurement-sigma must be a non-negative number of mm"),
+        "{}",
+        stderr(&out)
+    );
+    let out = truss(&[
+        "tolerance",
+        "--job",
+        job,
+        "--case",
+        "as-built",
+        "--target-arcsec",
+        "-20",
+        "--out",
+        dir.path().join("t").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--target-arcsec: -20"),
+        "{}",
+        stderr(&out)
+    );
+    let out = truss(&["model", "prism", "--side", "-380"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        stderr(&out).starts_with("truss: error: --side: "),
+        "{}",
+        stderr(&out)
+    );
+}

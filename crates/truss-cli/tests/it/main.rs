@@ -2,6 +2,9 @@
 //! hostile or meaningless input ([`limits`]).
 
 mod cli;
+mod files;
+#[path = "../../../run-dir/tests/support/hostile.rs"]
+mod hostile;
 mod limits;
 
 use std::process::Command;
@@ -18,4 +21,17 @@ pub fn truss(args: &[&str]) -> std::process::Output {
 pub fn json(out: &std::process::Output) -> serde_json::Value {
     serde_json::from_slice(&out.stdout)
         .unwrap_or_else(|e| panic!("not JSON ({e}): {}", String::from_utf8_lossy(&out.stdout)))
+}
+
+/// A job of one case (`c`, 1000 samples, batten and longeron σ 0.01 mm) of the 1-stage
+/// prism, written into `dir`: enough for `truss tolerance` to start.
+pub fn one_stage_job(dir: &std::path::Path) -> std::path::PathBuf {
+    let job = dir.join("job.json");
+    std::fs::write(
+        &job,
+        r#"{"model": {"prism": {"stages": 1}}, "seed": 1, "cases": [{"name": "c", "samples": 1000,
+  "length_errors": {"batten": {"normal": {"sigma": 0.01}}, "longeron": {"normal": {"sigma": 0.01}}}}]}"#,
+    )
+    .unwrap();
+    job
 }

@@ -85,6 +85,7 @@ use evaluate::dot_n;
 use std::sync::Arc;
 
 mod evaluate;
+mod floating;
 mod line_search;
 mod newton;
 mod step;
@@ -162,6 +163,10 @@ pub struct SolveReport {
     /// Newton iterations). 0 where the start was not solved by the capacitance matrix (a
     /// model with more than 96 cables, or a large slack set).
     pub soft_directions: u32,
+    /// Whether some stage's tilt is held by pretension or regularisation alone, not by
+    /// the members that bear (a *floating* stage; see [`crate::limit`]): the answer then
+    /// rests on effects the model leaves out. Never where the model's bars frame the tilt.
+    pub floating: bool,
 }
 
 /// One Newton iteration, recorded when [`SolveOptions::record_iterations`] is set.

@@ -170,6 +170,7 @@ impl Solver {
             evaluations: self.evaluations,
             loose_joints: self.loose_joint_count(),
             soft_directions: p.soft_directions,
+            floating: self.floating(),
         })
     }
 

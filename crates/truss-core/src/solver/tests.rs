@@ -405,8 +405,11 @@ fn bench_sample(model: &crate::Model, index: usize) -> Vec<f64> {
 /// mechanism).
 #[test]
 fn the_banded_linearised_start_finds_the_woodbury_solution() {
+    // At a ratio of 1e-4: at the limit's 1e-7 the linearised problem near a mechanism is a
+    // thousand times worse conditioned, and the two solutions agree to its rounding only.
     let model = PrismOptions {
         backlash: Some(BacklashOptions::default()),
+        compression_ratio: 1e-4,
         ..PrismOptions::with_stages(5)
     }
     .model()

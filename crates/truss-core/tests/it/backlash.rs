@@ -266,11 +266,20 @@ fn vanishing_clearance_recovers_the_model_without_backlash() {
 }
 
 /// Rotating the whole model with backlash (nodes, joint axes, reference normal) changes
-/// neither θ_P nor which joints are in contact.
+/// neither θ_P nor which joints are in contact: at a diagonal compression ratio of 1e-4,
+/// where the sample has joints of both kinds, and at the default (the limit), where its
+/// floating stages rise until their longerons touch their holes' edges and every joint
+/// reads as bearing, with θ_P to 1e-6.
 #[test]
 fn rigid_rotation_with_joints_changes_nothing() {
+    rigid_rotation_with_joints(1e-4, 1e-8, true);
+    rigid_rotation_with_joints(truss_core::DEFAULT_COMPRESSION_RATIO, 1e-6, false);
+}
+
+fn rigid_rotation_with_joints(compression_ratio: f64, tolerance: f64, both_kinds: bool) {
     let file = PrismOptions {
         backlash: Some(BacklashOptions::default()),
+        compression_ratio,
         ..PrismOptions::with_stages(3)
     }
     .file()
@@ -321,11 +330,13 @@ fn rigid_rotation_with_joints_changes_nothing() {
     top.reference_normal = rot(top.reference_normal);
     let (theta_r, engaged_r) = solve(&Model::new(rotated).unwrap());
     assert!(
-        (theta - theta_r).abs() <= 1e-8 * theta,
+        (theta - theta_r).abs() <= tolerance * theta,
         "{theta} vs {theta_r}"
     );
-    assert_eq!(engaged, engaged_r);
-    assert!(engaged.iter().any(|&e| e) && engaged.iter().any(|&e| !e));
+    if both_kinds {
+        assert_eq!(engaged, engaged_r);
+        assert!(engaged.iter().any(|&e| e) && engaged.iter().any(|&e| !e));
+    }
 }
 
 /// Vertical displacement of the top level \[mm\] of the N-stage prism with every diagonal
@@ -585,15 +596,15 @@ fn fig16_statistics_with(ratio: f64, diagonal_ratio: f64) -> Statistics {
     (p95, (tan_sq / (2.0 * samples as f64)).sqrt(), mean)
 }
 
-/// The issue's independence check: θ_P95, σ_t and the top surface's mean position agree
-/// within 1 % between a regularisation and one 1,000 times smaller (1e-12 against 1e-15 of
-/// the contact stiffness), and between 1e-15 and none at all (the default: a loose pin
-/// carries no force). (At 1e-9 a loose longeron's stiffness, 0.14 N/mm, is comparable with
-/// a slack diagonal's, 1e-4·E·A/L = 0.04 N/mm, which then holds some stages: θ_P95 moves by
-/// 10 % at this σ; REPRODUCTION.md has the study.)
+/// The joints need no regularisation: θ_P95, σ_t and the top surface's mean position agree
+/// within 1 % between a regularisation and one 1,000 times smaller (1e-15 against 1e-18 of
+/// the contact stiffness), and between 1e-18 and none at all (the default: a loose pin
+/// carries no force). A loose longeron's regularisation must stay well below the slack
+/// diagonals' stiffness in the limit, `LIMIT_RATIO·E·A/L` = 4e-5 N/mm: at 1e-15 it is
+/// 3e-7 N/mm; at 1e-12 (3e-4 N/mm) it holds some stages, and θ_P95 moves by some 10 %.
 #[test]
 fn the_answer_does_not_depend_on_the_regularisation() {
-    let runs: Vec<(f64, Statistics)> = [1e-12, 1e-15, 0.0]
+    let runs: Vec<(f64, Statistics)> = [1e-15, 1e-18, 0.0]
         .into_iter()
         .map(|r| (r, fig16_statistics(r)))
         .collect();
@@ -623,29 +634,122 @@ fn assert_neighbours_agree(what: &str, runs: &[(f64, Statistics)]) {
     }
 }
 
-/// What the answer at small σ does depend on: the slack diagonals' compression ratio `r`.
-/// In this study almost every sample has a longeron floating in its holes (99.9 % at
-/// σ = 0.0067 mm), and the stages around it are held only by the geometric stiffness of
-/// what pretension is left and by the slack diagonals' compression stiffness
-/// `r·E·A/L₀` = r · 404 N/mm (0.04 N/mm at the default r = 1e-4). The paper's `r` is 0. This
-/// test shows that the `r → 0` limit exists (θ_P95, σ_t and the mean top position agree
-/// within 1 % between 1e-7, 1e-8 and 1e-9, as the regularisation test above asks of the
-/// joints) and prints how far the default is from it (θ_P95 8 % higher over these 400
-/// samples; 5.6 % over 10,000 with the same draws: REPRODUCTION.md has the study). Slow:
-/// solves at 1e-9 take some 20 iterations.
+/// The default is the limit `r → 0` of the slack diagonals' compression ratio (the paper's
+/// zero), and a ratio of 1e-4 is not. In this study almost every sample has a longeron
+/// floating in its holes, and the stages around it are held only by the geometric stiffness
+/// of what pretension is left and by the slack diagonals' `r·E·A/L₀` = r · 404 N/mm. θ_P95,
+/// σ_t and the mean top position agree within 1 % between the default, 1e-8 and 1e-9 (400
+/// samples), while at 1e-4 θ_P95 is more than 3 % higher (about 6 %). Slow: solves at 1e-9
+/// take some 20 iterations.
 #[test]
-#[ignore = "slow: 1,200 backlash solves at small ratios, run in release by scripts/test.sh"]
-fn the_diagonals_ratio_has_a_limit_that_the_default_is_not_in() {
-    let runs: Vec<(f64, Statistics)> = [1e-7, 1e-8, 1e-9]
+#[ignore = "slow: 1,600 backlash solves at small ratios, run in release by scripts/test.sh"]
+fn the_default_is_the_diagonals_limit_and_1e4_is_not() {
+    let runs: Vec<(f64, Statistics)> = [truss_core::DEFAULT_COMPRESSION_RATIO, 1e-8, 1e-9]
         .into_iter()
         .map(|r| (r, fig16_statistics_with(0.0, r)))
         .collect();
     assert_neighbours_agree("diagonals' ratio", &runs);
-    let (p_limit, s_limit, _) = runs[2].1;
-    let (p_default, s_default, _) = fig16_statistics(0.0);
+    let (p_limit, _, _) = runs[2].1;
+    let (p_regularised, _, _) = fig16_statistics_with(0.0, 1e-4);
     println!(
-        "diagonals' ratio 1e-4 (default) against 1e-9: θ_P95 {:+.2} %, σ_t {:+.2} %",
-        100.0 * (p_default / p_limit - 1.0),
-        100.0 * (s_default / s_limit - 1.0)
+        "diagonals' ratio 1e-4 against 1e-9: θ_P95 {:+.2} %",
+        100.0 * (p_regularised / p_limit - 1.0)
     );
+    assert!(
+        p_regularised > 1.03 * p_limit,
+        "{p_regularised} vs {p_limit}"
+    );
+}
+
+/// θ_P of each of `samples` samples of the Fig. 16 case (σ = 0.0067 mm, diagonals
+/// U[−3σ, 0], clearances U[0.004, 0.017] mm; the draws of [`fig16_statistics_with`], from
+/// `seed`) at the diagonals' compression ratio `diagonal_ratio`, with whether it floats
+/// (`None` where the solve failed).
+fn fig16_thetas(seed: u64, samples: usize, diagonal_ratio: f64) -> Vec<Option<(f64, bool)>> {
+    let model = PrismOptions {
+        compression_ratio: diagonal_ratio,
+        backlash: Some(BacklashOptions::default()),
+        ..PrismOptions::with_stages(5)
+    }
+    .model()
+    .unwrap();
+    let sigma = 0.0067;
+    let mut rng = Normals::new(seed);
+    let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
+    (0..samples)
+        .map(|_| {
+            let errors: Vec<f64> = model
+                .members()
+                .iter()
+                .map(|m| match m.group.as_str() {
+                    "diagonal" => -3.0 * sigma * rng.uniform(),
+                    _ => sigma * rng.normal(),
+                })
+                .collect();
+            let clearances: Vec<f64> = (0..model.joints().len())
+                .map(|_| 0.004 + 0.013 * rng.uniform())
+                .collect();
+            let report = solver
+                .solve_perturbed(Perturbation {
+                    length_errors: &errors,
+                    clearances: &clearances,
+                    ..Perturbation::default()
+                })
+                .ok()?;
+            Some((solver.distortion()?.theta_p, report.floating))
+        })
+        .collect()
+}
+
+/// The acceptance test of the physical default: on the same 1,500 draws of the Fig. 16
+/// case, the default's θ_P95 is within 1 % of that at a compression ratio of 1e-10, and the
+/// median sample differs by less than 0.1 %; at the old regularisation, 1e-4, θ_P95 is more
+/// than 3 % off. (At 1e-10 the slack diagonals' stiffness, 4e-8 N/mm, is near the solver's
+/// force resolution: a few samples there do not converge and are left out of the
+/// comparison, and some tenth of those that float sit in another of the equilibria their
+/// stage allows; the statistics do not notice.)
+#[test]
+#[ignore = "slow: 4,500 backlash solves, run in release by scripts/test.sh"]
+fn the_default_holds_the_fig16_case_at_its_limit() {
+    let samples = 1500;
+    let default = fig16_thetas(26, samples, truss_core::DEFAULT_COMPRESSION_RATIO);
+    let limit = fig16_thetas(26, samples, 1e-10);
+    let old = fig16_thetas(26, samples, 1e-4);
+    assert!(
+        default.iter().all(Option::is_some),
+        "a default solve failed"
+    );
+    let both = |a: &[Option<(f64, bool)>]| -> Vec<(f64, f64)> {
+        a.iter()
+            .zip(&limit)
+            .filter_map(|(x, y)| Some((x.as_ref()?.0, y.as_ref()?.0)))
+            .collect()
+    };
+    let p95 = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[(0.95 * v.len() as f64) as usize]
+    };
+    let pairs = both(&default);
+    assert!(
+        pairs.len() >= samples - 15,
+        "{} of {samples} compared",
+        pairs.len()
+    );
+    let (mut d, mut l): (Vec<f64>, Vec<f64>) = pairs.iter().copied().unzip();
+    let mut rel: Vec<f64> = pairs.iter().map(|(a, b)| (a / b - 1.0).abs()).collect();
+    rel.sort_by(f64::total_cmp);
+    let (pd, pl) = (p95(&mut d), p95(&mut l));
+    println!(
+        "default against 1e-10: θ_P95 {pd:.6e} / {pl:.6e} ({:+.3} %), median |Δθ|/θ {:.2e}, \
+         {} samples compared, {} float",
+        100.0 * (pd / pl - 1.0),
+        rel[rel.len() / 2],
+        pairs.len(),
+        default.iter().flatten().filter(|(_, f)| *f).count()
+    );
+    assert!((pd - pl).abs() <= 0.01 * pl, "θ_P95 {pd} against {pl}");
+    assert!(rel[rel.len() / 2] <= 1e-3, "median {}", rel[rel.len() / 2]);
+    let (mut o, _): (Vec<f64>, Vec<f64>) = both(&old).into_iter().unzip();
+    let po = p95(&mut o);
+    assert!(po > 1.03 * pl, "at 1e-4 θ_P95 {po} against {pl}");
 }

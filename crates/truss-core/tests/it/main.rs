@@ -5,5 +5,6 @@ mod backlash;
 mod common;
 mod hand_solutions;
 mod invariance;
+mod limit;
 mod model_errors;
 mod prism;

@@ -116,9 +116,20 @@ fn cable_fields_are_checked() {
     let mut f = triangle();
     f.members[0].compression_ratio = Some(0.5);
     assert!(message(f).contains("cables only"));
+    // Negative, above 1, or not finite: refused, naming the member.
+    for bad in [1.5, -1e-9, f64::NAN, f64::INFINITY] {
+        let mut f = triangle();
+        f.members[0] = member("ab", "a", "b", 1.0, None, Some(bad));
+        let m = message(f);
+        assert!(
+            m.contains("\"ab\"") && m.contains("compression_ratio"),
+            "{bad}: {m}"
+        );
+    }
+    // 0 is the paper's: slack cables carry nothing (solved as the limit r → 0).
     let mut f = triangle();
-    f.members[0] = member("ab", "a", "b", 1.0, None, Some(1.5));
-    assert!(message(f).contains("compression_ratio must be in [0, 1)"));
+    f.members[0] = member("ab", "a", "b", 1.0, None, Some(0.0));
+    assert!(Model::new(f).is_ok());
 }
 
 fn triangle_json() -> String {
@@ -223,4 +234,23 @@ fn joint_layout_faults_are_named() {
             "{expected}: {m}"
         );
     }
+}
+
+/// A natural length further than 1 % of itself from the distance between its nodes sets an
+/// initial strain beyond the elastic range, as a length error that large would
+/// (`truss_core::MAX_LENGTH_ERROR_FRACTION`): refused naming the member and the field,
+/// before any solve. Within 1 % it is a pretension, and accepted.
+#[test]
+fn natural_lengths_beyond_the_strain_rule_are_named() {
+    let mut f = triangle();
+    f.members[0].natural_length = Some(126.0);
+    let m = message(f);
+    assert!(
+        m.contains("members[0]") && m.contains("\"ab\"") && m.contains("natural_length"),
+        "{m}"
+    );
+    assert!(m.contains("1%"), "{m}");
+    let mut f = triangle();
+    f.members[0].natural_length = Some(99.2);
+    Model::new(f).unwrap();
 }

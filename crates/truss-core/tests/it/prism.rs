@@ -208,3 +208,23 @@ fn soft_directions_count_the_panels_whose_bracing_is_all_slack() {
         }
     }
 }
+
+/// A prism's `diagonal_length` more than 1 % from the face diagonal (400 mm against
+/// 537.4 mm: 25 % strain) is refused by the options' check, naming the field, as the paper's
+/// 537.4 mm is accepted.
+#[test]
+fn diagonal_lengths_beyond_the_strain_rule_are_refused() {
+    let bad = PrismOptions {
+        diagonal_length: Some(400.0),
+        ..PrismOptions::default()
+    };
+    let (field, message) = bad.check().unwrap_err();
+    assert_eq!(field, "diagonal_length");
+    assert!(message.contains("1%"), "{message}");
+    PrismOptions::default().check().unwrap();
+    let pretensioned = PrismOptions {
+        diagonal_length: Some(535.0),
+        ..PrismOptions::default()
+    };
+    pretensioned.check().unwrap();
+}

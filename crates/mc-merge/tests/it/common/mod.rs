@@ -40,6 +40,8 @@ pub struct SynthCase {
     pub fail_every: Option<u64>,
     /// Whether samples record loose_joints (sample k has k % 4 loose joints).
     pub loose: bool,
+    /// If set, samples record `floating`, true for every n-th sample within the case.
+    pub floating_every: Option<u64>,
 }
 
 impl SynthCase {
@@ -53,6 +55,7 @@ impl SynthCase {
             law: Law::Rayleigh,
             fail_every: None,
             loose: false,
+            floating_every: None,
         }
     }
 }
@@ -145,6 +148,10 @@ impl SynthJob {
             residual: (!failed).then_some(1e-11),
             slack_cables: (!failed).then_some((index % 5) as u32),
             loose_joints: (case.loose && !failed).then_some((k % 4) as u32),
+            floating: case
+                .floating_every
+                .filter(|_| !failed)
+                .map(|n| k.is_multiple_of(n)),
             reason: failed
                 .then(|| format!("Newton did not converge in 60 iterations (sample {k})")),
         }
