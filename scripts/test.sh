@@ -8,8 +8,10 @@
 #    (tests/), then the slow statistical checks that the default run ignores
 #    (cargo test --release -- --ignored).
 # 2. The release binaries, then the Python package: built into target/py-venv with
-#    `maturin develop --release` (the workspace's target/release, shared with the binaries)
-#    and its pytest tests, which compare its numbers with the release binaries' bytes.
+#    `maturin develop --release` (in the workspace's target/release; the extension's
+#    dependencies are built with other features than the binaries', so most of them are
+#    compiled again) and its pytest tests, which compare its numbers with the release
+#    binaries' bytes.
 # 3. The end-to-end checks with real parts:
 #    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
 #      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted;
