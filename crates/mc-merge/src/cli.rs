@@ -23,9 +23,6 @@ pub const DEFAULT_SEED: u64 = 20_210_325;
 /// 20 arcseconds in radians, rounded as in the paper: 9.69e-5 rad.
 pub const DEFAULT_TARGET_ANGLE: f64 = 9.69e-5;
 
-/// Radians to arcseconds: 648000/π.
-pub const ARCSEC_PER_RAD: f64 = 648_000.0 / std::f64::consts::PI;
-
 /// The most bootstrap replicates `--replicates` accepts. The replicate percentiles are kept
 /// (8 bytes × percentiles × B), and the time grows as B × n: 100,000 replicates of 50,000
 /// samples take about half a minute; B = 2000 already puts the Monte Carlo error of a 95 %

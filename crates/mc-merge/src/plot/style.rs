@@ -10,8 +10,8 @@ pub type PlotResult = Result<(), Box<dyn std::error::Error>>;
 
 /// rad → µrad.
 pub const MICRO: f64 = 1e6;
-/// µrad → arcsec: 0.648/π = 0.206265 arcsec per µrad.
-pub const ARCSEC_PER_MICRORAD: f64 = crate::cli::ARCSEC_PER_RAD / MICRO;
+/// µrad → arcsec (`truss-units`).
+pub use truss_units::ARCSEC_PER_MICRORAD;
 /// The font family of every text (resolved by the renderer; see [`super::png`]).
 pub const FONT: &str = "sans-serif";
 /// Width of every plot in SVG units (pixels at 1×).
