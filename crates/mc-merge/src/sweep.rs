@@ -28,8 +28,8 @@
 //! is the point's own interval divided by the reference value, as the error bars of Fig. 9.
 
 use crate::analysis::{CaseAnalysis, replicate_interval};
-use crate::cli::Settings;
 use crate::report::*;
+use crate::settings::Settings;
 use shard_record::parameters::{SIGMA, STAGES};
 use std::collections::BTreeMap;
 use truss_units::ARCSEC_PER_RAD;

@@ -67,9 +67,11 @@
 pub mod audit;
 pub mod batch;
 pub mod cli;
+pub mod commands;
 pub mod errors;
 pub mod inputs;
 pub mod interrupt;
+pub mod plan;
 pub mod progress;
 pub mod reproduce;
 pub mod runner;

@@ -4,13 +4,12 @@
 //!
 //! - the runner (`mc-shard`) never links the merge (`mc-merge`) nor an async runtime;
 //! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
-//! - the solver links nothing of ours; nor do the statistics, the wire format and the unit
-//!   conversions (`truss-units`);
-//! - the run directory's file rules (`run-dir`) link only the exit codes, so every writer,
-//!   however low, can share them;
+//! - the solver links nothing of ours; nor do the statistics, the wire format, the run
+//!   directory's file rules (`run-dir`, so every writer, however low, can share them), the
+//!   unit conversions (`truss-units`) and the exit codes;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
 //! - the tolerance study links the solver, the job, the statistics, the file rules and the
-//!   unit conversions, and nothing else of ours;
+//!   units, and nothing else of ours;
 //! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
 //!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
 
@@ -81,10 +80,11 @@ fn dependencies_point_one_way() {
         "run-dir",
         "truss-py",
         "truss-units",
+        "truss-exit",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
     }
-    let forbidden: [(&str, &[&str]); 8] = [
+    let forbidden: [(&str, &[&str]); 10] = [
         (
             "mc-shard",
             &["mc-merge", "tokio", "plotters", "statrs", "truss-stats"],
@@ -93,7 +93,9 @@ fn dependencies_point_one_way() {
         ("truss-core", &[]),
         ("truss-stats", &[]),
         ("shard-record", &[]),
+        ("run-dir", &[]),
         ("truss-units", &[]),
+        ("truss-exit", &[]),
         (
             "truss-diagnose",
             &["mc-shard", "mc-merge", "shard-record", "truss-mc"],
@@ -126,12 +128,6 @@ fn dependencies_point_one_way() {
             );
         }
     }
-    // run-dir sits on the exit codes alone.
-    let files: Vec<String> = closure(&graph, "run-dir")
-        .intersection(&ours)
-        .cloned()
-        .collect();
-    assert_eq!(files, ["truss-exit"]);
     // truss-job sits directly on the solver and on nothing else of ours.
     let job: Vec<String> = closure(&graph, "truss-job")
         .intersection(&ours)
@@ -139,8 +135,7 @@ fn dependencies_point_one_way() {
         .collect();
     assert_eq!(job, ["truss-core"]);
     // truss-tolerance sits on the job, the solver, the statistics, the run directory's file
-    // rules and the unit conversions: not the runner, the merge, the wire format or the
-    // diagnosis.
+    // rules and the units: not the runner, the merge, the wire format or the diagnosis.
     let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
         .intersection(&ours)
         .cloned()
@@ -150,7 +145,6 @@ fn dependencies_point_one_way() {
         [
             "run-dir",
             "truss-core",
-            "truss-exit",
             "truss-job",
             "truss-stats",
             "truss-units"
