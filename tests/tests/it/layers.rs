@@ -7,9 +7,11 @@
 //! - the solver links nothing of ours; nor do the statistics, the wire format, the run
 //!   directory's file rules (`run-dir`, so every writer, however low, can share them), the
 //!   unit conversions (`truss-units`) and the exit codes;
+//! - the plot style (`truss-plot`) links only the unit conversions, so the merge, the
+//!   diagnosis and the tolerance study can all draw with it;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
-//! - the tolerance study links the solver, the job, the statistics, the file rules and the
-//!   units, and nothing else of ours;
+//! - the tolerance study links the solver, the job, the statistics, the file rules, the
+//!   units and the plot style, and nothing else of ours;
 //! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
 //!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
 
@@ -80,11 +82,12 @@ fn dependencies_point_one_way() {
         "run-dir",
         "truss-py",
         "truss-units",
+        "truss-plot",
         "truss-exit",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
     }
-    let forbidden: [(&str, &[&str]); 10] = [
+    let forbidden: [(&str, &[&str]); 11] = [
         (
             "mc-shard",
             &["mc-merge", "tokio", "plotters", "statrs", "truss-stats"],
@@ -96,6 +99,10 @@ fn dependencies_point_one_way() {
         ("run-dir", &[]),
         ("truss-units", &[]),
         ("truss-exit", &[]),
+        (
+            "truss-plot",
+            &["truss-core", "truss-job", "truss-stats", "run-dir"],
+        ),
         (
             "truss-diagnose",
             &["mc-shard", "mc-merge", "shard-record", "truss-mc"],
@@ -128,6 +135,12 @@ fn dependencies_point_one_way() {
             );
         }
     }
+    // The plot style sits on the unit conversions alone.
+    let plot: Vec<String> = closure(&graph, "truss-plot")
+        .intersection(&ours)
+        .cloned()
+        .collect();
+    assert_eq!(plot, ["truss-units"]);
     // truss-job sits directly on the solver and on nothing else of ours.
     let job: Vec<String> = closure(&graph, "truss-job")
         .intersection(&ours)
@@ -135,7 +148,8 @@ fn dependencies_point_one_way() {
         .collect();
     assert_eq!(job, ["truss-core"]);
     // truss-tolerance sits on the job, the solver, the statistics, the run directory's file
-    // rules and the units: not the runner, the merge, the wire format or the diagnosis.
+    // rules, the units and the plot style: not the runner, the merge, the wire format or the
+    // diagnosis.
     let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
         .intersection(&ours)
         .cloned()
@@ -146,6 +160,7 @@ fn dependencies_point_one_way() {
             "run-dir",
             "truss-core",
             "truss-job",
+            "truss-plot",
             "truss-stats",
             "truss-units"
         ]
