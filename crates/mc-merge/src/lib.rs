@@ -16,9 +16,11 @@
 //! mc-merge man
 //! ```
 //!
-//! Every numeric flag has a documented limit, refused naming the flag ([`cli`]).
+//! Every numeric flag has a documented limit, refused naming the flag ([`settings`] for the
+//! statistics, [`cli`] for the rest).
 //!
-//! The binary is a thin shell around [`run`]; the statistics are reusable functions:
+//! The binary is a thin shell around [`execute`] (a helper command, an export, or [`run`]: the
+//! merge with its table and files); the statistics are reusable functions:
 //! [`quantile`] (definition-1 percentiles, weighted percentiles, order-statistic interval),
 //! [`bootstrap`] (split-invariant Poisson bootstrap, percentile and BCa intervals), [`rayleigh`]
 //! (fit, χ² intervals, eq. 28), [`gof`] (KS and AD with estimated scale), [`sweep`] (line fits,

@@ -1,6 +1,6 @@
 //! The `mc-shard` command line: the flags of each command, parsed by clap and checked
 //! against their documented ranges. What a command does is [`crate::commands`]'s; the exit
-//! code of each failure is [`crate::errors::exit_code`]'s.
+//! code of each failure is [`crate::commands::exit_code`]'s.
 
 use crate::errors::RunError;
 use clap::{Args, Parser, Subcommand};
