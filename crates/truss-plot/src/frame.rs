@@ -46,13 +46,7 @@ pub fn captioned<'a, 'b, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     caption: String,
 ) -> ChartBuilder<'a, 'b, DB> {
-    let mut builder = ChartBuilder::on(area);
-    builder
-        .caption(caption, (FONT, text::CAPTION))
-        .margin(16)
-        .x_label_area_size(50)
-        .y_label_area_size(80);
-    builder
+    chart(area, caption, text::CAPTION, 16, (50, 80))
 }
 
 /// The primary mesh's style: light grid lines, tick labels by [`tick`], axis descriptions
@@ -65,11 +59,7 @@ where
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     DB: DrawingBackend,
 {
-    mesh.x_label_formatter(&tick)
-        .y_label_formatter(&tick)
-        .light_line_style(LIGHT)
-        .axis_desc_style((FONT, text::DESCRIPTION))
-        .label_style((FONT, text::LABEL))
+    mesh_in_sizes(mesh, text::DESCRIPTION, text::LABEL)
 }
 
 /// A chart builder for one panel of a figure of panels ([`PANELS_WIDTH`] wide, its title
@@ -79,13 +69,7 @@ pub fn panel<'a, 'b, DB: DrawingBackend>(
     area: &'a DrawingArea<DB, Shift>,
     caption: String,
 ) -> ChartBuilder<'a, 'b, DB> {
-    let mut builder = ChartBuilder::on(area);
-    builder
-        .caption(caption, (FONT, text::PANEL_CAPTION))
-        .margin(14)
-        .x_label_area_size(45)
-        .y_label_area_size(70);
-    builder
+    chart(area, caption, text::PANEL_CAPTION, 14, (45, 70))
 }
 
 /// The title strip of a figure of panels ([`crate::style::TITLE_HEIGHT`] high, the title
@@ -110,11 +94,44 @@ where
     Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
     DB: DrawingBackend,
 {
+    mesh_in_sizes(mesh, text::PANEL_DESCRIPTION, text::PANEL_LABEL)
+}
+
+/// A chart builder on `area`: its caption in `size` px, `margin` px around it, and
+/// `label_areas` px below (x labels) and left (y labels).
+fn chart<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: String,
+    size: u32,
+    margin: u32,
+    (below, left): (u32, u32),
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(caption, (FONT, size))
+        .margin(margin)
+        .x_label_area_size(below)
+        .y_label_area_size(left);
+    builder
+}
+
+/// A mesh with light grid lines, tick labels by [`tick`], axis descriptions in
+/// `description` px and labels in `label` px.
+fn mesh_in_sizes<'m, 'a, 'b, X, Y, DB>(
+    mesh: &'m mut MeshStyle<'a, 'b, X, Y, DB>,
+    description: u32,
+    label: u32,
+) -> &'m mut MeshStyle<'a, 'b, X, Y, DB>
+where
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    DB: DrawingBackend,
+{
     mesh.x_label_formatter(&tick)
         .y_label_formatter(&tick)
         .light_line_style(LIGHT)
-        .axis_desc_style((FONT, text::PANEL_DESCRIPTION))
-        .label_style((FONT, text::PANEL_LABEL))
+        .axis_desc_style((FONT, description))
+        .label_style((FONT, label))
 }
 
 /// The secondary axes' style: tick labels by [`tick`], descriptions in
