@@ -16,9 +16,11 @@
 //! mc-merge man
 //! ```
 //!
-//! Every numeric flag has a documented limit, refused naming the flag ([`cli`]).
+//! Every numeric flag has a documented limit, refused naming the flag ([`settings`] for the
+//! statistics, [`cli`] for the rest).
 //!
-//! The binary is a thin shell around [`run`]; the statistics are reusable functions:
+//! The binary is a thin shell around [`execute`] (a helper command, an export, or [`run`]: the
+//! merge with its table and files); the statistics are reusable functions:
 //! [`quantile`] (definition-1 percentiles, weighted percentiles, order-statistic interval),
 //! [`bootstrap`] (split-invariant Poisson bootstrap, percentile and BCa intervals), [`rayleigh`]
 //! (fit, χ² intervals, eq. 28), [`gof`] (KS and AD with estimated scale), [`sweep`] (line fits,
@@ -121,7 +123,7 @@
 //! serialise NaN or ∞. Angles in rad, σ in mm. The report holds nothing that depends on the
 //! split or the file order, so it is byte-identical for any split.
 //!
-//! ## 5. Exit codes ([`ExitCodes`])
+//! ## 5. Exit codes ([`MergeError::exit_code`])
 //!
 //! The scheme every truss-mc binary shares (`truss-exit`):
 //!
@@ -158,16 +160,18 @@ pub mod plot;
 pub mod rayleigh;
 pub mod report;
 pub mod report_dir;
+pub mod settings;
 pub mod sweep;
 pub mod table;
 
 /// The statistics live in `truss-stats`, shared with the diagnosis.
 pub use truss_stats::{bootstrap, quantile, rng};
 
-pub use cli::{Args, Options, Settings};
-pub use errors::{ExitCodes, MergeError};
+pub use cli::Args;
+pub use errors::MergeError;
 pub use load::{Dataset, LoadOptions};
 pub use report::Report;
+pub use settings::{Options, Settings};
 
 use analysis::{CaseAnalysis, analyse_case};
 use gof::CalibrationCache;
@@ -247,6 +251,26 @@ pub fn report_json(report: &Report) -> Result<String, MergeError> {
     })?;
     s.push('\n');
     Ok(s)
+}
+
+/// Does what the command line asks, writing to `out`: a helper command, an export, or a
+/// merge (the table and the files written, nothing with `--quiet`).
+pub fn execute(args: Args, out: &mut dyn Write) -> Result<(), MergeError> {
+    if let Some(helper) = &args.command {
+        return helper.print(out);
+    }
+    let export = args.export.clone();
+    let quiet = args.quiet;
+    let options = args.validate()?;
+    let mut sink = std::io::sink();
+    let out: &mut dyn Write = if quiet { &mut sink } else { out };
+    if let Some(to) = &export {
+        export::run(&options, to, out)?;
+        if options.out.is_none() {
+            return Ok(());
+        }
+    }
+    run(&options, out).map(|_| ())
 }
 
 /// Runs a merge as the command line asks: verify, compute, print the table to `out`, and with

@@ -432,7 +432,7 @@ fn top_by_hand(stages: usize, delta: f64, g: f64, contact: f64) -> f64 {
     (0..stages).map(|s| a[s][n] / a[s][s]).sum()
 }
 
-/// The hand check: the 5-stage truss, every clearance `g`, no length errors but
+/// A hand check: the 5-stage truss, every clearance `g`, no length errors but
 /// every diagonal shortened by 0.05 mm. Every joint bears, each joint's force lies along its
 /// longeron with its offset `g` (plus the contact's penetration `F/k_t`) along that force,
 /// and the top surface is lower than without backlash by [`top_by_hand`]'s difference, to
