@@ -73,8 +73,9 @@
 //! ## 4. Output
 //!
 //! With `--out REPORT_DIR`: `report.json` (schema in [`report`], summary below, and the
-//! standalone JSON Schema `docs/report.schema.json`), and SVG and PNG plots ([`plot`]),
-//! each written atomically and never through a link into a directory that holds no other
+//! standalone JSON Schema `docs/report.schema.json`), SVG and PNG plots ([`plot`]), and
+//! for people `report.md` and a self-contained `report.html` ([`readable`]: the same
+//! results with their units, the plots linked or embedded), each written atomically and never through a link into a directory that holds no other
 //! job's report and that no other merge is writing; a rerun removes only the files it listed
 //! in its manifest ([`report_dir`]).
 //! Unless `--quiet`: a table on stdout (angles in rad and arcsec). With `--export FILE`: every
@@ -158,6 +159,7 @@ pub mod gof;
 pub mod load;
 pub mod plot;
 pub mod rayleigh;
+pub mod readable;
 pub mod report;
 pub mod report_dir;
 pub mod settings;
@@ -274,7 +276,8 @@ pub fn execute(args: Args, out: &mut dyn Write) -> Result<(), MergeError> {
 }
 
 /// Runs a merge as the command line asks: verify, compute, print the table to `out`, and with
-/// a report directory write `report.json` and the plots ([`report_dir`]: the directory is
+/// a report directory write `report.json`, the plots, `report.md` and `report.html`
+/// ([`readable`]) ([`report_dir`]: the directory is
 /// locked, another job's report directory is refused, every file written atomically and
 /// never through a link, only our own earlier files removed).
 pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError> {
@@ -285,10 +288,14 @@ pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError>
         let mut files = report_dir::open(dir, &merge.report.job_id)?;
         let path = files.write(report_dir::REPORT_FILE, json.as_bytes())?;
         text.push_str(&format!("\nwrote {}\n", path.display()));
-        if options.plots {
-            for p in plot::draw_all(&mut files, &merge.dataset.cases, &merge.report)? {
-                text.push_str(&format!("wrote {}\n", p.display()));
-            }
+        let plots = if options.plots {
+            plot::draw_all(&mut files, &merge.dataset.cases, &merge.report)?
+        } else {
+            vec![]
+        };
+        let readable = readable::write(&mut files, &merge.report, &merge.dataset.writers, &plots)?;
+        for p in plots.iter().chain(&readable) {
+            text.push_str(&format!("wrote {}\n", p.display()));
         }
         files.finish()?;
     }
