@@ -12,10 +12,10 @@ use super::plots;
 use super::rayleigh::rayleigh_section;
 use super::sweeps;
 use super::words::{NONE, arcsec, figure_interval, figure_value, parameters, plain, rad, verdict};
-use crate::cli::ARCSEC_PER_RAD;
 use crate::load::ShardWriter;
 use crate::report::Report;
 use std::collections::BTreeSet;
+use truss_units::ARCSEC_PER_RAD;
 
 /// The report's title.
 pub const TITLE: &str = "Distortion angle θ_P: Monte Carlo report";

@@ -4,8 +4,8 @@
 //! Every number shown comes from the report (a [`Real`], finite by construction), so no
 //! `NaN` or `inf` can be printed.
 
-use crate::cli::ARCSEC_PER_RAD;
 use crate::report::{CaseReport, Figure, Interval, Real, short};
+use truss_units::ARCSEC_PER_RAD;
 
 /// What a cell shows for a figure that could not be computed.
 pub const NONE: &str = "—";
