@@ -97,6 +97,13 @@ impl Structure {
         self.tilt_framed
     }
 
+    /// Whether some cable of ratio 0 is solved near its limit r → 0 at
+    /// [`crate::limit::LIMIT_RATIO`] (the bars do not frame the tilt): a stage held by slack
+    /// cables alone may then have no well-resolved position, and a solve can fail there.
+    pub fn near_the_limit(&self) -> bool {
+        !self.tilt_framed && self.members.iter().any(|c| c.limit)
+    }
+
     /// Number of rows of the stiffness matrix (3 per node with a free direction).
     pub fn free_dofs(&self) -> usize {
         self.free
