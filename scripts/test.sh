@@ -8,9 +8,9 @@
 #    (tests/), then the slow statistical checks that the default run ignores
 #    (cargo test --release -- --ignored).
 # 2. The release binaries, then the Python package: built into target/py-venv with
-#    `maturin develop --release` (in the workspace's target/release; the extension's
-#    dependencies are built with other features than the binaries', so most of them are
-#    compiled again) and its pytest tests, which compare its numbers with the release
+#    `maturin develop --release` (in the workspace's target/release: the feature unifier
+#    crates/workspace-hack gives its dependencies the binaries' features, so only PyO3 and
+#    the extension are compiled) and its pytest tests, which compare its numbers with the release
 #    binaries' bytes.
 # 3. The end-to-end checks with real parts:
 #    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
@@ -36,10 +36,14 @@ phase "cargo test --workspace (without the png feature)"
 cargo test --workspace --no-default-features --quiet
 
 phase "the slow statistical checks (#[ignore]d in the default run), in release"
-# Only the crates that have such tests: building every test target in release costs minutes.
+# Only the crates that have such tests (building every test target in release costs
+# minutes), in one build: with the feature unifier (crates/workspace-hack) the binaries and the
+# Python extension below reuse its compiled dependencies.
+slow=()
 for crate in $(grep -rl '#\[ignore' crates/*/src crates/*/tests | cut -d/ -f2 | sort -u); do
-    cargo test --release --quiet -p "$crate" -- --ignored
+    slow+=(-p "$crate")
 done
+cargo test --release --quiet "${slow[@]}" -- --ignored
 
 phase "release binaries"
 cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-mc

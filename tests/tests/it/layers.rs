@@ -14,10 +14,18 @@
 //!   units and the plot style, and nothing else of ours;
 //! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
 //!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
+//!
+//! The feature unifier `workspace-hack` (cargo-hakari's) is left out of the graph: every crate
+//! depends on it, it holds no code, and it names only third-party crates, with the features
+//! some build of the workspace already gives them.
 
 use std::collections::{BTreeMap, BTreeSet};
 
-/// Each workspace package's normal dependencies (any package, by name).
+/// The feature unifier: no code, a build setting (see the module's doc).
+const FEATURE_UNIFIER: &str = "workspace-hack";
+
+/// Each workspace package's normal dependencies (any package, by name), without the feature
+/// unifier.
 fn normal_dependencies() -> BTreeMap<String, BTreeSet<String>> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let out = std::process::Command::new(cargo)
@@ -48,9 +56,11 @@ fn normal_dependencies() -> BTreeMap<String, BTreeSet<String>> {
                 .iter()
                 .filter(|d| d["kind"].is_null())
                 .map(|d| d["name"].as_str().unwrap().to_string())
+                .filter(|d| d != FEATURE_UNIFIER)
                 .collect();
             (p["name"].as_str().unwrap().to_string(), deps)
         })
+        .filter(|(name, _)| name != FEATURE_UNIFIER)
         .collect()
 }
 

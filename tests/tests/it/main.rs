@@ -1,9 +1,10 @@
 //! The workspace's cross-crate tests, one binary: the pipeline, golden reproducibility,
-//! the dependency graph, circles of imports between files, the README's commands, and the
-//! cron round script.
+//! the dependency graph, circles of imports between files, the release builds' shared
+//! features, the README's commands, and the cron round script.
 
 mod circles;
 mod cron;
+mod features;
 mod golden;
 mod layers;
 mod pipeline;
