@@ -39,8 +39,7 @@ pub const MAX_GOF_REPLICATES: u32 = 100_000;
 /// The most percentiles `--percentiles` accepts (each one is bootstrapped).
 pub const MAX_PERCENTILES: usize = 64;
 
-/// The most worker threads `--threads` accepts.
-pub const MAX_THREADS: usize = 1024;
+pub use truss_threads::MAX_THREADS;
 
 /// The largest target angle `--target-angle` accepts, in rad: a tilt below a right angle.
 pub const MAX_TARGET_ANGLE: f64 = std::f64::consts::FRAC_PI_2;
@@ -245,14 +244,9 @@ impl Default for Settings {
             target_percentile: 95.0,
             allow_partial: false,
             allow_failed: false,
-            threads: default_threads(),
+            threads: truss_threads::available(),
         }
     }
-}
-
-/// All available cores.
-pub fn default_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// A validated merge request.
@@ -276,7 +270,7 @@ impl Args {
     /// Checks every value and builds the options.
     pub fn validate(self) -> Result<Options, MergeError> {
         if let Some(t) = self.threads
-            && !(1..=MAX_THREADS).contains(&t)
+            && !truss_threads::accepted(t)
         {
             return Err(usage(format!(
                 "--threads {t}: must be between 1 and {MAX_THREADS}"
@@ -293,7 +287,7 @@ impl Args {
             target_percentile: self.target_percentile,
             allow_partial: self.allow_partial,
             allow_failed: self.allow_failed,
-            threads: self.threads.unwrap_or_else(default_threads),
+            threads: truss_threads::or_available(self.threads),
         }
         .validate()?;
         Ok(Options {

@@ -63,12 +63,11 @@ pub const MAX_SHARDS: u64 = 1_000_000;
 /// The longest `--heartbeat` or `--stale-after` \[s\]: one week.
 pub const MAX_SECONDS: f64 = 7.0 * 24.0 * 3600.0;
 
-/// The most threads (or `run-all` workers) a command starts.
-pub const MAX_THREADS: usize = 1024;
+pub use truss_threads::MAX_THREADS;
 
 /// Checks a thread or worker count given as `--NAME` (1 to [`MAX_THREADS`]).
 pub fn check_threads(name: &str, threads: usize) -> Result<usize, RunError> {
-    if (1..=MAX_THREADS).contains(&threads) {
+    if truss_threads::accepted(threads) {
         Ok(threads)
     } else {
         Err(RunError::Usage(format!(
@@ -356,7 +355,7 @@ pub fn man_page(cmd: clap::Command, out: &mut dyn Write) -> Result<(), CliError>
 
 /// `mc-shard audit`: re-solve a seeded sample of lines; exit 6 on a mismatch.
 fn audit_command(a: AuditArgs, out: &mut dyn Write) -> Result<(), CliError> {
-    let threads = check_threads("threads", a.threads.unwrap_or_else(default_threads))?;
+    let threads = check_threads("threads", truss_threads::or_available(a.threads))?;
     let job = Job::read(&a.job)?;
     let options = crate::audit::AuditOptions {
         samples: a.samples,
@@ -428,9 +427,7 @@ fn run_command(a: RunArgs, out: &mut dyn Write) -> Result<(), CliError> {
         job.samples(),
         |k| std::env::var(k).ok(),
     )?;
-    let threads = a
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let threads = truss_threads::or_available(a.threads);
     check_threads("threads", threads)?;
     crate::interrupt::install()?;
     let summary = run_shard(
@@ -507,7 +504,7 @@ fn work_command(a: WorkArgs, out: &mut dyn Write) -> Result<(), CliError> {
         ))
         .into());
     }
-    let threads = check_threads("threads", a.threads.unwrap_or_else(default_threads))?;
+    let threads = check_threads("threads", truss_threads::or_available(a.threads))?;
     let job = Job::read(&a.job)?;
     let options = crate::work::WorkOptions {
         shards: a.shards,
@@ -610,11 +607,6 @@ pub fn kept_samples(job: &Job, dir: &std::path::Path, shards: u64) -> u64 {
     })
 }
 
-/// The default thread or worker count: the machine's cores.
-pub fn default_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
-}
-
 /// `mc-shard plan`: the job's id and cases, and a split suggested from a short timing.
 fn plan(a: &PlanArgs, out: &mut dyn Write) -> Result<(), CliError> {
     let job = Job::read(&a.job)?;
@@ -637,7 +629,7 @@ fn plan(a: &PlanArgs, out: &mut dyn Write) -> Result<(), CliError> {
         cpu_seconds += each * c.samples as f64;
         per_case.push(each);
     }
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+    let cores = truss_threads::available() as u64;
     let advice = Advice::new(cpu_seconds, cores, job.samples());
     let cluster_shards = advice.cluster_shards.unwrap_or(1);
     if a.json {

@@ -2,7 +2,7 @@
 
 use crate::run_all::{RunAllError, RunAllOptions, run_all};
 use clap::{Args, Parser, Subcommand};
-use mc_shard::cli::{CliError, default_threads, run_exit_code};
+use mc_shard::cli::{CliError, run_exit_code};
 use mc_shard::{Job, RunError};
 use std::io::Write;
 use std::path::PathBuf;
@@ -116,7 +116,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
         )?),
         Command::Shard(command) => Ok(mc_shard::cli::run(mc_shard::cli::Cli { command }, out)?),
         Command::RunAll(a) => {
-            let workers = a.workers.unwrap_or_else(default_threads);
+            let workers = truss_threads::or_available(a.workers);
             mc_shard::cli::check_threads("workers", workers).map_err(CliError::from)?;
             if let Some(k) = a.shards {
                 mc_shard::cli::check_shards(k).map_err(CliError::from)?;

@@ -4,12 +4,13 @@
 //!
 //! - the runner (`mc-shard`) never links the merge (`mc-merge`) nor an async runtime;
 //! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
-//! - the solver links nothing of ours; nor do the statistics and the wire format;
+//! - the solver links nothing of ours; nor do the statistics, the wire format and the thread
+//!   count (`truss-threads`, which every crate that starts threads shares);
 //! - the run directory's file rules (`run-dir`) link only the exit codes, so every writer,
 //!   however low, can share them;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
-//! - the tolerance study links the solver, the job, the statistics and the file rules, and
-//!   nothing else of ours;
+//! - the tolerance study links the solver, the job, the statistics, the file rules and the
+//!   thread count, and nothing else of ours;
 //! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
 //!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
 
@@ -79,10 +80,11 @@ fn dependencies_point_one_way() {
         "truss-tolerance",
         "run-dir",
         "truss-py",
+        "truss-threads",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
     }
-    let forbidden: [(&str, &[&str]); 7] = [
+    let forbidden: [(&str, &[&str]); 8] = [
         (
             "mc-shard",
             &["mc-merge", "tokio", "plotters", "statrs", "truss-stats"],
@@ -91,6 +93,7 @@ fn dependencies_point_one_way() {
         ("truss-core", &[]),
         ("truss-stats", &[]),
         ("shard-record", &[]),
+        ("truss-threads", &[]),
         (
             "truss-diagnose",
             &["mc-shard", "mc-merge", "shard-record", "truss-mc"],
@@ -135,8 +138,8 @@ fn dependencies_point_one_way() {
         .cloned()
         .collect();
     assert_eq!(job, ["truss-core"]);
-    // truss-tolerance sits on the job, the solver, the statistics and the run directory's
-    // file rules: not the runner, the merge, the wire format or the diagnosis.
+    // truss-tolerance sits on the job, the solver, the statistics, the run directory's file
+    // rules and the thread count: not the runner, the merge, the wire format or the diagnosis.
     let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
         .intersection(&ours)
         .cloned()
@@ -148,7 +151,8 @@ fn dependencies_point_one_way() {
             "truss-core",
             "truss-exit",
             "truss-job",
-            "truss-stats"
+            "truss-stats",
+            "truss-threads"
         ]
     );
 }
