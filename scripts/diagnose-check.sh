@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# diagnose-check.sh: the hidden-effect checks of `truss diagnose`'s forward selection
-# (issues 7, 14 and 15), with the release build. Too slow for CI (tens of minutes): not part
+# diagnose-check.sh: the hidden-effect checks of `truss diagnose`'s forward selection,
+# with the release build. Too slow for CI (tens of minutes): not part
 # of scripts/test.sh, whose default and slow tiers run smaller versions of the key checks.
 #
 # Data: made by `truss synth-measured` from jobs/diagnose-baseline.json (the paper's 5-stage

@@ -4,13 +4,15 @@
 //!
 //! - the runner (`mc-shard`) never links the merge (`mc-merge`) nor an async runtime;
 //! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
-//! - the solver links nothing of ours; nor do the statistics, the wire format and the thread
-//!   count (`truss-threads`, which every crate that starts threads shares);
-//! - the run directory's file rules (`run-dir`) link only the exit codes, so every writer,
-//!   however low, can share them;
+//! - the solver links nothing of ours; nor do the statistics, the wire format, the run
+//!   directory's file rules (`run-dir`, so every writer, however low, can share them), the
+//!   unit conversions (`truss-units`), the exit codes and the thread count (`truss-threads`,
+//!   which every crate that starts threads shares, the merge as well as the job's engine);
+//! - the plot style (`truss-plot`) links only the unit conversions, so the merge, the
+//!   diagnosis and the tolerance study can all draw with it;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
-//! - the tolerance study links the solver, the job, the statistics, the file rules and the
-//!   thread count, and nothing else of ours;
+//! - the tolerance study links the solver, the job, the statistics, the file rules, the
+//!   units, the plot style and the thread count, and nothing else of ours;
 //! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
 //!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
 
@@ -80,11 +82,14 @@ fn dependencies_point_one_way() {
         "truss-tolerance",
         "run-dir",
         "truss-py",
+        "truss-units",
+        "truss-plot",
+        "truss-exit",
         "truss-threads",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
     }
-    let forbidden: [(&str, &[&str]); 8] = [
+    let forbidden: [(&str, &[&str]); 12] = [
         (
             "mc-shard",
             &["mc-merge", "tokio", "plotters", "statrs", "truss-stats"],
@@ -93,7 +98,14 @@ fn dependencies_point_one_way() {
         ("truss-core", &[]),
         ("truss-stats", &[]),
         ("shard-record", &[]),
+        ("run-dir", &[]),
+        ("truss-units", &[]),
+        ("truss-exit", &[]),
         ("truss-threads", &[]),
+        (
+            "truss-plot",
+            &["truss-core", "truss-job", "truss-stats", "run-dir"],
+        ),
         (
             "truss-diagnose",
             &["mc-shard", "mc-merge", "shard-record", "truss-mc"],
@@ -126,12 +138,12 @@ fn dependencies_point_one_way() {
             );
         }
     }
-    // run-dir sits on the exit codes alone.
-    let files: Vec<String> = closure(&graph, "run-dir")
+    // The plot style sits on the unit conversions alone.
+    let plot: Vec<String> = closure(&graph, "truss-plot")
         .intersection(&ours)
         .cloned()
         .collect();
-    assert_eq!(files, ["truss-exit"]);
+    assert_eq!(plot, ["truss-units"]);
     // truss-job sits directly on the solver and on nothing else of ours.
     let job: Vec<String> = closure(&graph, "truss-job")
         .intersection(&ours)
@@ -139,7 +151,8 @@ fn dependencies_point_one_way() {
         .collect();
     assert_eq!(job, ["truss-core"]);
     // truss-tolerance sits on the job, the solver, the statistics, the run directory's file
-    // rules and the thread count: not the runner, the merge, the wire format or the diagnosis.
+    // rules, the units, the plot style and the thread count: not the runner, the merge, the
+    // wire format or the diagnosis.
     let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
         .intersection(&ours)
         .cloned()
@@ -149,10 +162,11 @@ fn dependencies_point_one_way() {
         [
             "run-dir",
             "truss-core",
-            "truss-exit",
             "truss-job",
+            "truss-plot",
             "truss-stats",
-            "truss-threads"
+            "truss-threads",
+            "truss-units"
         ]
     );
 }

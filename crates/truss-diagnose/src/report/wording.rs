@@ -113,7 +113,7 @@ pub(super) fn spans(baseline: &Baseline) -> [f64; 3] {
 /// A fitted parameter in plain words: what it means for the hardware.
 pub(super) fn plain_reading(effect: &str, p: &FittedParameter, span: [f64; 3]) -> String {
     let v = p.value;
-    let um = |mm: f64| format!("{:.1} µm", mm * 1e3);
+    let um = |mm: f64| format!("{:.1} µm", mm * truss_units::MICROMETRE_PER_MM);
     let name = p.name.as_str();
     match (effect, name) {
         ("thermal_gradient", "offset") => format!(
