@@ -1,6 +1,6 @@
 //! The constant "distribution": every draw the same value (its two words unused).
 
-use super::{DistributionSpec, Kind, finite};
+use super::kind::{Kind, finite};
 use serde::{Deserialize, Serialize};
 
 /// Always the same value: `{"constant": {"value": -0.01}}`.
@@ -45,19 +45,18 @@ impl Kind for Constant {
         format!("a value of {} mm", truss_core::readable(self.reach()))
     }
 
-    fn shifted(&self, shift: f64) -> DistributionSpec {
+    fn shifted(&self, shift: f64) -> Self {
         Constant {
             value: self.value + shift,
         }
-        .into()
     }
 
     /// No spread to scale: the constant itself.
-    fn spread_scaled(&self, _ratio: f64) -> DistributionSpec {
-        (*self).into()
+    fn spread_scaled(&self, _ratio: f64) -> Self {
+        *self
     }
 
-    fn with_sigma(&self, _sigma: f64) -> Result<DistributionSpec, String> {
+    fn with_sigma(&self, _sigma: f64) -> Result<Option<Self>, String> {
         Err("its length error is a constant: a tolerance study needs random errors".into())
     }
 

@@ -29,11 +29,13 @@
 //! come from it. A new distribution is one more file and one more line here.
 
 mod constant;
+mod kind;
 mod normal;
 mod truncated_normal;
 mod uniform;
 
 pub use constant::Constant;
+pub use kind::Kind;
 pub use normal::{NORMAL_REACH, Normal};
 pub use truncated_normal::TruncatedNormal;
 pub use uniform::Uniform;
@@ -41,41 +43,6 @@ pub use uniform::Uniform;
 use rand_core::Rng;
 use rand_distr::Distribution;
 use serde::{Deserialize, Serialize};
-
-/// Everything a distribution says about itself (lengths in mm).
-pub trait Kind {
-    /// Checks the parameters as read; the message names the faulty field.
-    fn check(&self) -> Result<(), String>;
-    /// The value the two words `w1`, `w2` give (see the module doc).
-    fn draw(&self, w1: u64, w2: u64) -> f64;
-    /// Mean \[mm\].
-    fn mean(&self) -> f64;
-    /// Standard deviation \[mm\].
-    fn std_dev(&self) -> f64;
-    /// The least value a draw can take \[mm\] (−∞ if unbounded).
-    fn lowest(&self) -> f64;
-    /// The greatest value a draw can take \[mm\] (+∞ if unbounded).
-    fn highest(&self) -> f64;
-    /// The largest magnitude a draw is taken to reach \[mm\], checked against a member's
-    /// elastic range ([`truss_core::MAX_LENGTH_ERROR_FRACTION`]).
-    fn reach(&self) -> f64;
-    /// How [`Kind::reach`] comes about, in words for a refusal
-    /// (`mean 0 mm, σ 1 mm: |mean| + 6σ = 6 mm`).
-    fn reach_in_words(&self) -> String;
-    /// The distribution of the values plus `shift` \[mm\].
-    fn shifted(&self, shift: f64) -> DistributionSpec;
-    /// The spread about the mean multiplied by `ratio` > 0, the mean kept (so the standard
-    /// deviation is multiplied by `ratio`); a distribution without spread stays as it is.
-    fn spread_scaled(&self, ratio: f64) -> DistributionSpec;
-    /// The same shape, zero-mean, with standard deviation `sigma` ≥ 0 \[mm\], for a
-    /// tolerance study, which scales each group's errors `e = σ·z` with `z` fixed by the
-    /// sample's stream; or why it cannot be scaled so (not zero-mean, no spread).
-    fn with_sigma(&self, sigma: f64) -> Result<DistributionSpec, String>;
-    /// A key and value this distribution puts into its case's parameters (so that cases
-    /// differing in it form their own series in the merge's sweeps), if any. Of several
-    /// groups with the same key, the case keeps the largest value.
-    fn series_marker(&self) -> Option<(&'static str, f64)>;
-}
 
 /// Registers the distributions: each line a variant of [`DistributionSpec`], its type, and
 /// its name in the job format.
@@ -106,6 +73,32 @@ macro_rules! distributions {
             pub fn kind(&self) -> &dyn Kind {
                 match self {
                     $(DistributionSpec::$variant(d) => d,)*
+                }
+            }
+
+            /// The distribution of the values plus `shift` \[mm\].
+            pub fn shifted(&self, shift: f64) -> DistributionSpec {
+                match self {
+                    $(DistributionSpec::$variant(d) => d.shifted(shift).into(),)*
+                }
+            }
+
+            /// The spread about the mean multiplied by `ratio` (see [`Kind::spread_scaled`]).
+            pub fn spread_scaled(&self, ratio: f64) -> DistributionSpec {
+                match self {
+                    $(DistributionSpec::$variant(d) => d.spread_scaled(ratio).into(),)*
+                }
+            }
+
+            /// The same shape, zero-mean, with standard deviation `sigma` \[mm\] (no error
+            /// at all, a normal of σ 0, where the shape has no form without spread), or why
+            /// it cannot be scaled (see [`Kind::with_sigma`]).
+            pub fn with_sigma(&self, sigma: f64) -> Result<DistributionSpec, String> {
+                let none = DistributionSpec::Normal(Normal { mean: 0.0, sigma: 0.0 });
+                match self {
+                    $(DistributionSpec::$variant(d) => {
+                        Ok(d.with_sigma(sigma)?.map_or(none, Into::into))
+                    })*
                 }
             }
 
@@ -197,22 +190,6 @@ impl DistributionSpec {
         self.kind().reach_in_words()
     }
 
-    /// The distribution of the values plus `shift` \[mm\].
-    pub fn shifted(&self, shift: f64) -> DistributionSpec {
-        self.kind().shifted(shift)
-    }
-
-    /// The spread about the mean multiplied by `ratio` (see [`Kind::spread_scaled`]).
-    pub fn spread_scaled(&self, ratio: f64) -> DistributionSpec {
-        self.kind().spread_scaled(ratio)
-    }
-
-    /// The same shape, zero-mean, with standard deviation `sigma` \[mm\], or why it cannot
-    /// be scaled (see [`Kind::with_sigma`]).
-    pub fn with_sigma(&self, sigma: f64) -> Result<DistributionSpec, String> {
-        self.kind().with_sigma(sigma)
-    }
-
     /// Its mark in its case's parameters, if any (see [`Kind::series_marker`]).
     pub fn series_marker(&self) -> Option<(&'static str, f64)> {
         self.kind().series_marker()
@@ -234,26 +211,36 @@ impl Distribution<f64> for DistributionSpec {
     }
 }
 
-/// `2⁻⁵³`: a word's top 53 bits times this is a uniform number in [0, 1).
-const SCALE: f64 = 1.0 / (1u64 << 53) as f64;
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// `u₁ = ((w >> 11) + ½)·2⁻⁵³ ∈ (0, 1)`.
-#[inline]
-fn open_unit(w: u64) -> f64 {
-    ((w >> 11) as f64 + 0.5) * SCALE
-}
-
-/// `u₂ = (w >> 11)·2⁻⁵³ ∈ [0, 1)`.
-#[inline]
-fn half_open_unit(w: u64) -> f64 {
-    (w >> 11) as f64 * SCALE
-}
-
-/// `Err` naming `name` unless `v` is finite.
-fn finite(name: &str, v: f64) -> Result<(), String> {
-    if v.is_finite() {
-        Ok(())
-    } else {
-        Err(format!("{name} is not a finite number"))
+    /// Scaled to σ 0, a shape without a form of no spread (the truncated normal) becomes no
+    /// error at all, a normal of σ 0; the others keep their shape.
+    #[test]
+    fn scaled_to_no_spread() {
+        let zero = DistributionSpec::from(Normal {
+            mean: 0.0,
+            sigma: 0.0,
+        });
+        let truncated = TruncatedNormal {
+            mean: 0.0,
+            sigma: 0.01,
+            limit: 0.02,
+        };
+        assert_eq!(DistributionSpec::from(truncated).with_sigma(0.0), Ok(zero));
+        let normal = DistributionSpec::from(Normal {
+            mean: 0.0,
+            sigma: 0.5,
+        });
+        assert_eq!(normal.with_sigma(0.0), Ok(zero));
+        let uniform = DistributionSpec::from(Uniform {
+            low: -1.0,
+            high: 1.0,
+        });
+        assert!(matches!(
+            uniform.with_sigma(0.0),
+            Ok(DistributionSpec::Uniform(_))
+        ));
     }
 }

@@ -1,6 +1,6 @@
 //! The normal distribution: `mean + σ·z`, `z` from the Box–Muller transform of the two words.
 
-use super::{DistributionSpec, Kind, finite, half_open_unit, open_unit};
+use super::kind::{Kind, finite, half_open_unit, open_unit};
 use serde::{Deserialize, Serialize};
 
 /// How many standard deviations from its mean a normal draw is taken to reach when a job's
@@ -78,30 +78,28 @@ impl Kind for Normal {
         )
     }
 
-    fn shifted(&self, shift: f64) -> DistributionSpec {
+    fn shifted(&self, shift: f64) -> Self {
         Normal {
             mean: self.mean + shift,
             sigma: self.sigma,
         }
-        .into()
     }
 
-    fn spread_scaled(&self, ratio: f64) -> DistributionSpec {
+    fn spread_scaled(&self, ratio: f64) -> Self {
         Normal {
             mean: self.mean,
             sigma: self.sigma * ratio,
         }
-        .into()
     }
 
-    fn with_sigma(&self, sigma: f64) -> Result<DistributionSpec, String> {
+    fn with_sigma(&self, sigma: f64) -> Result<Option<Self>, String> {
         if self.mean != 0.0 {
             return Err(format!(
                 "its length error has mean {} mm: a tolerance study needs zero-mean errors",
                 self.mean
             ));
         }
-        Ok(Normal { mean: 0.0, sigma }.into())
+        Ok(Some(Normal { mean: 0.0, sigma }))
     }
 
     fn series_marker(&self) -> Option<(&'static str, f64)> {

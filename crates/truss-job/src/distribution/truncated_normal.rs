@@ -34,7 +34,7 @@
 //! the series `a²·Σ c_k/(2k + 3) / Σ c_k/(2k + 1)`, `c_k = (−a²/2)^k/k!`. It tends to σ²
 //! for a large limit and to the uniform's t²/3 for a small one.
 
-use super::{DistributionSpec, Kind, Normal, SCALE, finite};
+use super::kind::{Kind, SCALE, finite};
 use serde::{Deserialize, Serialize};
 
 /// Normal with mean (default 0) and σ > 0, truncated to `mean ± limit` (limit > 0):
@@ -127,27 +127,25 @@ impl Kind for TruncatedNormal {
         )
     }
 
-    fn shifted(&self, shift: f64) -> DistributionSpec {
+    fn shifted(&self, shift: f64) -> Self {
         TruncatedNormal {
             mean: self.mean + shift,
             ..*self
         }
-        .into()
     }
 
     /// σ and the limit multiplied by `ratio` (the shape `a` kept).
-    fn spread_scaled(&self, ratio: f64) -> DistributionSpec {
+    fn spread_scaled(&self, ratio: f64) -> Self {
         TruncatedNormal {
             mean: self.mean,
             sigma: self.sigma * ratio,
             limit: self.limit * ratio,
         }
-        .into()
     }
 
     /// σ and the limit scaled together, the limit in proportion (the shape `a` kept); at
-    /// σ = 0 every part is exact, a normal of σ 0.
-    fn with_sigma(&self, sigma: f64) -> Result<DistributionSpec, String> {
+    /// σ = 0 every part is exact: no form of this shape (`None`, no error at all).
+    fn with_sigma(&self, sigma: f64) -> Result<Option<Self>, String> {
         if self.mean != 0.0 {
             return Err(format!(
                 "its length error has mean {} mm: a tolerance study needs zero-mean errors",
@@ -155,15 +153,14 @@ impl Kind for TruncatedNormal {
             ));
         }
         if sigma == 0.0 {
-            return Ok(Normal { mean: 0.0, sigma }.into());
+            return Ok(None);
         }
         let ratio = sigma / self.std_dev();
-        Ok(TruncatedNormal {
+        Ok(Some(TruncatedNormal {
             mean: 0.0,
             sigma: self.sigma * ratio,
             limit: self.limit * ratio,
-        }
-        .into())
+        }))
     }
 
     /// `truncated_normal`: the limit in standard deviations `a = limit/σ`, so that cases
@@ -288,8 +285,8 @@ mod as241 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampler::{sample_stream, stream_key};
-    use rand_core::Rng;
+    use rand_chacha::ChaCha20Rng;
+    use rand_core::{Rng, SeedableRng};
 
     /// Φ(x) − ½ for x ≥ 0, from libm's erf (an independent route to the quantile's inverse).
     fn above_half(x: f64) -> f64 {
@@ -361,16 +358,14 @@ mod tests {
         for (mean, sigma, limit) in [(0.0, 0.01, 0.02), (0.3, 2.0, 1.0), (-0.1, 0.5, 3.0)] {
             let d = TruncatedNormal { mean, sigma, limit };
             d.check().unwrap();
-            let key = stream_key(11, "truncated");
+            let mut rng = ChaCha20Rng::seed_from_u64(11);
             let n = 200_000;
-            let mut xs = Vec::with_capacity(n);
-            for k in 0..(n / 1000) as u64 {
-                let mut rng = sample_stream(&key, k);
-                for _ in 0..1000 {
+            let xs: Vec<f64> = (0..n)
+                .map(|_| {
                     let (w1, w2) = (rng.next_u64(), rng.next_u64());
-                    xs.push(d.draw(w1, w2));
-                }
-            }
+                    d.draw(w1, w2)
+                })
+                .collect();
             assert!(xs.iter().all(|x| (mean - limit..=mean + limit).contains(x)));
             let nf = n as f64;
             let m = xs.iter().sum::<f64>() / nf;
@@ -409,9 +404,11 @@ mod tests {
             sigma: 0.01,
             limit: 0.02,
         };
-        let DistributionSpec::TruncatedNormal(s) = d.with_sigma(0.003).unwrap() else {
-            panic!("a truncated normal scales to one")
-        };
+        let s = d
+            .with_sigma(0.003)
+            .unwrap()
+            .expect("a truncated normal scales to one");
+        assert_eq!(d.with_sigma(0.0), Ok(None), "σ 0: no truncated normal");
         assert!((s.std_dev() - 0.003).abs() < 1e-15);
         assert!((s.limit_in_sigmas() - 2.0).abs() < 1e-14);
         let r = s.sigma / d.sigma;

@@ -1,6 +1,6 @@
 //! The uniform distribution: `low + (high − low)·u₂`.
 
-use super::{DistributionSpec, Kind, finite, half_open_unit};
+use super::kind::{Kind, finite, half_open_unit};
 use serde::{Deserialize, Serialize};
 
 /// Uniform on [low, high], low ≤ high: `{"uniform": {"low": -0.2, "high": 0.2}}`.
@@ -58,16 +58,15 @@ impl Kind for Uniform {
         format!("a bound of {} mm", truss_core::readable(self.reach()))
     }
 
-    fn shifted(&self, shift: f64) -> DistributionSpec {
+    fn shifted(&self, shift: f64) -> Self {
         Uniform {
             low: self.low + shift,
             high: self.high + shift,
         }
-        .into()
     }
 
     /// About the midpoint `m`, half-width `h·ratio`: `[m − h·ratio, m + h·ratio]`.
-    fn spread_scaled(&self, ratio: f64) -> DistributionSpec {
+    fn spread_scaled(&self, ratio: f64) -> Self {
         let (m, h) = (
             0.5 * (self.low + self.high),
             0.5 * (self.high - self.low) * ratio,
@@ -76,11 +75,10 @@ impl Kind for Uniform {
             low: m - h,
             high: m + h,
         }
-        .into()
     }
 
     /// Half-width `√3·σ`.
-    fn with_sigma(&self, sigma: f64) -> Result<DistributionSpec, String> {
+    fn with_sigma(&self, sigma: f64) -> Result<Option<Self>, String> {
         if self.low != -self.high {
             return Err(format!(
                 "its uniform length error on [{}, {}] mm is not centred on 0: a tolerance \
@@ -88,11 +86,10 @@ impl Kind for Uniform {
                 self.low, self.high
             ));
         }
-        Ok(Uniform {
+        Ok(Some(Uniform {
             low: -3f64.sqrt() * sigma,
             high: 3f64.sqrt() * sigma,
-        }
-        .into())
+        }))
     }
 
     /// `uniform`: 1.
