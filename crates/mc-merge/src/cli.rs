@@ -13,15 +13,15 @@
 //! before anything is read, naming the flag, instead of exhausting memory.
 
 use crate::errors::MergeError;
-use crate::settings::{DEFAULT_SEED, DEFAULT_TARGET_ANGLE, Options, Settings, default_threads};
+use crate::settings::{DEFAULT_SEED, DEFAULT_TARGET_ANGLE, Options, Settings};
 #[cfg(doc)]
 use crate::settings::{MAX_GOF_REPLICATES, MAX_PERCENTILES, MAX_REPLICATES, MAX_TARGET_ANGLE};
 use clap::{CommandFactory, Parser, Subcommand};
 use std::io::Write;
 use std::path::PathBuf;
 
-/// The most worker threads `--threads` accepts.
-pub const MAX_THREADS: usize = 1024;
+/// The most worker threads `--threads` accepts (every command's bound).
+pub use truss_threads::MAX_THREADS;
 
 const AFTER_HELP: &str = "\
 Exit codes (the scheme every truss-mc binary shares):
@@ -167,7 +167,7 @@ impl Args {
     /// Checks every value and builds the options.
     pub fn validate(self) -> Result<Options, MergeError> {
         if let Some(t) = self.threads
-            && !(1..=MAX_THREADS).contains(&t)
+            && !truss_threads::accepted(t)
         {
             return Err(MergeError::Usage {
                 message: format!("--threads {t}: must be between 1 and {MAX_THREADS}"),
@@ -184,7 +184,7 @@ impl Args {
             target_percentile: self.target_percentile,
             allow_partial: self.allow_partial,
             allow_failed: self.allow_failed,
-            threads: self.threads.unwrap_or_else(default_threads),
+            threads: truss_threads::or_available(self.threads),
         }
         .validate()?;
         Ok(Options {

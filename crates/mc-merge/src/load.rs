@@ -61,7 +61,7 @@ impl Default for LoadOptions {
         Self {
             allow_partial: false,
             allow_failed: false,
-            threads: crate::settings::default_threads(),
+            threads: truss_threads::available(),
         }
     }
 }

@@ -70,14 +70,9 @@ impl Default for Settings {
             target_percentile: 95.0,
             allow_partial: false,
             allow_failed: false,
-            threads: default_threads(),
+            threads: truss_threads::available(),
         }
     }
-}
-
-/// All available cores.
-pub fn default_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// A validated merge request.

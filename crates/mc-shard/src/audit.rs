@@ -18,7 +18,7 @@
 //! 2. K of the verified sample lines are chosen by reservoir sampling (Algorithm R) driven
 //!    by a ChaCha20 stream seeded with `--seed` (default 0): a uniform K-subset, the same
 //!    for the same files and seed. Incomplete shards contribute their verified lines.
-//! 3. Each chosen line is re-solved ([`crate::worker::Worker`], on T threads) and its line
+//! 3. Each chosen line is re-solved (the job crate's sample engine, on T threads) and its line
 //!    compared with the file's, byte for byte.
 //!
 //! The result goes to `audit.json` beside the shards (the first directory given, or the
@@ -28,13 +28,14 @@
 //! does not verify exits with the verification code (6); another job's shard with 5.
 
 use crate::job::Job;
-use crate::worker::Worker;
+use crate::worker::record;
 use rand_chacha::ChaCha20Rng;
 use rand_core::{Rng, SeedableRng};
 use serde::Serialize;
 use shard_record::{ScanError, scan_shard};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use truss_job::Engine;
 
 /// The largest `--samples` an audit accepts (it holds the chosen lines in memory: about
 /// 300 bytes each).
@@ -269,39 +270,27 @@ pub fn audit(
     Ok(report)
 }
 
-/// Re-solves the chosen lines on `threads` threads; returns those that differ, in file and
-/// line order.
+/// Re-solves the chosen lines on `threads` threads (the job crate's sample engine); returns
+/// those that differ, in file and line order.
 fn resolve(job: &Job, files: &[PathBuf], chosen: &[Chosen], threads: usize) -> Vec<Mismatch> {
-    let per = chosen.len().div_ceil(threads).max(1);
-    let mut mismatches: Vec<Mismatch> = std::thread::scope(|scope| {
-        let handles: Vec<_> = chosen
-            .chunks(per)
-            .map(|part| {
-                scope.spawn(move || {
-                    let mut worker = Worker::new(job);
-                    part.iter()
-                        .filter_map(|(f, line, index, bytes)| {
-                            let again = worker.sample(*index);
-                            let expected = again.to_line();
-                            (expected.as_bytes() != bytes.as_slice()).then(|| Mismatch {
-                                file: files[*f].clone(),
-                                line: *line,
-                                index: *index,
-                                case: again.case.clone(),
-                                sample: again.sample,
-                                found: String::from_utf8_lossy(bytes).trim_end().to_string(),
-                                expected: expected.trim_end().to_string(),
-                            })
-                        })
-                        .collect::<Vec<_>>()
-                })
+    let indices: Vec<u64> = chosen.iter().map(|(_, _, index, _)| *index).collect();
+    let lines = Engine::new(job, threads).map(indices.as_slice(), |_, r| record(job, &r));
+    let mut mismatches: Vec<Mismatch> = chosen
+        .iter()
+        .zip(lines)
+        .filter_map(|((f, line, index, bytes), again)| {
+            let expected = again.to_line();
+            (expected.as_bytes() != bytes.as_slice()).then(|| Mismatch {
+                file: files[*f].clone(),
+                line: *line,
+                index: *index,
+                case: again.case.clone(),
+                sample: again.sample,
+                found: String::from_utf8_lossy(bytes).trim_end().to_string(),
+                expected: expected.trim_end().to_string(),
             })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("an audit thread panicked"))
-            .collect()
-    });
+        })
+        .collect();
     mismatches.sort_by(|a, b| (&a.file, a.line).cmp(&(&b.file, b.line)));
     mismatches
 }

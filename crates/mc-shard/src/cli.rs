@@ -56,12 +56,12 @@ pub const MAX_SHARDS: u64 = 1_000_000;
 /// The longest `--heartbeat` or `--stale-after` \[s\]: one week.
 pub const MAX_SECONDS: f64 = 7.0 * 24.0 * 3600.0;
 
-/// The most threads (or `run-all` workers) a command starts.
-pub const MAX_THREADS: usize = 1024;
+/// The most threads (or `run-all` workers) a command starts (every command's bound).
+pub use truss_threads::MAX_THREADS;
 
 /// Checks a thread or worker count given as `--NAME` (1 to [`MAX_THREADS`]).
 pub fn check_threads(name: &str, threads: usize) -> Result<usize, RunError> {
-    if (1..=MAX_THREADS).contains(&threads) {
+    if truss_threads::accepted(threads) {
         Ok(threads)
     } else {
         Err(RunError::Usage(format!(
@@ -252,9 +252,4 @@ pub struct StatusArgs {
     /// Print JSON: one object per shard (`shard`, `range`, `state`, `samples`, `reason`).
     #[arg(long)]
     pub json: bool,
-}
-
-/// The default thread or worker count: the machine's cores.
-pub fn default_threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }

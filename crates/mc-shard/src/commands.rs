@@ -7,7 +7,7 @@
 use crate::audit::AuditError;
 use crate::cli::{
     AuditArgs, Cli, Command, InputsArgs, PlanArgs, ReproduceArgs, RunArgs, StatusArgs, WorkArgs,
-    check_shards, check_threads, default_threads,
+    check_shards, check_threads,
 };
 use crate::errors::{RunError, ShardError};
 use crate::interrupt::Signal;
@@ -146,7 +146,7 @@ pub fn man_page(cmd: clap::Command, out: &mut dyn Write) -> Result<(), CommandEr
 
 /// `mc-shard audit`: re-solve a seeded sample of lines; exit 6 on a mismatch.
 fn audit_command(a: AuditArgs, out: &mut dyn Write) -> Result<(), CommandError> {
-    let threads = check_threads("threads", a.threads.unwrap_or_else(default_threads))?;
+    let threads = check_threads("threads", truss_threads::or_available(a.threads))?;
     let job = Job::read(&a.job)?;
     let options = crate::audit::AuditOptions {
         samples: a.samples,
@@ -194,9 +194,7 @@ fn run_command(a: RunArgs, out: &mut dyn Write) -> Result<(), CommandError> {
         job.samples(),
         |k| std::env::var(k).ok(),
     )?;
-    let threads = a
-        .threads
-        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let threads = truss_threads::or_available(a.threads);
     check_threads("threads", threads)?;
     crate::interrupt::install()?;
     let summary = run_shard(
@@ -256,7 +254,7 @@ fn reproduce_command(a: ReproduceArgs, out: &mut dyn Write) -> Result<(), Comman
 fn work_command(a: WorkArgs, out: &mut dyn Write) -> Result<(), CommandError> {
     check_shards(a.shards)?;
     let (heartbeat, stale_after) = a.durations()?;
-    let threads = check_threads("threads", a.threads.unwrap_or_else(default_threads))?;
+    let threads = check_threads("threads", truss_threads::or_available(a.threads))?;
     let job = Job::read(&a.job)?;
     let options = crate::work::WorkOptions {
         shards: a.shards,

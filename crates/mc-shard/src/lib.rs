@@ -50,8 +50,9 @@
 //! in full before it is skipped; a shard is resumed or skipped only if its header matches
 //! the job (id, range, cases and their parameters). `audit` checks the numbers themselves.
 //!
-//! In memory, [`batch::solve_range`] solves a range on T threads and hands the records back in
-//! index order (the Python package `truss_mc` runs jobs through it).
+//! Samples are solved on T threads by the job crate's sample engine ([`truss_job::engine`]),
+//! which hands them back in index order: the runner writes them as the shard's lines, and the
+//! Python package `truss_mc` reads the same records ([`worker::record`]) in memory.
 //!
 //! Running every shard on one machine and merging (`truss-mc run-all`) lives in the crate
 //! above both runner and merge, `truss-mc`: this crate, the worker that runs on every
@@ -69,7 +70,6 @@
 //! finished sample kept ([`interrupt`]).
 
 pub mod audit;
-pub mod batch;
 pub mod cli;
 pub mod commands;
 pub mod errors;

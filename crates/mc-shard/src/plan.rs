@@ -38,7 +38,7 @@ impl Plan {
             cpu_seconds += each * c.samples as f64;
             per_case.push(each);
         }
-        let cores = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+        let cores = truss_threads::available() as u64;
         Plan {
             seconds_per_sample: per_case,
             advice: Advice::new(cpu_seconds, cores, job.samples()),

@@ -1,34 +1,29 @@
-//! Running a shard: samples computed on T threads, written in index order to the shard file.
+//! Running a shard: samples computed on T threads by the job crate's sample engine
+//! ([`truss_job::engine`]), written in index order to the shard file.
 //!
-//! Workers take chunks of consecutive indices from a shared counter, write the chunk's lines
-//! into one buffer and send it to the writer (this thread), which keeps a small reordering
-//! buffer and appends every chunk that is next in order, in one write. Memory stays flat in the sample count:
-//! the buffer holds at most the lines in flight. Each sample's line depends only on the job
-//! and its index, so the file is the same bytes for any thread count.
+//! The engine's workers take chunks of consecutive indices and format each chunk's lines into
+//! one buffer; the writer (this thread) receives the chunks in index order and appends each
+//! in one write. Memory stays flat in the sample count: the engine holds at most the chunks
+//! in flight. Each sample's line depends only on the job and its index, so the file is the
+//! same bytes for any thread count. A crash loses at most the chunks being computed, which
+//! are re-solved on resume.
 //!
 //! After SIGINT or SIGTERM (once [`crate::interrupt::install`]ed) workers stop before their
 //! next sample and send what they finished; the writer appends every line that is next in
 //! order, syncs the file and returns with [`RunSummary::interrupted`] set, leaving the shard
 //! without its end line for a rerun to resume.
 
-use crate::errors::RunError;
+use crate::errors::{RunError, ShardError};
 use crate::interrupt::{self, Signal};
 use crate::job::Job;
 use crate::progress::Progress;
 use crate::shard::{Opened, ShardWriter, begin};
-use crate::worker::Worker;
+use crate::worker::record;
 use shard_record::{ShardRange, Status};
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::sync_channel;
 use std::time::Instant;
-
-/// Indices a worker takes at a time. Each chunk wakes the writer and costs one write: at 16
-/// (about 0.2 ms of 5-stage samples) those wakeups, on a machine with as many cores as
-/// workers, held two threads to 1.73 times one on `scripts/bench-shard.sh`'s job; at 64,
-/// 1.84 times. A crash loses at most the chunks being computed, which are re-solved on resume.
-const CHUNK: u64 = 64;
+use truss_job::Engine;
+use truss_job::solve::{SampleResult, SampleSolver};
 
 /// How a shard run ended.
 #[derive(Debug, Clone, PartialEq)]
@@ -98,64 +93,26 @@ pub fn run_shard(
         first - range.start,
         options.quiet,
     );
-    let threads = options.threads.max(1);
-    let next = AtomicU64::new(first);
-    let stop = AtomicBool::new(false);
-    // One message per chunk: its first index, its lines' bytes, and each line's length and
-    // whether it failed.
-    let (tx, rx) = sync_channel::<(u64, ChunkLines)>(64 * threads);
-    let result = std::thread::scope(|scope| {
-        for _ in 0..threads {
-            let tx = tx.clone();
-            let (next, stop) = (&next, &stop);
-            scope.spawn(move || {
-                let mut worker = Worker::new(job);
-                loop {
-                    let start = next.fetch_add(CHUNK, Ordering::Relaxed);
-                    let halt = || stop.load(Ordering::Relaxed) || interrupt::requested().is_some();
-                    if start >= range.end || halt() {
-                        break;
-                    }
-                    let end = (start + CHUNK).min(range.end);
-                    let mut bytes = Vec::with_capacity(300 * (end - start) as usize);
-                    let mut lines = Vec::with_capacity((end - start) as usize);
-                    for index in start..end {
-                        if halt() {
-                            // Interrupted: send the samples finished so far.
-                            break;
-                        }
-                        let sample = worker.sample(index);
-                        let before = bytes.len();
-                        sample.write_line(&mut bytes);
-                        lines.push((bytes.len() - before, sample.status == Status::Failed));
-                    }
-                    let partial = lines.len() as u64 != end - start;
-                    if !lines.is_empty() && tx.send((start, (bytes, lines))).is_err() {
-                        return;
-                    }
-                    if partial {
-                        return;
-                    }
-                }
-            });
-        }
-        drop(tx);
-        // The writer: append runs of chunks in index order as they complete.
-        let mut pending: BTreeMap<u64, ChunkLines> = BTreeMap::new();
-        let mut expect = first;
-        for (start, chunk) in rx {
-            pending.insert(start, chunk);
-            while let Some((bytes, lines)) = pending.remove(&expect) {
-                expect += lines.len() as u64;
-                if let Err(e) = writer.append(&bytes, &lines) {
-                    stop.store(true, Ordering::Relaxed);
-                    return Err(e);
-                }
+    let halt = || interrupt::requested().is_some();
+    let engine = Engine::new(job, options.threads).halting_when(&halt);
+    // Each chunk's lines back to back, and per line its length and whether it failed:
+    // formatted on the workers, appended by this thread in index order, in one write.
+    let each = |(bytes, lines): &mut ChunkLines, _: &SampleSolver<'_>, result: SampleResult| {
+        let sample = record(job, &result);
+        let before = bytes.len();
+        sample.write_line(bytes);
+        lines.push((bytes.len() - before, sample.status == Status::Failed));
+    };
+    let result: Result<u64, ShardError> = engine
+        .run(first..range.end, each, |chunk| match chunk {
+            Some((bytes, lines)) => {
+                writer.append(&bytes, &lines)?;
                 progress.advance(lines.len() as u64);
+                Ok(())
             }
-        }
-        Ok(expect)
-    });
+            None => Ok(()),
+        })
+        .map(|handed| first + handed);
     progress.finish();
     let written = result?;
     let path = writer.path().to_path_buf();

@@ -117,6 +117,8 @@ pub mod parameters {
     pub const STAGES: &str = "stages";
     /// 1 when any length-error distribution is uniform.
     pub const UNIFORM: &str = "uniform";
+    /// The largest limit/σ of the case's truncated normal length errors, when it has any.
+    pub const TRUNCATED_NORMAL: &str = "truncated_normal";
     /// 1 for a model with backlash joints.
     pub const BACKLASH: &str = "backlash";
     /// The joints' regularisation `k_c/k_t` (cases differing in it form their own series).
@@ -125,10 +127,11 @@ pub mod parameters {
     /// is not the default 0 (the limit; cases differing in it form their own series).
     pub const CABLE_COMPRESSION_RATIO: &str = "cable_compression_ratio";
     /// Every key, in the order above.
-    pub const ALL: [&str; 6] = [
+    pub const ALL: [&str; 7] = [
         SIGMA,
         STAGES,
         UNIFORM,
+        TRUNCATED_NORMAL,
         BACKLASH,
         JOINT_COMPRESSION_RATIO,
         CABLE_COMPRESSION_RATIO,

@@ -20,7 +20,7 @@
 use crate::baseline::{Baseline, CaseEdit};
 use crate::errors::DiagnoseError;
 use truss_core::prism::BacklashOptions;
-use truss_job::distribution::DistributionSpec;
+use truss_job::distribution::{Constant, DistributionSpec, Uniform};
 use truss_job::effects::{
     ALUMINIUM_ALPHA, ALUMINIUM_DENSITY, GravitySpec, STANDARD_GRAVITY, ThermalSpec,
 };
@@ -176,20 +176,7 @@ pub fn library_for(baseline: &Baseline, spread: bool) -> Library {
 
 /// Adds `shift` to a distribution's values.
 fn shifted(d: Option<DistributionSpec>, shift: f64) -> DistributionSpec {
-    match d {
-        None => DistributionSpec::Constant { value: shift },
-        Some(DistributionSpec::Normal { mean, sigma }) => DistributionSpec::Normal {
-            mean: mean + shift,
-            sigma,
-        },
-        Some(DistributionSpec::Uniform { low, high }) => DistributionSpec::Uniform {
-            low: low + shift,
-            high: high + shift,
-        },
-        Some(DistributionSpec::Constant { value }) => DistributionSpec::Constant {
-            value: value + shift,
-        },
-    }
+    d.map_or(Constant { value: shift }.into(), |d| d.shifted(shift))
 }
 
 /// Self-weight of a ground test.
@@ -371,25 +358,10 @@ impl Candidate for LengthSigma {
     }
     fn apply(&self, v: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError> {
         for ((g, s0), &s) in self.groups.iter().zip(v) {
-            let r = s / s0;
-            let d = match edit.distribution(g) {
-                Some(DistributionSpec::Normal { mean, sigma }) => DistributionSpec::Normal {
-                    mean,
-                    sigma: sigma * r,
-                },
-                Some(DistributionSpec::Uniform { low, high }) => {
-                    let (m, h) = (0.5 * (low + high), 0.5 * (high - low) * r);
-                    DistributionSpec::Uniform {
-                        low: m - h,
-                        high: m + h,
-                    }
-                }
-                other => {
-                    return Err(DiagnoseError::Usage(format!(
-                        "length_sigma: group {g} has no spread to scale ({other:?})"
-                    )));
-                }
-            };
+            let d = edit.distribution(g).ok_or_else(|| {
+                DiagnoseError::Usage(format!("length_sigma: group {g} has no spread to scale"))
+            })?;
+            let d = d.spread_scaled(s / s0);
             edit.set_distribution(g, d);
         }
         Ok(())
@@ -534,12 +506,13 @@ impl Candidate for Backlash {
 /// every joint's clearance is linear in (mean, h), and the likelihood smooth in both.
 pub fn clearance_distribution(mean: f64, spread: f64) -> DistributionSpec {
     if spread > 0.0 {
-        DistributionSpec::Uniform {
+        Uniform {
             low: mean - spread,
             high: mean + spread,
         }
+        .into()
     } else {
-        DistributionSpec::Constant { value: mean }
+        Constant { value: mean }.into()
     }
 }
 
@@ -638,6 +611,32 @@ mod tests {
         Baseline::read(&job, case).unwrap()
     }
 
+    /// `length_sigma` scales any distribution through its own method: a truncated normal's
+    /// σ and limit together, so the group's standard deviation becomes the parameter.
+    #[test]
+    fn length_sigma_scales_a_truncated_normal() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("job.json");
+        let text = r#"{"model": {"prism": {"stages": 1}}, "seed": 1, "cases": [{"name": "c",
+            "samples": 10, "length_errors": {"longeron":
+            {"truncated_normal": {"mean": 0.001, "sigma": 0.01, "limit": 0.02}}}}]}"#;
+        std::fs::write(&path, text).unwrap();
+        let baseline = Baseline::read(&path, "c").unwrap();
+        let (candidates, _) = library(&baseline);
+        let c = candidates
+            .iter()
+            .find(|c| c.name() == "length_sigma")
+            .unwrap();
+        let s0 = baseline.case().length_errors["longeron"].std_dev();
+        assert_eq!(c.parameters()[0].null, s0);
+        let mut edit = baseline.derived_case();
+        c.apply(&[2.0 * s0], &mut edit).unwrap();
+        let job = baseline.job_of(&edit, 10, None).unwrap();
+        let d = job.cases[0].length_errors["longeron"];
+        assert!((d.std_dev() / (2.0 * s0) - 1.0).abs() < 1e-12);
+        assert_eq!((d.mean(), d.highest()), (0.001, 0.001 + 0.04));
+    }
+
     /// On the rigid prism of section 4.2.3, `backlash` makes every node a pin joint with the
     /// fitted clearance, validated by the job crate, keeping the baseline's node and member ids
     /// where they were (measured coordinates and members are found by id either way) and the
@@ -661,7 +660,7 @@ mod tests {
         assert_eq!(pinned.joints().len(), 2 * rigid.nodes().len() - 6);
         assert_eq!(
             case.backlash.unwrap().clearance,
-            DistributionSpec::Constant { value: 0.012 }
+            DistributionSpec::from(Constant { value: 0.012 })
         );
         for (i, n) in rigid.nodes().iter().enumerate() {
             assert_eq!(pinned.nodes()[i].id, n.id);
@@ -702,10 +701,10 @@ mod tests {
         let (d, x) = draws(mean, h);
         assert_eq!(
             d,
-            DistributionSpec::Uniform {
+            DistributionSpec::from(Uniform {
                 low: mean - h,
                 high: mean + h
-            }
+            })
         );
         assert_eq!(x.len(), 200 * 30);
         assert!(x.iter().all(|&c| mean - h <= c && c <= mean + h));
@@ -720,7 +719,7 @@ mod tests {
             assert!(((b - mean) - 1.5 * (a - mean)).abs() < 1e-15, "{a} {b}");
         }
         let (d0, x0) = draws(mean, 0.0);
-        assert_eq!(d0, DistributionSpec::Constant { value: mean });
+        assert_eq!(d0, DistributionSpec::from(Constant { value: mean }));
         assert!(x0.iter().all(|&c| c == mean));
         let (mut one, mut two) = (baseline.derived_case(), baseline.derived_case());
         c.apply(&[mean], &mut one).unwrap();

@@ -383,7 +383,7 @@ fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
     let config = |seed| BootstrapConfig {
         replicates: 1000,
         seed,
-        threads: crate::simulate::threads(),
+        threads: truss_threads::available(),
     };
     let by = bootstrap_quantiles(&sy, &percentiles, &config(1));
     let bx = bootstrap_quantiles(&sx, &percentiles, &config(2));

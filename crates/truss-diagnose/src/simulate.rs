@@ -1,7 +1,8 @@
-//! Running a derived case: `N` samples solved by the job crate's own [`SampleSolver`] (the same draws
-//! and solver as a shard run), each sample's displacements at the measured coordinates
-//! collected, and, when asked, the instrument's noise added and the top surface's angles
-//! computed from the noisy positions, exactly as they are from a measured specimen.
+//! Running a derived case: `N` samples solved by the job crate's sample engine
+//! ([`truss_job::engine`]: the same draws and solver as a shard run, results in index
+//! order), each sample's displacements at the measured coordinates collected, and, when
+//! asked, the instrument's noise added and the top surface's angles computed from the noisy
+//! positions, exactly as they are from a measured specimen.
 //!
 //! ## Measurement noise
 //!
@@ -14,8 +15,9 @@
 use crate::errors::DiagnoseError;
 use crate::measured::Coordinate;
 use truss_core::measure::distortion;
+use truss_job::Engine;
 use truss_job::Job;
-use truss_job::solve::{Outcome, SampleSolver};
+use truss_job::solve::Outcome;
 use truss_stats::rng::{Stream, bits, box_muller, open01, replicate_key};
 
 /// The simulated samples of one case.
@@ -59,11 +61,6 @@ pub fn noise_normal(seed: u64, k: u64, j: u64) -> f64 {
     let u1 = open01(bits(key, 2 * j));
     let u2 = open01(bits(key, 2 * j + 1));
     box_muller(u1, u2)
-}
-
-/// Worker threads to use.
-pub fn threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// Index of each top-surface node's x, y, z in `coords`, if they are all there.
@@ -110,39 +107,21 @@ pub fn simulate(
                 }),
         })
         .collect::<Result<_, _>>()?;
-    let nodes = &nodes;
-    let threads = threads().clamp(1, samples.max(1));
-    let chunk = samples.div_ceil(threads).max(1);
-    let mut rows: Vec<Row> = Vec::with_capacity(samples);
-    std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..threads)
-            .map(|t| {
-                scope.spawn(move || {
-                    let mut worker = SampleSolver::new(job);
-                    let range = (t * chunk)..((t + 1) * chunk).min(samples);
-                    range
-                        .map(|k| {
-                            if let Outcome::Failed(reason) = worker.solve(k as u64).outcome {
-                                return Row {
-                                    x: Vec::new(),
-                                    failure: Some(reason),
-                                };
-                            }
-                            let solver = worker.solver(0).expect("the case was solved");
-                            Row {
-                                x: nodes
-                                    .iter()
-                                    .map(|&(node, axis)| solver.displacement(node)[axis])
-                                    .collect(),
-                                failure: None,
-                            }
-                        })
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        for h in handles {
-            rows.extend(h.join().expect("a simulation thread panicked"));
+    let engine = Engine::new(job, truss_threads::available());
+    let rows = engine.map(0..samples as u64, |solver, result| {
+        if let Outcome::Failed(reason) = result.outcome {
+            return Row {
+                x: Vec::new(),
+                failure: Some(reason),
+            };
+        }
+        let solver = solver.solver(0).expect("the case was solved");
+        Row {
+            x: nodes
+                .iter()
+                .map(|&(node, axis)| solver.displacement(node)[axis])
+                .collect(),
+            failure: None,
         }
     });
     let case = &job.cases[0];

@@ -24,7 +24,7 @@
 //! | `cases[].name` | unique, at most [`MAX_CASE_NAME_BYTES`] bytes, no control characters; names the case in shard files, reports and plot file names |
 //! | `cases[].samples` | ≥ 1 |
 //! | `cases[].model` | optional: this case's own model, same forms as `model` |
-//! | `cases[].length_errors` | per member group, a distribution of the length error (natural length minus nominal, mm): `{"normal": {"sigma": s}}` (optional `"mean"`), `{"uniform": {"low": a, "high": b}}`, `{"constant": {"value": v}}`. Groups not named get none. |
+//! | `cases[].length_errors` | per member group, a distribution of the length error (natural length minus nominal, mm): `{"normal": {"sigma": s}}` (optional `"mean"`), `{"uniform": {"low": a, "high": b}}`, `{"constant": {"value": v}}`, `{"truncated_normal": {"sigma": s, "limit": t}}` (optional `"mean"`: a normal whose parts beyond mean ± t are scrapped at inspection; see [`crate::distribution::TruncatedNormal`]). Groups not named get none. |
 //! | `cases[].backlash` | optional: `{"clearance": distribution}`, each joint's clearance (mm, ≥ 0), drawn per joint and sample; needs a model with joints (`{"prism": {"stages": 5, "backlash": true}}`) |
 //! | `cases[].effects` | optional deterministic effects: `gravity` (self-weight) and `thermal_gradient` (a linear temperature field); see [`crate::effects`] |
 //!
@@ -42,7 +42,8 @@
 //! more than [`MAX_JOB_SAMPLES`]; a length error can reach beyond
 //! [`MAX_LENGTH_ERROR_FRACTION`](truss_core::MAX_LENGTH_ERROR_FRACTION) of a member's
 //! natural length (a normal's `|mean| + 6σ`, see
-//! [`NORMAL_REACH`](crate::distribution::NORMAL_REACH); a uniform's bounds; a constant),
+//! [`NORMAL_REACH`](crate::distribution::NORMAL_REACH); a uniform's bounds; a constant; a
+//! truncated normal's `|mean| + limit`),
 //! alone or with a thermal effect's `α·ΔT·L`; a clearance can exceed
 //! [`MAX_CLEARANCE_FRACTION`](truss_core::model::MAX_CLEARANCE_FRACTION) of a jointed
 //! member's length; an effect's value is implausible (see [`crate::effects`]); a group is
@@ -429,8 +430,11 @@ impl Job {
                 if b.clearance.lowest() < 0.0 {
                     return Err(JobError::at(
                         &path,
-                        "a clearance cannot be negative: give a distribution whose values are \
-                         all ≥ 0 (uniform with low ≥ 0, or a constant)",
+                        &format!(
+                            "a clearance cannot be negative: give a distribution whose values \
+                             are all ≥ 0 (this one reaches down to {} mm)",
+                            truss_core::readable(b.clearance.lowest())
+                        ),
                     ));
                 }
             }
@@ -454,11 +458,11 @@ impl Job {
             if let Some(n) = stages {
                 parameters.insert("stages".to_string(), n as f64);
             }
-            if c.length_errors
-                .values()
-                .any(|d| matches!(d, DistributionSpec::Uniform { .. }))
-            {
-                parameters.insert("uniform".to_string(), 1.0);
+            // A distribution's own mark (the uniform's, the truncated normal's shape), the
+            // largest of its groups' values: cases differing in it form their own series.
+            for (key, value) in c.length_errors.values().filter_map(|d| d.series_marker()) {
+                let kept = parameters.entry(key.to_string()).or_insert(value);
+                *kept = kept.max(value);
             }
             // Cases whose cables have another compression ratio than the default (the first
             // cable's: a prism gives all its diagonals one) form their own series too; absent
@@ -586,20 +590,7 @@ fn check_reach(
         let thermal = applied.length_changes.get(m).map_or(0.0, |x| x.abs());
         let dist = length_errors.get(&member.group);
         let reach = dist.map_or(0.0, DistributionSpec::reach);
-        let reach_shown = truss_core::readable(reach);
-        let what = match dist {
-            Some(DistributionSpec::Normal { mean, sigma }) => {
-                format!(
-                    "mean {} mm, σ {} mm: |mean| + {}σ = {reach_shown} mm",
-                    truss_core::readable(*mean),
-                    truss_core::readable(*sigma),
-                    crate::distribution::NORMAL_REACH
-                )
-            }
-            Some(DistributionSpec::Uniform { .. }) => format!("a bound of {reach_shown} mm"),
-            Some(DistributionSpec::Constant { .. }) => format!("a value of {reach_shown} mm"),
-            None => String::new(),
-        };
+        let what = dist.map_or_else(String::new, DistributionSpec::reach_in_words);
         let limit = format!(
             "more than {percent}% of member {:?}'s natural length {} mm ({max} mm): a \
              length error beyond the elastic range, where the model means nothing (see \
@@ -806,6 +797,7 @@ mod tests {
             r#"{"normal": {"sigma": 0.64}}"#,
             r#"{"uniform": {"low": -0.2, "high": 1e308}}"#,
             r#"{"constant": {"value": -3.81}}"#,
+            r#"{"truncated_normal": {"mean": 0.01, "sigma": 0.01, "limit": 3.8}}"#,
         ] {
             let m = refusal(&group(dist));
             assert!(
@@ -819,9 +811,49 @@ mod tests {
         for dist in [
             r#"{"normal": {"sigma": 0.63}}"#,
             r#"{"uniform": {"low": -3.8, "high": 3.8}}"#,
+            r#"{"truncated_normal": {"sigma": 50, "limit": 3.8}}"#,
         ] {
             Job::from_json(&group(dist), Path::new(".")).unwrap();
         }
+    }
+
+    /// A truncated normal's σ and limit must be positive and finite, refused by the group's
+    /// JSON path; a valid one marks its case's parameters with its shape limit/σ (the
+    /// largest of its groups'), and its standard deviation is the truncated one.
+    #[test]
+    fn truncated_normals_are_checked_and_marked() {
+        let group = |dist: &str| job(&format!(r#", "length_errors": {{"longeron": {dist}}}"#));
+        for (dist, said) in [
+            (r#"{"sigma": 0, "limit": 0.01}"#, "sigma must be positive"),
+            (
+                r#"{"sigma": -0.01, "limit": 0.01}"#,
+                "sigma must be positive",
+            ),
+            (r#"{"sigma": 0.01, "limit": 0}"#, "limit must be positive"),
+            (r#"{"sigma": 0.01}"#, "missing field `limit`"),
+            (
+                r#"{"sigma": 0.01, "limit": 0.02, "max": 1}"#,
+                "unknown field `max`",
+            ),
+        ] {
+            let m = refusal(&group(&format!(r#"{{"truncated_normal": {dist}}}"#)));
+            assert!(
+                m.starts_with("cases[0].length_errors.longeron: ") && m.contains(said),
+                "{dist}: {m}"
+            );
+        }
+        let text = job(
+            r#", "length_errors": {"longeron": {"truncated_normal": {"sigma": 0.01, "limit": 0.02}},
+                                   "batten": {"truncated_normal": {"sigma": 0.01, "limit": 0.015}}}"#,
+        );
+        let j = Job::from_json(&text, Path::new(".")).unwrap();
+        let c = &j.cases[0];
+        assert_eq!(c.parameters["truncated_normal"], 2.0);
+        assert!(!c.parameters.contains_key("uniform"));
+        let sd = c.length_errors["longeron"].std_dev();
+        // σ·√(1 − 2a·φ(a)/erf(a/√2)) at a = 2: 0.879 626 0… σ.
+        assert!((sd / 0.01 - 0.879_626).abs() < 1e-6, "{sd}");
+        assert_eq!(c.parameters["sigma"], sd);
     }
 
     /// A thermal strain α·ΔT beyond 1 % is refused by the effect's path; implausible effect

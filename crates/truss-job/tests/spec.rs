@@ -4,7 +4,7 @@
 
 use std::path::Path;
 use truss_job::Job;
-use truss_job::distribution::DistributionSpec;
+use truss_job::distribution::{DistributionSpec, Normal};
 use truss_job::job::{JobSpec, ModelSpec};
 
 fn jobs_dir() -> std::path::PathBuf {
@@ -38,10 +38,10 @@ fn a_typed_edit_is_the_job_it_writes() {
     let case = &mut spec.cases[0];
     case.length_errors.insert(
         "longeron".into(),
-        DistributionSpec::Normal {
+        DistributionSpec::Normal(Normal {
             mean: 0.001,
             sigma: 0.01,
-        },
+        }),
     );
     if let Some(ModelSpec::Prism(p)) = &mut case.model {
         p.stages = 4;

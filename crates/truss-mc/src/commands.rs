@@ -4,7 +4,6 @@
 
 use crate::cli::{Cli, Command};
 use crate::run_all::{RunAllError, RunAllOptions, run_all};
-use mc_shard::cli::default_threads;
 use mc_shard::commands::CommandError;
 use mc_shard::{Job, RunError};
 use std::io::Write;
@@ -69,7 +68,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
             out,
         )?),
         Command::RunAll(a) => {
-            let workers = a.workers.unwrap_or_else(default_threads);
+            let workers = truss_threads::or_available(a.workers);
             mc_shard::cli::check_threads("workers", workers).map_err(CommandError::from)?;
             if let Some(k) = a.shards {
                 mc_shard::cli::check_shards(k).map_err(CommandError::from)?;

@@ -1,5 +1,6 @@
 //! `truss_mc._native.Job`: a validated job file, and its samples computed in-process by the
-//! shard runner's own code: [`mc_shard::batch::solve_range`] over the runner's worker, the
+//! shard runner's own code: the job crate's sample engine ([`truss_job::engine`]) writing
+//! the runner's records ([`mc_shard::worker::record`]), the
 //! drawn inputs of [`mc_shard::inputs::InputTable`], and [`mc_shard::reproduce`]. So every
 //! number equals the shard line's, `mc-shard inputs`' and `mc-shard reproduce`'s, bit for
 //! bit, whatever the thread count. The interpreter lock is released while samples are
@@ -18,6 +19,8 @@ use shard_record::ShardRange;
 use std::path::PathBuf;
 use std::sync::Arc;
 use truss_job::Job;
+use truss_job::engine::Engine;
+use truss_job::solve::{SampleResult, SampleSolver};
 
 /// A validated job.
 #[pyclass(frozen, name = "Job", module = "truss_mc._native")]
@@ -158,30 +161,36 @@ impl PyJob {
     ) -> PyResult<Bound<'py, PyDict>> {
         let job = Arc::clone(&self.job);
         let (c, range) = selection(&job, case, range)?;
-        let threads = mc_shard::cli::check_threads(
-            "threads",
-            threads.unwrap_or_else(mc_shard::cli::default_threads),
-        )
-        .map_err(Failure::from)?;
+        let threads = mc_shard::cli::check_threads("threads", truss_threads::or_available(threads))
+            .map_err(Failure::from)?;
         let table = inputs.then(|| InputTable::new(&job, c, range));
         let (samples, values) = py.detach(|| {
             let mut samples = Table::new();
             let mut values = Vec::new();
-            let each = |w: &mut mc_shard::worker::Worker<'_>, i: u64| {
+            type Row = (Vec<u8>, Option<Vec<f64>>);
+            let each = |chunk: &mut Vec<Row>, _: &SampleSolver<'_>, result: SampleResult| {
                 // The shard line's bytes, read back into columns on the calling thread: a
                 // worker allocates little that another thread frees (the allocator's
                 // arenas would be contended).
                 let mut line = Vec::with_capacity(256);
-                w.sample(i).write_line(&mut line);
+                mc_shard::worker::record(&job, &result).write_line(&mut line);
                 let row = table.as_ref().map(|t| {
                     let mut v = Vec::with_capacity(t.width());
                     let mut row = vec![None; t.width()];
-                    push_row(&job, t, i, &mut Draws::default(), &mut row, &mut v);
+                    push_row(
+                        &job,
+                        t,
+                        result.index,
+                        &mut Draws::default(),
+                        &mut row,
+                        &mut v,
+                    );
                     v
                 });
-                (line, row)
+                chunk.push((line, row));
             };
-            mc_shard::batch::solve_range(&job, range, threads, each, |chunk| match chunk {
+            let engine = Engine::new(&job, threads);
+            engine.run(range.start..range.end, each, |chunk| match chunk {
                 Some(chunk) => {
                     for (line, row) in chunk {
                         let record: serde_json::Map<String, serde_json::Value> =

@@ -10,7 +10,7 @@
 //! | Python | library |
 //! |---|---|
 //! | `prism(stages=5, …)`, `Model.from_file`, `solve(model, length_errors={…})` | `truss_job::job::parse_prism`, `truss_core::Model`, `truss_core::Solver`, `truss_core::output::EquilibriumById` (as `truss solve`) |
-//! | `Job.from_file`, `job.run(case=…, range=…, threads=…, inputs=True)` | `truss_job::Job`, `mc_shard::batch::solve_range` over the runner's worker, `mc_shard::inputs::InputTable` (as `mc-shard run` and `mc-shard inputs`) |
+//! | `Job.from_file`, `job.run(case=…, range=…, threads=…, inputs=True)` | `truss_job::Job`, `truss_job::engine::Engine` writing the runner's records (`mc_shard::worker::record`), `mc_shard::inputs::InputTable` (as `mc-shard run` and `mc-shard inputs`) |
 //! | `job.reproduce(case, sample, detail=…)` | `mc_shard::reproduce::reproduce` (as `mc-shard reproduce`) |
 //! | `read_shards(paths)` | `shard_record::read_shard` (as the merge verifies) |
 //!

@@ -65,9 +65,10 @@
 //! ## Limits
 //!
 //! Cases with effects (gravity, a temperature field) or pin joints with clearance are
-//! refused: the tilt is then not homogeneous in the errors. A group whose length error is not
-//! zero-mean normal or symmetric uniform, or has σ = 0, is refused (its influence cannot be
-//! measured). A group whose share is below 10⁻⁹ has an unbounded tolerance: refused unless
+//! refused: the tilt is then not homogeneous in the errors. A group whose length error its
+//! distribution cannot scale to a σ (one not zero-mean, or a constant: see
+//! `truss_job::distribution::Kind::with_sigma`), or has σ = 0, is refused (its influence
+//! cannot be measured). A group whose share is below 10⁻⁹ has an unbounded tolerance: refused unless
 //! `--fix`ed. The regression's cost grows with the square of the number of members with
 //! errors; it suits models of up to a few hundred.
 //!

@@ -1,11 +1,14 @@
 //! The study's input: the job and case, the groups whose tolerance is allocated, the
 //! `--cost` and `--fix` values, and jobs of the same case with other σ values.
 //!
-//! A group's length error must be zero-mean and scalable: `{"normal": {"sigma": σ}}` (mean 0)
-//! or `{"uniform": {"low": −a, "high": a}}` (σ = a/√3). Changing a group's σ keeps its
-//! distribution's type: the normal gets the new σ, the uniform the half-width √3·σ. The draws
-//! of a sample are `σ·z` with `z` from the sample's stream (see `truss_job::sampler`), so two
-//! runs of the same case at different σ see the same `z`: common random numbers.
+//! A group's length error must be zero-mean and scalable, as its distribution says
+//! (`truss_job::distribution::Kind::with_sigma`): `{"normal": {"sigma": σ}}` (mean 0),
+//! `{"uniform": {"low": −a, "high": a}}` (σ = a/√3) or
+//! `{"truncated_normal": {"sigma": s, "limit": t}}` (mean 0). Changing a group's σ keeps its
+//! distribution's type: the normal gets the new σ, the uniform the half-width √3·σ, the
+//! truncated normal its s and t scaled together. The draws of a sample are `σ·z` with `z`
+//! from the sample's stream (see `truss_job::sampler`), so two runs of the same case at
+//! different σ see the same `z`: common random numbers.
 
 use crate::errors::ToleranceError;
 use std::collections::BTreeMap;
@@ -42,17 +45,6 @@ pub struct Study {
     pub groups: Vec<Group>,
     /// Where the job file is (model paths are resolved against it).
     pub base: PathBuf,
-}
-
-/// The distribution `d` (zero-mean normal or symmetric uniform) with standard deviation `sigma`.
-pub fn with_sigma(d: &DistributionSpec, sigma: f64) -> DistributionSpec {
-    match *d {
-        DistributionSpec::Uniform { .. } => DistributionSpec::Uniform {
-            low: -3f64.sqrt() * sigma,
-            high: 3f64.sqrt() * sigma,
-        },
-        _ => DistributionSpec::Normal { mean: 0.0, sigma },
-    }
 }
 
 /// Parses `GROUP=NUMBER` of `flag`.
@@ -136,26 +128,8 @@ impl Study {
                 group: name.clone(),
                 reason,
             };
-            match *d {
-                DistributionSpec::Normal { mean, .. } if mean != 0.0 => {
-                    return Err(not(format!(
-                        "its length error has mean {mean} mm: a tolerance study needs zero-mean errors"
-                    )));
-                }
-                DistributionSpec::Uniform { low, high } if low != -high => {
-                    return Err(not(format!(
-                        "its uniform length error on [{low}, {high}] mm is not centred on 0: a \
-                         tolerance study needs zero-mean errors"
-                    )));
-                }
-                DistributionSpec::Constant { .. } => {
-                    return Err(not(
-                        "its length error is a constant: a tolerance study needs random errors"
-                            .into(),
-                    ));
-                }
-                _ => {}
-            }
+            // Whether the distribution can be scaled to a σ, in its own words.
+            d.with_sigma(d.std_dev()).map_err(not)?;
             let sigma = d.std_dev();
             if sigma <= 0.0 {
                 return Err(not(
@@ -275,7 +249,13 @@ impl Study {
             .groups
             .iter()
             .zip(sigmas)
-            .map(|(g, &s)| (g.name.clone(), with_sigma(&g.distribution, s)))
+            .map(|(g, &s)| {
+                let scaled = g.distribution.with_sigma(s);
+                (
+                    g.name.clone(),
+                    scaled.expect("checked scalable in Study::new"),
+                )
+            })
             .collect::<BTreeMap<_, _>>();
         case
     }

@@ -1,14 +1,12 @@
-//! Runs the samples of a one-case job in-process, over scoped threads, through
-//! `truss_job::solve::SampleSolver` (the same per-sample solve as the shard runner).
-//!
-//! Samples are split into contiguous blocks, one per thread; every sample's result depends
-//! only on (job, seed, case, index) and the blocks are joined in index order, so the result
-//! does not depend on the thread count. A failed sample is never dropped: the run fails with
-//! the count and the first reason.
+//! Runs the samples of a one-case job in-process on the job crate's sample engine
+//! (`truss_job::engine`: the same per-sample solve as the shard runner, results in index
+//! order), so the result does not depend on the thread count. A failed sample is never
+//! dropped: the run fails with the count and the first reason.
 
 use crate::errors::ToleranceError;
+use truss_job::Engine;
 use truss_job::Job;
-use truss_job::solve::{Outcome, SampleSolver};
+use truss_job::solve::Outcome;
 
 /// The samples of a run, in index order.
 #[derive(Debug, Clone, Default)]
@@ -41,14 +39,9 @@ impl Run {
     }
 }
 
-/// Worker threads to use: the machine's parallelism.
-pub fn threads() -> usize {
-    std::thread::available_parallelism().map_or(1, |n| n.get())
-}
-
-/// Solves every sample of the single case of `job` over `threads` threads. `columns`: the
-/// members whose drawn length errors are kept (for the regression; empty for none).
-/// `stage` names the run in errors.
+/// Solves every sample of the single case of `job` over `threads` threads (the job crate's
+/// sample engine). `columns`: the members whose drawn length errors are kept (for the
+/// regression; empty for none). `stage` names the run in errors.
 pub fn run_case(
     job: &Job,
     columns: &[usize],
@@ -56,60 +49,37 @@ pub fn run_case(
     stage: &'static str,
 ) -> Result<Run, ToleranceError> {
     assert_eq!(job.cases.len(), 1, "a one-case job");
-    let samples = job.cases[0].samples as usize;
-    let threads = threads.clamp(1, samples.max(1));
-    let chunk = samples.div_ceil(threads).max(1);
-    type Block = (Run, Vec<(u64, String)>);
-    let blocks: Vec<Block> = std::thread::scope(|scope| {
-        let handles: Vec<_> = (0..samples)
-            .step_by(chunk)
-            .map(|from| {
-                let to = (from + chunk).min(samples);
-                scope.spawn(move || {
-                    let mut solver = SampleSolver::new(job);
-                    let mut run = Run {
-                        columns: columns.to_vec(),
-                        ..Run::default()
-                    };
-                    let mut failed = Vec::new();
-                    for k in from..to {
-                        let result = solver.solve(k as u64);
-                        match result.outcome {
-                            Outcome::Converged(c) => {
-                                let d = c.distortion;
-                                run.tilt.push([d.tan_theta_x, d.tan_theta_y]);
-                                run.theta_p.push(d.theta_p);
-                                let e = solver.last_errors();
-                                run.errors.extend(columns.iter().map(|&i| e[i]));
-                            }
-                            Outcome::Failed(reason) => failed.push((k as u64, reason)),
-                        }
-                    }
-                    (run, failed)
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("a sample thread panicked"))
-            .collect()
+    let samples = job.cases[0].samples;
+    let solved = Engine::new(job, threads).map(0..samples, |solver, result| match result.outcome {
+        Outcome::Converged(c) => {
+            let e = solver.last_errors();
+            Ok((
+                c.distortion,
+                columns.iter().map(|&i| e[i]).collect::<Vec<_>>(),
+            ))
+        }
+        Outcome::Failed(reason) => Err((result.index, reason)),
     });
     let mut run = Run {
         columns: columns.to_vec(),
         ..Run::default()
     };
     let mut failed: Vec<(u64, String)> = Vec::new();
-    for (block, f) in blocks {
-        run.errors.extend(block.errors);
-        run.tilt.extend(block.tilt);
-        run.theta_p.extend(block.theta_p);
-        failed.extend(f);
+    for sample in solved {
+        match sample {
+            Ok((d, errors)) => {
+                run.tilt.push([d.tan_theta_x, d.tan_theta_y]);
+                run.theta_p.push(d.theta_p);
+                run.errors.extend(errors);
+            }
+            Err(f) => failed.push(f),
+        }
     }
     if let Some((first, reason)) = failed.first() {
         return Err(ToleranceError::FailedSamples {
             stage,
             failed: failed.len(),
-            samples,
+            samples: samples as usize,
             first: *first,
             reason: reason.clone(),
         });

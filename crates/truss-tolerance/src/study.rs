@@ -5,7 +5,7 @@ use crate::allocate::{self, AllocationError, GroupModel};
 use crate::errors::ToleranceError;
 use crate::sensitivity::{Sensitivity, sensitivity};
 use crate::setup::Study;
-use crate::simulate::{run_case, threads};
+use crate::simulate::run_case;
 use crate::verify::{Percentile, percentile};
 use crate::{plot, report};
 use std::path::PathBuf;
@@ -214,7 +214,7 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
     let job_id = truss_job::Job::new(&study.spec, &study.base)?.id;
     let target = o.target_arcsec / ARCSEC_PER_RAD;
     let q = o.percentile / 100.0;
-    let threads = o.threads.unwrap_or_else(threads).max(1);
+    let threads = truss_threads::or_available(o.threads).max(1);
     let seed = study.spec.seed;
 
     // 1. Sensitivity at the input σ.

@@ -6,12 +6,13 @@
 //! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
 //! - the solver links nothing of ours; nor do the statistics, the wire format, the run
 //!   directory's file rules (`run-dir`, so every writer, however low, can share them), the
-//!   unit conversions (`truss-units`) and the exit codes;
+//!   unit conversions (`truss-units`), the exit codes and the thread count (`truss-threads`,
+//!   which every crate that starts threads shares, the merge as well as the job's engine);
 //! - the plot style (`truss-plot`) links only the unit conversions, so the merge, the
 //!   diagnosis and the tolerance study can all draw with it;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
 //! - the tolerance study links the solver, the job, the statistics, the file rules, the
-//!   units and the plot style, and nothing else of ours;
+//!   units, the plot style and the thread count, and nothing else of ours;
 //! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
 //!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
 //!
@@ -94,10 +95,11 @@ fn dependencies_point_one_way() {
         "truss-units",
         "truss-plot",
         "truss-exit",
+        "truss-threads",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
     }
-    let forbidden: [(&str, &[&str]); 11] = [
+    let forbidden: [(&str, &[&str]); 12] = [
         (
             "mc-shard",
             &["mc-merge", "tokio", "plotters", "statrs", "truss-stats"],
@@ -109,6 +111,7 @@ fn dependencies_point_one_way() {
         ("run-dir", &[]),
         ("truss-units", &[]),
         ("truss-exit", &[]),
+        ("truss-threads", &[]),
         (
             "truss-plot",
             &["truss-core", "truss-job", "truss-stats", "run-dir"],
@@ -158,8 +161,8 @@ fn dependencies_point_one_way() {
         .collect();
     assert_eq!(job, ["truss-core"]);
     // truss-tolerance sits on the job, the solver, the statistics, the run directory's file
-    // rules, the units and the plot style: not the runner, the merge, the wire format or the
-    // diagnosis.
+    // rules, the units, the plot style and the thread count: not the runner, the merge, the
+    // wire format or the diagnosis.
     let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
         .intersection(&ours)
         .cloned()
@@ -172,6 +175,7 @@ fn dependencies_point_one_way() {
             "truss-job",
             "truss-plot",
             "truss-stats",
+            "truss-threads",
             "truss-units"
         ]
     );

@@ -48,6 +48,10 @@ fn groups_that_cannot_be_scaled_are_refused() {
             "skew",
             r#"{"longeron": {"uniform": {"low": 0, "high": 0.01}}}"#,
         ),
+        (
+            "biased-truncated",
+            r#"{"longeron": {"truncated_normal": {"mean": 0.01, "sigma": 0.01, "limit": 0.02}}}"#,
+        ),
     ];
     let path = job(&dir, 1, &cases);
     for (case, _) in cases {

@@ -107,6 +107,48 @@ fn the_result_does_not_depend_on_the_thread_count() {
     assert_eq!(text(1), text(3));
 }
 
+/// Truncated normal length errors are scaled along their σ with the limit in proportion:
+/// the allocated job keeps each group's shape limit/σ = 2 and gives it the allocated
+/// standard deviation (the truncated one, which the study reports as the group's σ).
+#[test]
+fn truncated_normals_are_scaled_with_their_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let truncated = r#"{"truncated_normal": {"sigma": 0.0063, "limit": 0.0126}}"#;
+    let errors = format!(r#"{{"batten": {truncated}, "longeron": {truncated}}}"#);
+    let path = job(&dir, 1, &[("c", &errors)]);
+    let out = dir.path().join("out");
+    let o = Options {
+        sensitivity_samples: 1000,
+        samples: 1000,
+        plots: false,
+        ..Options::new(path, "c", 20.0, out.clone())
+    };
+    let t = match run(&o) {
+        Ok(t) => t,
+        Err(e) => panic!("{e}"),
+    };
+    let input = Job::read(&dir.path().join("job.json")).unwrap();
+    let allocated = Job::read(&out.join("allocated-job.json")).unwrap();
+    for g in &t.groups {
+        assert_eq!(
+            g.input_sigma,
+            input.cases[0].length_errors[&g.name].std_dev()
+        );
+        let d = allocated.cases[0].length_errors[&g.name];
+        let truss_job::distribution::DistributionSpec::TruncatedNormal(d) = d else {
+            panic!("{}: {d:?}", g.name)
+        };
+        assert!((d.limit / d.sigma - 2.0).abs() < 1e-12, "{d:?}");
+        let sd = allocated.cases[0].length_errors[&g.name].std_dev();
+        assert!(
+            (sd / g.sigma - 1.0).abs() < 1e-12,
+            "{}: {sd} vs {}",
+            g.name,
+            g.sigma
+        );
+    }
+}
+
 /// The paper's 5-stage truss, σ = 0.0063 mm on battens and longerons, 20″ at the 95th
 /// percentile, the default 20,000 verification samples: verifies, the battens' share is
 /// small (the paper: battens alone give about 4 % of θ_P95, so about 0.2 % of the variance),
