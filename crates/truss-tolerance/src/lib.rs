@@ -83,6 +83,8 @@
 
 pub mod allocate;
 pub mod errors;
+pub mod options;
+pub mod outcome;
 pub mod percentile;
 pub mod plot;
 pub mod report;
@@ -93,4 +95,6 @@ pub mod study;
 pub mod verify;
 
 pub use errors::ToleranceError;
-pub use study::{Options, Tolerance, run};
+pub use options::Options;
+pub use outcome::{GroupResult, Tolerance};
+pub use study::run;

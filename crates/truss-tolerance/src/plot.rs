@@ -12,7 +12,7 @@
 //!   ids are placed by their order within the group.
 
 use crate::errors::ToleranceError;
-use crate::study::Tolerance;
+use crate::outcome::Tolerance;
 use plotters::prelude::*;
 use run_dir::OutputDir;
 use std::path::PathBuf;

@@ -23,9 +23,9 @@
 //! (B = 2000) for θ_Pq.
 
 use crate::errors::ToleranceError;
+use crate::outcome::Tolerance;
 use crate::plot;
 use crate::setup::Study;
-use crate::study::Tolerance;
 use run_dir::OutputDir;
 use serde_json::{Map, Value, json};
 use std::fmt::Write as _;

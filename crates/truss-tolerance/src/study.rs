@@ -3,12 +3,13 @@
 
 use crate::allocate::{self, AllocationError, GroupModel};
 use crate::errors::ToleranceError;
-use crate::sensitivity::{Sensitivity, sensitivity};
+use crate::options::{Options, bad};
+use crate::outcome::{GroupResult, Tolerance};
+use crate::sensitivity::sensitivity;
 use crate::setup::Study;
 use crate::simulate::run_case;
 use crate::verify::{Percentile, percentile};
 use crate::{plot, report};
-use std::path::PathBuf;
 use truss_units::ARCSEC_PER_RAD;
 
 /// The target's margin: the rescale aims the interval's upper end at θ*(1 − MARGIN), so that
@@ -20,134 +21,6 @@ pub const LEAST_SHARE: f64 = 1e-9;
 
 /// Verification runs at most (the first, then rescaled ones).
 const MAX_RUNS: usize = 3;
-
-/// What to study.
-#[derive(Debug, Clone)]
-pub struct Options {
-    /// The job file.
-    pub job: PathBuf,
-    /// The case's name.
-    pub case: String,
-    /// The target θ* \[arcsec\].
-    pub target_arcsec: f64,
-    /// The percentile, in % (0 < p < 100).
-    pub percentile: f64,
-    /// `GROUP=WEIGHT` cost weights.
-    pub costs: Vec<String>,
-    /// `GROUP=SIGMA` pinned σ \[mm\].
-    pub fixes: Vec<String>,
-    /// Output directory.
-    pub out: PathBuf,
-    /// Samples of each verification run.
-    pub samples: usize,
-    /// Samples of the sensitivity run.
-    pub sensitivity_samples: usize,
-    /// Draw the SVG plots.
-    pub plots: bool,
-    /// Worker threads (None: the machine's; results do not depend on it).
-    pub threads: Option<usize>,
-    /// No progress on stderr.
-    pub quiet: bool,
-}
-
-impl Options {
-    /// Default options for a job, case, target and output directory.
-    pub fn new(job: PathBuf, case: &str, target_arcsec: f64, out: PathBuf) -> Self {
-        Self {
-            job,
-            case: case.to_string(),
-            target_arcsec,
-            percentile: 95.0,
-            costs: Vec::new(),
-            fixes: Vec::new(),
-            out,
-            samples: 20_000,
-            sensitivity_samples: 4_000,
-            plots: true,
-            threads: None,
-            quiet: true,
-        }
-    }
-}
-
-/// One group's result.
-#[derive(Debug, Clone, PartialEq)]
-pub struct GroupResult {
-    /// Name.
-    pub name: String,
-    /// Allocated σ \[mm\] (the pinned one if fixed).
-    pub sigma: f64,
-    /// σ in the input case \[mm\].
-    pub input_sigma: f64,
-    /// Share of the tilt's variance at the input σ, with its 95 % interval.
-    pub share: (f64, (f64, f64)),
-    /// `S_g` \[mm⁻²\]: the tilt's half-trace variance per unit σ_g².
-    pub sensitivity: f64,
-    /// `∂θ_Pq/∂σ_g` at the input σ \[rad/mm\].
-    pub derivative: f64,
-    /// Members.
-    pub members: usize,
-    /// Cost weight.
-    pub weight: f64,
-    /// Pinned by `--fix`.
-    pub fixed: bool,
-}
-
-/// The study's result.
-#[derive(Debug, Clone)]
-pub struct Tolerance {
-    /// The case.
-    pub case: String,
-    /// The input job's id.
-    pub job_id: String,
-    /// θ* \[rad\].
-    pub target_rad: f64,
-    /// The percentile in %.
-    pub percentile: f64,
-    /// Per group.
-    pub groups: Vec<GroupResult>,
-    /// Per member (with errors): id, group index, the sensitivity fit's shares.
-    pub members: Vec<(String, usize)>,
-    /// The member shares with intervals.
-    pub sensitivity: Sensitivity,
-    /// θ_Pq at the input σ, from the sensitivity run.
-    pub input: Percentile,
-    /// The model's θ_Pq at the input σ \[rad\].
-    pub input_model: f64,
-    /// The common σ meeting the target \[mm\].
-    pub uniform_sigma: f64,
-    /// The uniform σ's runs (how many) and the last one's θ_Pq.
-    pub uniform_run: (usize, Percentile),
-    /// Costs (allocated, uniform).
-    pub cost: (f64, f64),
-    /// Every verification run in order: (σ per group \[mm\], θ_Pq, model θ_Pq \[rad\]).
-    pub runs: Vec<(Vec<f64>, Percentile, f64)>,
-    /// The tilt covariance's eigenvalue ratio λ₂/λ₁ at the allocation (1: isotropic).
-    pub isotropy: f64,
-    /// Whether the last run verifies.
-    pub verified: bool,
-    /// Files written.
-    pub files: Vec<PathBuf>,
-}
-
-impl Tolerance {
-    /// The last verification run.
-    pub fn verified_run(&self) -> &(Vec<f64>, Percentile, f64) {
-        self.runs.last().expect("at least one verification run")
-    }
-
-    /// The cost ratio, allocated over uniform.
-    pub fn cost_ratio(&self) -> f64 {
-        self.cost.0 / self.cost.1
-    }
-}
-
-fn bad(flag: &str, message: String) -> ToleranceError {
-    ToleranceError::BadValue {
-        flag: flag.into(),
-        message,
-    }
-}
 
 fn say(quiet: bool, message: &str) {
     if !quiet {
@@ -189,28 +62,33 @@ pub const WRITER: &str = "truss-tolerance";
 /// does not verify.
 pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
     let o = options;
-    if !(o.target_arcsec.is_finite() && o.target_arcsec > 0.0 && o.target_arcsec < 324_000.0) {
-        return Err(bad(
-            "--target-arcsec",
-            format!("{} is not an angle in (0, 324000) arcsec", o.target_arcsec),
-        ));
-    }
-    if !(o.percentile.is_finite() && o.percentile > 0.0 && o.percentile < 100.0) {
-        return Err(bad(
-            "--percentile",
-            format!("{} is not a percentage in (0, 100)", o.percentile),
-        ));
-    }
-    if o.samples < 1000 {
-        return Err(bad(
-            "--samples",
-            format!("{} verification samples: need at least 1000", o.samples),
-        ));
-    }
+    o.check()?;
     // Before any work: no output may go through a link.
     let outputs: Vec<&str> = report::FILES.iter().chain(&plot::PLOTS).copied().collect();
     run_dir::OutputDir::check(&o.out, &outputs)?;
     let study = Study::read(&o.job, &o.case, &o.costs, &o.fixes)?;
+    let mut result = analyse(o, &study)?;
+    let last = result.verified_run().1;
+    let target = result.target_rad;
+    let mut out = run_dir::OutputDir::open(&o.out, WRITER)?;
+    result.files = report::write_all(&study, &result, &mut out, o.plots)?;
+    out.finish()?;
+    if !result.verified {
+        return Err(ToleranceError::Verification {
+            percentile: o.percentile,
+            theta: last.theta,
+            lower: last.interval.0,
+            upper: last.interval.1,
+            target,
+        });
+    }
+    Ok(result)
+}
+
+/// The study's work, between reading the case and writing the files: 1. the sensitivity run
+/// at the input σ and the member shares; 2. the groups' model, its derivatives and the
+/// allocation; 3. verification with the homogeneity rescale; 4. the uniform σ the same way.
+fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
     let job_id = truss_job::Job::new(&study.spec, &study.base)?.id;
     let target = o.target_arcsec / ARCSEC_PER_RAD;
     let q = o.percentile / 100.0;
@@ -366,7 +244,7 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
         .zip(&group_of)
         .map(|(&i, &g)| (model.members()[i].id.clone(), g))
         .collect();
-    let mut result = Tolerance {
+    Ok(Tolerance {
         case: o.case.clone(),
         job_id,
         target_rad: target,
@@ -383,18 +261,5 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
         isotropy,
         verified: last.verifies(target),
         files: Vec::new(),
-    };
-    let mut out = run_dir::OutputDir::open(&o.out, WRITER)?;
-    result.files = report::write_all(&study, &result, &mut out, o.plots)?;
-    out.finish()?;
-    if !result.verified {
-        return Err(ToleranceError::Verification {
-            percentile: o.percentile,
-            theta: last.theta,
-            lower: last.interval.0,
-            upper: last.interval.1,
-            target,
-        });
-    }
-    Ok(result)
+    })
 }

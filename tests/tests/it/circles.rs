@@ -21,8 +21,8 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// Circles that are being removed (the diagnosis's and the tolerance study's, each reshaped
-/// on its own branch): skipped for now, by crate and the files of the circle (under `src/`).
+/// Circles that are being removed (the diagnosis's, reshaped on its own branch): skipped for
+/// now, by crate and the files of the circle (under `src/`).
 /// Delete an entry when its circle is gone.
 const KNOWN: &[(&str, &[&str])] = &[
     (
@@ -33,7 +33,6 @@ const KNOWN: &[(&str, &[&str])] = &[
         "truss-diagnose",
         &["report/markdown.rs", "report/markdown/discrepancy.rs"],
     ),
-    ("truss-tolerance", &["plot.rs", "report.rs", "study.rs"]),
 ];
 
 #[test]
