@@ -3,11 +3,14 @@
 //! step of the selection, the updated job, the baseline against the final model, what to
 //! measure or do next, the plots and the method.
 
-use super::METHOD;
-use super::wording::{code_list, g, parameter_text, plain_reading, spans};
-use crate::baseline::Baseline;
-use crate::diagnose::{Diagnosis, FittedParameter, Verdict};
-use crate::measured::Measured;
+use super::method::METHOD;
+use super::wording::{code_list, effect, g, parameter_text, plain_reading, push, spans};
+use crate::candidates::candidate::separating_measurement;
+use crate::comparison::baseline::Baseline;
+use crate::comparison::measured::Measured;
+use crate::likelihood::score::FittedParameter;
+use crate::selection::Diagnosis;
+use crate::selection::decide::Verdict;
 use discrepancy::{before_after_section, disagreement_section, step_section};
 
 mod discrepancy;
@@ -24,7 +27,7 @@ pub fn markdown(
     data_section(&mut m, baseline, measured, d);
     disagreement_section(&mut m, d);
     for s in &d.steps {
-        step_section(&mut m, baseline, s);
+        step_section(&mut m, baseline, d, s);
     }
     for (n, why) in &d.skipped {
         push(&mut m, &format!("- `{n}` not tried: {why}."));
@@ -37,12 +40,6 @@ pub fn markdown(
     next_step_section(&mut m, measured, d);
     method_section(&mut m, d, plots);
     m
-}
-
-/// Appends `s` and a newline.
-fn push(m: &mut String, s: &str) {
-    m.push_str(s);
-    m.push('\n');
 }
 
 /// The title, the verdict and the fitted values.
@@ -87,13 +84,14 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
                 m,
                 &format!("Fitted `{}` (swapped in; the last joint re-fit):\n", e.name),
             );
-            for p in fit.map_or(&[][..], |f| &f.parameters) {
+            let c = effect(d, &e.name);
+            for (j, p) in fit.map_or(&[][..], |f| &f.parameters).iter().enumerate() {
                 push(
                     m,
                     &format!(
                         "- {}: {}",
-                        parameter_text(p),
-                        plain_reading(&e.name, p, span)
+                        parameter_text(c, j, p),
+                        plain_reading(c, j, p, span)
                     ),
                 );
             }
@@ -107,7 +105,8 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
             .iter()
             .find(|e| e.name == c.name)
             .map(|e| &e.parameters);
-        for p in &c.parameters {
+        let effect = effect(d, &c.name);
+        for (j, p) in c.parameters.iter().enumerate() {
             let now = last
                 .and_then(|ps| ps.iter().find(|q| q.0 == p.name))
                 .map(|q| q.2)
@@ -120,13 +119,13 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
                 m,
                 &format!(
                     "- {}{}: {}",
-                    parameter_text(p),
+                    parameter_text(effect, j, p),
                     now.map_or(String::new(), |v| format!(
                         "; {} {} after the later steps' re-fit",
                         g(v),
                         p.unit
                     )),
-                    plain_reading(&c.name, &reading, span)
+                    plain_reading(effect, j, &reading, span)
                 ),
             );
         }
@@ -223,17 +222,16 @@ fn updated_job_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
 fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
     push(m, "## Next step\n");
     let mut advice = Vec::new();
-    let joint_like = ["length_bias", "diagonal_pretension"];
     for s in &d.steps {
         let Some(named) = s.named_effect() else {
             continue;
         };
-        let mixes_backlash = (named == "backlash"
-            && s.indistinguishable
-                .iter()
-                .any(|o| joint_like.contains(&o.as_str())))
-            || (joint_like.contains(&named) && s.indistinguishable.iter().any(|o| o == "backlash"));
-        if mixes_backlash && measured.members.is_none() {
+        let a = effect(d, named);
+        let mistaken = s.indistinguishable.iter().any(|o| {
+            let b = effect(d, o);
+            a.mistaken_without_members(b.trace()) || b.mistaken_without_members(a.trace())
+        });
+        if mistaken && measured.members.is_none() {
             advice.push(format!(
                 "Step {}: `{named}` and {} fit the node positions equally well: joint free play shortens the truss much as a member-length error does. Measure the member lengths one by one (longerons and diagonals, to a few µm) and run again with `--measured-members`: then they separate.",
                 s.number,
@@ -248,7 +246,7 @@ fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
                     .iter()
                     .map(|n| format!(
                         "from `{n}`, {}",
-                        crate::stepwise::separating_measurement(named, n)
+                        separating_measurement(a, effect(d, n))
                     ))
                     .collect::<Vec<_>>()
                     .join("; ")

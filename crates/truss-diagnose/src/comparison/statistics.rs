@@ -22,8 +22,8 @@
 //! mean within ±[`TOL_MEAN`] predicted standard deviations, every coordinate's scatter and the
 //! median and 95th percentile of θ_P within a factor [`TOL_RATIO`] of the prediction.
 
-use crate::measured::{Coordinate, Measured};
-use crate::simulate::Simulation;
+use crate::comparison::measured::{Coordinate, Measured};
+use crate::comparison::simulate::Simulation;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
 use truss_stats::bootstrap::{BootstrapConfig, SortedSample, bootstrap_quantiles};
@@ -383,7 +383,7 @@ fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
     let config = |seed| BootstrapConfig {
         replicates: 1000,
         seed,
-        threads: crate::simulate::threads(),
+        threads: crate::comparison::simulate::threads(),
     };
     let by = bootstrap_quantiles(&sy, &percentiles, &config(1));
     let bx = bootstrap_quantiles(&sx, &percentiles, &config(2));
@@ -545,7 +545,7 @@ pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> EnergyTest 
 }
 
 /// The comparison's family-wise level: a statistic disagrees when its Holm-adjusted p is
-/// below it. Half of the verdict's α = 0.05 ([`crate::diagnose::Settings::alpha`]): a verdict other
+/// below it. Half of the verdict's α = 0.05 ([`crate::settings::Settings::alpha`]): a verdict other
 /// than "the model agrees" on data that miss nothing can come from either of two families
 /// of tests (the comparison here, which alone can say `unexplained`, and the candidates'
 /// likelihood-ratio tests, which name an effect), so each family gets α/2 and their union
@@ -629,7 +629,7 @@ pub fn compare(
     stats.push(cov_statistic(ca, cb, ya, yb, xa, xb));
     stats.extend(percentile_statistics(&measured.theta_p, &sim.theta_p));
     stats.push(ks_statistic(&measured.theta_p, &sim.theta_p));
-    let floor = (sigma_m * sigma_m + crate::likelihood::RESOLUTION.powi(2)).sqrt();
+    let floor = (sigma_m * sigma_m + crate::likelihood::gaussian::RESOLUTION.powi(2)).sqrt();
     let scale: Vec<f64> = (0..d)
         .map(|j| moments(&columns[j].1).sd.max(floor))
         .collect();
@@ -719,7 +719,7 @@ mod tests {
     fn energy_distance_sees_a_shift_and_not_noise() {
         let gauss = |seed: u64, n: usize, shift: f64| -> Vec<f64> {
             (0..n * 2)
-                .map(|i| crate::simulate::noise_normal(seed, i as u64, 0) + shift)
+                .map(|i| crate::comparison::simulate::noise_normal(seed, i as u64, 0) + shift)
                 .collect()
         };
         let y = gauss(1, 100, 0.0);
@@ -746,7 +746,7 @@ mod tests {
     fn energy_noise_is_the_spread_under_the_null() {
         let gauss = |seed: u64, n: usize| -> Vec<f64> {
             (0..n * 2)
-                .map(|i| crate::simulate::noise_normal(seed, i as u64, 0))
+                .map(|i| crate::comparison::simulate::noise_normal(seed, i as u64, 0))
                 .collect()
         };
         let tests: Vec<EnergyTest> = (0..40)

@@ -2,15 +2,15 @@
 //! likelihood-ratio test against the baseline, and its intervals (Wald for every candidate,
 //! profile likelihood for those the verdict rests on).
 
-use crate::baseline::{Baseline, CaseEdit};
-use crate::candidates::Candidate;
-use crate::derivatives::Terms;
+use crate::candidates::candidate::Candidate;
+use crate::comparison::baseline::{Baseline, CaseEdit};
+use crate::comparison::measured::Measured;
+use crate::comparison::simulate::{Simulation, simulate};
 use crate::errors::DiagnoseError;
-use crate::fit::{Fit, Interval, Options, adjustments, maximise, wald_intervals};
-use crate::likelihood::{Gaussian, member_log_likelihood};
-use crate::measured::Measured;
-use crate::profile::{Intervals, Problem, Profile, profile_intervals};
-use crate::simulate::{Simulation, simulate};
+use crate::likelihood::derivatives::Terms;
+use crate::likelihood::fit::{Fit, Interval, Options, adjustments, maximise, wald_intervals};
+use crate::likelihood::gaussian::{Gaussian, member_log_likelihood};
+use crate::likelihood::profile::{Intervals, Problem, Profile, profile_intervals};
 use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::time::Instant;
@@ -31,7 +31,7 @@ pub struct FittedParameter {
     pub wald_interval: Interval,
     /// Where profiled: the projection of the joint 95 % profile-likelihood region of all
     /// the candidate's k parameters (threshold χ²_k(0.95)·c·λ̄), so that every parameter
-    /// lies in its joint interval at once with 95 % confidence ([`crate::profile`]).
+    /// lies in its joint interval at once with 95 % confidence ([`crate::likelihood::profile`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub joint_interval: Option<Interval>,
     /// The plausible range searched.
@@ -82,6 +82,28 @@ pub struct CandidateScore {
     pub error: Option<String>,
 }
 
+/// A p-value for people: `p < 1e-16` below what a double can tell from 0 after
+/// `1 − CDF`, else two significant digits.
+pub fn p_text(p: f64) -> String {
+    if p < 1e-16 {
+        "< 1e-16".into()
+    } else if p >= 0.01 {
+        format!("{p:.2}")
+    } else {
+        format!("{p:.1e}")
+    }
+}
+
+/// `p = 0.03` or `p < 1e-16`.
+pub fn p_is(p: f64) -> String {
+    let t = p_text(p);
+    if t.starts_with('<') {
+        format!("p {t}")
+    } else {
+        format!("p = {t}")
+    }
+}
+
 /// ℓ of the measured data under an edited case: the current model of a forward-selection
 /// step (`start`: the baseline with the effects added so far) with one candidate applied.
 pub(crate) struct Evaluator<'a> {
@@ -110,10 +132,10 @@ impl Evaluator<'_> {
 
     /// The terms of ℓ: each specimen's, then each member observation's.
     /// With member measurements, each specimen's node term is conditioned on its own
-    /// measured members ([`crate::conditional`]).
+    /// measured members ([`crate::likelihood::conditional`]).
     pub fn score(&self, job: &truss_job::Job, sim: &Simulation) -> Result<Terms, DiagnoseError> {
         let mut terms = if self.condition && self.measured.members.is_some() {
-            crate::conditional::log_densities(
+            crate::likelihood::conditional::log_densities(
                 job,
                 self.baseline.model(),
                 sim,
@@ -334,7 +356,7 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
     }
 }
 
-/// Profile-likelihood intervals for a fitted candidate ([`crate::profile`]); where a profile
+/// Profile-likelihood intervals for a fitted candidate ([`crate::likelihood::profile`]); where a profile
 /// finds a higher point the candidate is fitted again from there and scored anew (at most
 /// twice). A profile that fails, or still finds a higher point after that, leaves the Wald
 /// intervals and says why in the progress notes.
@@ -435,4 +457,18 @@ pub(crate) fn profile_candidate(
     fitted.score.profile_evaluations = spent;
     fitted.score.seconds = seconds + clock.elapsed().as_secs_f64();
     fitted.fit = Some(fit);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// p-values for people: below what a double tells from 0, `< 1e-16`, never `0.00e0`.
+    #[test]
+    fn p_values_read_plainly() {
+        assert_eq!(p_text(0.0), "< 1e-16");
+        assert_eq!(p_is(1e-20), "p < 1e-16");
+        assert_eq!(p_is(0.034), "p = 0.03");
+        assert_eq!(p_text(2.5e-7), "2.5e-7");
+    }
 }
