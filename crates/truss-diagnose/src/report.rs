@@ -3,7 +3,7 @@
 //! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
 //! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 5)
+//! ## diagnosis.json (format `truss-diagnose`, version 6)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -33,13 +33,28 @@
 //!               discrepancy_noise_after (the energy distances' permutation noise), seconds}]
 //! effects     [{name, parameters [[name, unit, value]]}]   the final model's effects at
 //!              their final values (after the re-fits): what updated-job.json holds
-//! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null}]
+//! final_fit   [{name, parameters[]}]   the same effects fitted jointly, each parameter (as
+//!              below) with the joint fit's interval: Wald, profile where the Wald one is
+//!              cut at the range; for a model of one effect, its step's fit (profile
+//!              intervals); empty when no effect was added
+//! confounding [{effect, rival, parameters[] {name, unit, value, with_rival, interval,
+//!              moved, widening}, lr_statistic, p_value, delta_bic, separate_by}]   rivals
+//!              that, added to the final model and fitted jointly, move an effect's
+//!              parameters out of their intervals (moved) or widen their Wald intervals
+//!              two-fold or more (widening): the data cannot tell how that part of the
+//!              signal divides between the two; the rival is also listed in the
+//!              `indistinguishable` of the step that named the effect
+//! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
+//!              determined}]
 //!              (the first named effect's, as fitted in its step; for an effect swapped in,
 //!              the last joint re-fit's, Wald intervals)
 //!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
 //!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
 //!              indistinguishable from it, else "wald"; lower/upper null when not found;
 //!              an end at the range end is the range's (the interval is cut there)
+//!   determined false where the interval, or the Wald interval, covers at least half of the
+//!              plausible range (on the fit's scale): "not determined by these data", no
+//!              physical reading
 //!   joint_interval  where profiled: the joint 95 % region of all k parameters projected on
 //!              this one (same fields, threshold χ²_k(0.95)·c·λ̄): every parameter inside its
 //!              joint interval at once with 95 % confidence
@@ -61,8 +76,12 @@
 //!              model; after = before when no effect is added)
 //! method      {likelihood, fit, intervals, selection, verdicts, steps, statistics, discrepancy}
 //!             (in words)
-//! timing      {simulations, solves, seconds}
+//! timing      {simulations, solves, seconds, final_fit_seconds}
 //! ```
+//!
+//! Version 6 (from 5): `final_fit`, `confounding`, each parameter's `determined`,
+//! `timing.final_fit_seconds`; a confounded rival is also in its effect's step's
+//! `indistinguishable`.
 //!
 //! Within version 5, the `backlash` candidate's `parameters` became `clearance` (the
 //! joints' mean clearance) and `spread` (the half-width of their uniform scatter; before:
@@ -91,6 +110,7 @@ use crate::comparison::measured::{DataReport, Measured};
 use crate::comparison::statistics::Comparison;
 use crate::likelihood::score::{CandidateScore, FittedParameter};
 use crate::selection::Diagnosis;
+use crate::selection::confound::Confounding;
 use crate::selection::decide::Verdict;
 use crate::selection::eliminate::Removal;
 use crate::selection::model::{ModelEffect, RefitEffect};
@@ -109,7 +129,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -141,6 +161,7 @@ struct Timing {
     simulations: usize,
     solves: usize,
     seconds: f64,
+    final_fit_seconds: f64,
 }
 
 #[derive(Serialize)]
@@ -163,6 +184,8 @@ struct Report<'a> {
     skipped: Vec<Skipped<'a>>,
     steps: Vec<StepReport<'a>>,
     effects: &'a [ModelEffect],
+    final_fit: &'a [RefitEffect],
+    confounding: &'a [Confounding],
     statistics: Statistics<'a>,
     discrepancy_before: f64,
     discrepancy_after: f64,
@@ -275,6 +298,8 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
             .collect(),
         steps: d.steps.iter().map(StepReport::of).collect(),
         effects: &d.effects,
+        final_fit: &d.final_fit,
+        confounding: &d.confounding,
         statistics: Statistics {
             before: &d.before,
             after: d.after.as_ref(),
@@ -286,6 +311,7 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
             simulations: d.work.0,
             solves: d.work.1,
             seconds: d.work.2,
+            final_fit_seconds: d.final_seconds,
         },
     };
     let mut s = serde_json::to_string_pretty(&report).expect("the report serialises");

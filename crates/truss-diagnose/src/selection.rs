@@ -30,6 +30,7 @@
 //! false discoveries among them is never larger, and the probability of any false discovery
 //! is at most that of forward selection alone.
 
+pub mod confound;
 pub mod decide;
 pub mod eliminate;
 pub mod model;
@@ -71,6 +72,13 @@ pub struct Diagnosis {
     pub updated: CaseEdit,
     /// The final model's effects at their final values (after the re-fits).
     pub effects: Vec<ModelEffect>,
+    /// The final model's effects fitted jointly, with the joint fit's intervals (profile
+    /// where the Wald one is cut at the range; [`confound`]); empty when none was added.
+    pub final_fit: Vec<model::RefitEffect>,
+    /// Rivals that explain part of what the final model's effects explain ([`confound`]).
+    pub confounding: Vec<confound::Confounding>,
+    /// Wall time of the final fit and the confounding tests \[s\].
+    pub final_seconds: f64,
     /// Simulated samples per evaluation N.
     pub samples: usize,
     /// The simulations behind `before` and `after` (for plots).
@@ -171,6 +179,7 @@ pub fn diagnose(
         top,
         progress,
         simulations: std::cell::Cell::new(0),
+        memo: Default::default(),
     };
     progress.note(&format!(
         "{n} specimens, {} coordinates; simulating the baseline case {:?} ({samples} samples)",
@@ -220,13 +229,35 @@ pub fn diagnose(
         );
     }
     let (verdict, reason) = overall(&steps, kept);
-    let effects = steps
+    let last = steps
         .iter()
-        .filter(|s| s.kept)
+        .enumerate()
+        .filter(|(_, s)| s.kept)
         .nth(kept.max(1) - 1)
         .filter(|_| kept > 0)
-        .map_or_else(Vec::new, |s| s.effects.clone());
+        .map(|(i, _)| i);
+    let effects = last.map_or_else(Vec::new, |i| steps[i].effects.clone());
     progress.note(&format!("{}: {reason}", verdict.words()));
+    let library = library_for(baseline, measured.members.is_some()).0;
+    let clock = std::time::Instant::now();
+    let (final_fit, confounding) = match last {
+        Some(i) => {
+            let fit = confound::final_fit(&ctx, &steps[..=i], &steps[i], &library);
+            let found = confound::confounding(&ctx, &steps[..=i], &fit, &library);
+            (fit.effects, found)
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    for c in &confounding {
+        if let Some(s) = steps
+            .iter_mut()
+            .find(|s| s.kept && s.named_effect() == Some(c.effect.as_str()))
+            && !s.indistinguishable.contains(&c.rival)
+        {
+            s.indistinguishable.push(c.rival.clone());
+        }
+    }
+    let final_seconds = clock.elapsed().as_secs_f64();
     let sims = ctx.simulations.get();
     let mut models = models.into_iter();
     let base = models.next().expect("the baseline is there");
@@ -236,7 +267,10 @@ pub fn diagnose(
         reason,
         steps,
         skipped,
-        library: library_for(baseline, measured.members.is_some()).0,
+        library,
+        final_fit,
+        confounding,
+        final_seconds,
         baseline_log_likelihood: base.log_likelihood,
         before: base.comparison,
         updated: last.as_ref().map_or(base.edit, |m| m.edit.clone()),
@@ -429,6 +463,7 @@ mod tests {
             refitted: Vec::new(),
             removed,
             effects: Vec::new(),
+            joint: None,
             seconds: 0.0,
         };
         let steps = vec![

@@ -157,7 +157,7 @@ impl Welch {
 ///
 /// The measured moments are not used here: at n = 30 a fourth moment (a covariance's or a
 /// standard deviation's variance) is underestimated more often than not, and on data made
-/// from the baseline itself (issue 15's null check) the top nodes' x/y covariances reached
+/// from the baseline itself (the null check) the top nodes' x/y covariances reached
 /// p ≈ 7e-5 from 30 specimens, where their variance under the model gives p ≈ 3e-3. The
 /// 95 % intervals stay Welch's (measured and simulated moments, [`Welch`]): they describe
 /// the size of a difference where one exists.
@@ -549,7 +549,7 @@ pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> EnergyTest 
 /// than "the model agrees" on data that miss nothing can come from either of two families
 /// of tests (the comparison here, which alone can say `unexplained`, and the candidates'
 /// likelihood-ratio tests, which name an effect), so each family gets α/2 and their union
-/// α (Bonferroni). Issue 15's null check counts both.
+/// α (Bonferroni). The null check counts both.
 pub const LEVEL: f64 = 0.025;
 
 /// Holm's step-down adjustment over the comparison's statistics.

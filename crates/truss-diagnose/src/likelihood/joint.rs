@@ -99,7 +99,8 @@ impl Candidate for Combined<'_> {
 }
 
 /// A joint fit of a model's effects.
-pub(crate) struct JointFit {
+#[derive(Debug, Clone)]
+pub struct JointFit {
     /// Each effect's values, in the order given.
     pub values: Vec<Vec<f64>>,
     /// Each effect's fitted parameters with their 95 % Wald intervals (the joint sandwich).

@@ -379,6 +379,18 @@ pub fn profile_intervals(
     f: &mut Objective,
     joint: bool,
 ) -> Result<Profile, DiagnoseError> {
+    let all: Vec<usize> = (0..fit.internal.len()).collect();
+    profile_some(fit, problem, f, joint, &all)
+}
+
+/// [`profile_intervals`] of the parameters `which` only (their intervals in that order).
+pub fn profile_some(
+    fit: &Fit,
+    problem: &Problem,
+    f: &mut Objective,
+    joint: bool,
+    which: &[usize],
+) -> Result<Profile, DiagnoseError> {
     let k = fit.internal.len();
     let a = &fit.curvature;
     let a_inv = nalgebra::Cholesky::new(a.clone()).map(|c| c.inverse());
@@ -394,7 +406,7 @@ pub fn profile_intervals(
     };
     let mut marginal = Vec::with_capacity(k);
     let mut projected = Vec::with_capacity(k);
-    for j in 0..k {
+    for &j in which {
         let q = CHI2_1_95 * problem.inflation * lambdas[j].max(1.0);
         let scale = match &a_inv {
             Some(inv) => inv[(j, j)].sqrt(),

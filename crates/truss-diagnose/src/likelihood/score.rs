@@ -3,6 +3,7 @@
 //! profile likelihood for those the verdict rests on).
 
 use crate::candidates::candidate::Candidate;
+use crate::candidates::parameter::Parameter;
 use crate::comparison::baseline::{Baseline, CaseEdit};
 use crate::comparison::measured::Measured;
 use crate::comparison::simulate::{Simulation, simulate};
@@ -38,6 +39,41 @@ pub struct FittedParameter {
     pub range: [f64; 2],
     /// The value at which the candidate is the baseline.
     pub null: f64,
+    /// Whether the data determine it: `false` where its 95 % interval, or its Wald
+    /// interval, covers at least [`UNDETERMINED`] of its plausible range
+    /// ([`FittedParameter::coverage`]). An undetermined parameter's value is the best fit,
+    /// with no physical reading.
+    pub determined: bool,
+}
+
+/// The share of its plausible range that a parameter's 95 % interval must cover for the
+/// parameter to be reported "not determined by these data": most of it.
+pub const UNDETERMINED: f64 = 0.5;
+
+/// The share of `p`'s plausible range that `interval` covers, on the fit's scale
+/// ([`Parameter::internal`]); an end not found counts as the range's.
+pub fn coverage(p: &Parameter, interval: &Interval) -> f64 {
+    let lower = interval.lower.map_or(0.0, |v| p.internal(v));
+    let upper = interval.upper.map_or(1.0, |v| p.internal(v));
+    (upper.min(1.0) - lower.max(0.0)).max(0.0)
+}
+
+impl FittedParameter {
+    /// The share of the plausible range of parameter `p` (this one's) that the data leave
+    /// open: the larger of its interval's and its Wald interval's [`coverage`]. The Wald
+    /// interval is the likelihood's own curvature, without the feasible set: where a
+    /// profile's ends are set by a constraint that couples the parameter to others
+    /// (gravity's \|g\| ≤ 1 holding g_z small because g_x and g_y are large), the interval
+    /// is narrow while the data say nothing of the parameter itself.
+    pub fn coverage(&self, p: &Parameter) -> f64 {
+        coverage(p, &self.interval).max(coverage(p, &self.wald_interval))
+    }
+
+    /// Sets the interval the report uses, and whether the parameter is determined.
+    pub fn set_interval(&mut self, p: &Parameter, interval: Interval) {
+        self.interval = interval;
+        self.determined = self.coverage(p) < UNDETERMINED;
+    }
 }
 
 /// One candidate's fit and score.
@@ -104,6 +140,43 @@ pub fn p_is(p: f64) -> String {
     }
 }
 
+/// ℓ's terms of the cases already simulated, by job id (the SHA-256 of the derived job's
+/// canonical form: its case, N and seed), so that a case met again (the current model at
+/// every candidate's null, a point a later fit passes through) is not simulated again.
+/// With common random numbers a case's terms are a function of its job alone, so a
+/// remembered value is exactly the one a new simulation would give. At most
+/// [`MEMO_CASES`] are kept, the oldest forgotten first.
+#[derive(Default)]
+pub(crate) struct Memo {
+    terms: std::cell::RefCell<(
+        std::collections::HashMap<String, Terms>,
+        std::collections::VecDeque<String>,
+    )>,
+}
+
+/// Most cases a [`Memo`] keeps (each n + member-observation values).
+pub const MEMO_CASES: usize = 512;
+
+impl Memo {
+    /// The terms of job `id`, if remembered.
+    pub fn get(&self, id: &str) -> Option<Terms> {
+        self.terms.borrow().0.get(id).cloned()
+    }
+
+    /// Remembers the terms of job `id`.
+    pub fn put(&self, id: &str, terms: &Terms) {
+        let (map, order) = &mut *self.terms.borrow_mut();
+        if map.insert(id.to_string(), terms.clone()).is_none() {
+            order.push_back(id.to_string());
+        }
+        while order.len() > MEMO_CASES {
+            if let Some(old) = order.pop_front() {
+                map.remove(&old);
+            }
+        }
+    }
+}
+
 /// ℓ of the measured data under an edited case: the current model of a forward-selection
 /// step (`start`: the baseline with the effects added so far) with one candidate applied.
 pub(crate) struct Evaluator<'a> {
@@ -114,7 +187,10 @@ pub(crate) struct Evaluator<'a> {
     pub sigma_m: f64,
     /// Condition the node terms on the specimens' measured members.
     pub condition: bool,
+    /// Simulations run (cases found in `memo` not counted).
     pub simulations: std::cell::Cell<usize>,
+    /// The terms of cases already simulated, if shared.
+    pub memo: Option<&'a Memo>,
 }
 
 impl Evaluator<'_> {
@@ -125,9 +201,16 @@ impl Evaluator<'_> {
 
     fn log_likelihood(&self, edit: &CaseEdit) -> Result<Terms, DiagnoseError> {
         let job = self.job(edit)?;
+        if let Some(terms) = self.memo.and_then(|m| m.get(&job.id)) {
+            return Ok(terms);
+        }
         let sim = simulate(&job, &self.measured.coords, self.samples, None)?;
         self.simulations.set(self.simulations.get() + 1);
-        self.score(&job, &sim)
+        let terms = self.score(&job, &sim)?;
+        if let Some(m) = self.memo {
+            m.put(&job.id, &terms);
+        }
+        Ok(terms)
     }
 
     /// The terms of ℓ: each specimen's, then each member observation's.
@@ -285,6 +368,7 @@ pub(crate) fn score_of(c: &dyn Candidate, fit: &Fit, test: &Test) -> CandidateSc
                 name: p.name.clone(),
                 unit: p.unit,
                 value,
+                determined: coverage(p, &wald) < UNDETERMINED,
                 interval: wald.clone(),
                 wald_interval: wald,
                 joint_interval: None,
@@ -448,8 +532,15 @@ pub(crate) fn profile_candidate(
     }) = outcome
     {
         let joint = joint.into_iter().map(Some).chain(std::iter::repeat(None));
-        for ((p, i), jt) in fitted.score.parameters.iter_mut().zip(marginal).zip(joint) {
-            p.interval = i;
+        for (((p, q), i), jt) in fitted
+            .score
+            .parameters
+            .iter_mut()
+            .zip(c.parameters())
+            .zip(marginal)
+            .zip(joint)
+        {
+            p.set_interval(q, i);
             p.joint_interval = jt;
         }
     }

@@ -8,8 +8,9 @@ use super::wording::{code_list, effect, g, parameter_text, plain_reading, push, 
 use crate::candidates::candidate::separating_measurement;
 use crate::comparison::baseline::Baseline;
 use crate::comparison::measured::Measured;
-use crate::likelihood::score::FittedParameter;
+use crate::likelihood::score::p_is;
 use crate::selection::Diagnosis;
+use crate::selection::confound::WIDENED;
 use crate::selection::decide::Verdict;
 use discrepancy::{before_after_section, disagreement_section, step_section};
 
@@ -66,70 +67,125 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
     );
     push(m, &format!("{}.\n", d.reason.trim_end_matches('.')));
     let span = spans(baseline);
-    for e in &d.effects {
-        let Some((s, c)) = d
+    for e in &d.final_fit {
+        let c = effect(d, &e.name);
+        let step = d
             .steps
             .iter()
             .filter(|s| s.kept)
-            .find_map(|s| s.named_score().filter(|c| c.name == e.name).map(|c| (s, c)))
-        else {
-            // Swapped in: its values and intervals are those of the last joint fit.
-            let fit = d
-                .steps
+            .find(|s| s.named_effect() == Some(e.name.as_str()));
+        let joint = d.final_fit.len() > 1
+            || step.is_none_or(|s| {
+                s.named_score().is_none_or(|n| {
+                    n.parameters
+                        .iter()
+                        .zip(&e.parameters)
+                        .any(|(a, b)| a.value != b.value)
+                })
+            });
+        push(
+            m,
+            &format!(
+                "Fitted `{}` ({}{}):\n",
+                e.name,
+                step.map_or("swapped in".to_string(), |s| format!(
+                    "named in step {}",
+                    s.number
+                )),
+                if joint {
+                    "; the final model's effects fitted jointly, with that fit's intervals"
+                } else {
+                    ""
+                }
+            ),
+        );
+        for (j, p) in e.parameters.iter().enumerate() {
+            let rivals: Vec<&String> = d
+                .confounding
                 .iter()
-                .filter(|s| s.kept)
-                .flat_map(|s| &s.refitted)
-                .rfind(|r| r.name == e.name);
-            push(
-                m,
-                &format!("Fitted `{}` (swapped in; the last joint re-fit):\n", e.name),
-            );
-            let c = effect(d, &e.name);
-            for (j, p) in fit.map_or(&[][..], |f| &f.parameters).iter().enumerate() {
-                push(
-                    m,
-                    &format!(
-                        "- {}: {}",
-                        parameter_text(c, j, p),
-                        plain_reading(c, j, p, span)
-                    ),
-                );
-            }
-            push(m, "");
-            continue;
-        };
-        push(m, &format!("Fitted `{}` (step {}):\n", c.name, s.number));
-        // The final value where a later step re-fitted it.
-        let last = d
-            .effects
-            .iter()
-            .find(|e| e.name == c.name)
-            .map(|e| &e.parameters);
-        let effect = effect(d, &c.name);
-        for (j, p) in c.parameters.iter().enumerate() {
-            let now = last
-                .and_then(|ps| ps.iter().find(|q| q.0 == p.name))
-                .map(|q| q.2)
-                .filter(|&v| v != p.value);
-            let reading = FittedParameter {
-                value: now.unwrap_or(p.value),
-                ..p.clone()
-            };
+                .filter(|k| k.effect == e.name && k.parameters.iter().any(|q| q.name == p.name))
+                .map(|k| &k.rival)
+                .collect();
             push(
                 m,
                 &format!(
-                    "- {}{}: {}",
-                    parameter_text(effect, j, p),
-                    now.map_or(String::new(), |v| format!(
-                        "; {} {} after the later steps' re-fit",
-                        g(v),
-                        p.unit
-                    )),
-                    plain_reading(effect, j, &reading, span)
+                    "- {}: {}{}",
+                    parameter_text(c, j, p),
+                    plain_reading(c, j, p, span),
+                    if rivals.is_empty() {
+                        String::new()
+                    } else {
+                        format!(
+                            "; confounded with {} (below): this reading holds only without {}",
+                            code_list(&rivals, " and "),
+                            if rivals.len() == 1 { "it" } else { "them" }
+                        )
+                    }
                 ),
             );
         }
         push(m, "");
+    }
+    confounding_section(m, d);
+}
+
+/// What the data cannot tell apart within the final model: each rival confounded with an
+/// effect's parameters, and the measurement that would separate them.
+fn confounding_section(m: &mut String, d: &Diagnosis) {
+    for c in &d.confounding {
+        push(
+            m,
+            &format!(
+                "**Cannot be told apart: `{}` and `{}`.** With `{}` added and every effect fitted jointly, {} of `{}` {} confounded with it: {}; `{}` given the model: Λ = {:.1}, {}, ΔBIC = {:.1}. These data cannot say how that part of the signal divides between the two, so the values above are one reading of it. What would separate them: {}.\n",
+                c.effect,
+                c.rival,
+                c.rival,
+                code_list(
+                    &c.parameters.iter().map(|p| &p.name).collect::<Vec<_>>(),
+                    ", "
+                ),
+                c.effect,
+                if c.parameters.len() == 1 { "is" } else { "are" },
+                c.parameters
+                    .iter()
+                    .map(|p| {
+                        if p.moved && p.widening >= WIDENED {
+                            format!(
+                                "`{}` moves from {} to {} {}, outside its interval, which widens {:.1}-fold",
+                                p.name,
+                                g(p.value),
+                                g(p.with_rival),
+                                p.unit,
+                                p.widening
+                            )
+                        } else if p.moved {
+                            format!(
+                                "`{}` moves from {} to {} {}, outside its interval",
+                                p.name,
+                                g(p.value),
+                                g(p.with_rival),
+                                p.unit
+                            )
+                        } else {
+                            format!(
+                                "`{}`'s interval widens {:.1}-fold ({} to {} {})",
+                                p.name,
+                                p.widening,
+                                g(p.value),
+                                g(p.with_rival),
+                                p.unit
+                            )
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .join("; "),
+                c.rival,
+                c.lr_statistic,
+                p_is(c.p_value),
+                c.delta_bic,
+                c.separate_by
+            ),
+        );
     }
 }
 
@@ -216,6 +272,24 @@ fn updated_job_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
             )
         },
     );
+    let undetermined: Vec<String> =
+        d.final_fit
+            .iter()
+            .flat_map(|e| {
+                e.parameters.iter().filter(|p| !p.determined).map(move |p| {
+                    format!("`{}` of `{}` ({} {})", p.name, e.name, g(p.value), p.unit)
+                })
+            })
+            .collect();
+    if !undetermined.is_empty() {
+        push(
+            m,
+            &format!(
+                "Not determined by these data: {}. The updated job holds the best-fitting value, but the data leave most of the plausible range open: treat it as unknown.\n",
+                undetermined.join(", ")
+            ),
+        );
+    }
 }
 
 /// `## Next step`: what to measure or do next.

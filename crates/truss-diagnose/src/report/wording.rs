@@ -89,14 +89,21 @@ pub(super) fn spans(baseline: &Baseline) -> [f64; 3] {
 }
 
 /// Parameter `j` of effect `c` in plain words: what its value means for the hardware
-/// ([`Candidate::reading`]).
+/// ([`Candidate::reading`]); none where the data do not determine it.
 pub(super) fn plain_reading(
     c: &dyn Candidate,
     j: usize,
     p: &FittedParameter,
     span: [f64; 3],
 ) -> String {
-    c.reading(j, p.value, span)
+    if p.determined {
+        c.reading(j, p.value, span)
+    } else {
+        format!(
+            "not determined by these data (they leave {:.0} % of its plausible range open): no reading is given",
+            100.0 * p.coverage(&c.parameters()[j])
+        )
+    }
 }
 
 /// Names in code spans, joined by `separator`: `` `a`, `b` ``.

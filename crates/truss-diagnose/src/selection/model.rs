@@ -8,7 +8,7 @@ use crate::comparison::measured::Measured;
 use crate::comparison::simulate::{Noise, Simulation, simulate};
 use crate::comparison::statistics::{Comparison, compare};
 use crate::errors::DiagnoseError;
-use crate::likelihood::score::{Evaluator, FittedParameter};
+use crate::likelihood::score::{Evaluator, FittedParameter, Memo};
 use crate::settings::{Progress, Settings};
 use std::cell::Cell;
 
@@ -23,6 +23,8 @@ pub(crate) struct Context<'a> {
     pub progress: &'a Progress,
     /// Simulations run so far.
     pub simulations: Cell<usize>,
+    /// ℓ's terms of the cases simulated so far.
+    pub memo: Memo,
 }
 
 impl Context<'_> {
@@ -36,6 +38,7 @@ impl Context<'_> {
             sigma_m: self.settings.measurement_sigma,
             condition: self.settings.condition_on_members,
             simulations: Cell::new(0),
+            memo: Some(&self.memo),
         }
     }
 
@@ -74,7 +77,9 @@ pub(crate) fn compare_model(ctx: &Context, edit: CaseEdit) -> Result<ComparedMod
         Some((ctx.noise, ctx.top)),
     )?;
     ctx.simulations.set(ctx.simulations.get() + 1);
-    let log_likelihood: f64 = ev.score(&job, &simulation)?.iter().sum();
+    let terms = ev.score(&job, &simulation)?;
+    ctx.memo.put(&job.id, &terms);
+    let log_likelihood: f64 = terms.iter().sum();
     let comparison = compare(
         ctx.measured,
         &simulation,

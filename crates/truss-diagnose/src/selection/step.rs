@@ -44,6 +44,7 @@ use crate::comparison::baseline::CaseEdit;
 use crate::comparison::statistics::{Comparison, LEVEL};
 use crate::errors::DiagnoseError;
 use crate::likelihood::derivatives::Terms;
+use crate::likelihood::joint::JointFit;
 use crate::likelihood::score::{
     CandidateScore, Evaluator, Fitted, Test, fit_candidate, p_is, p_text, profile_candidate,
 };
@@ -97,6 +98,8 @@ pub struct Step {
     /// The model's effects after this step, with their values: each (name, parameter
     /// names and units, values).
     pub effects: Vec<ModelEffect>,
+    /// The joint fit behind `refitted`, if any.
+    pub joint: Option<JointFit>,
     /// Wall time of the step \[s\].
     pub seconds: f64,
 }
@@ -256,9 +259,11 @@ pub(crate) fn run(
         refitted: Vec::new(),
         removed: Vec::new(),
         effects: Vec::new(),
+        joint: None,
         seconds: 0.0,
     };
     let next = up.map(|up| {
+        step.joint = up.joint;
         step.refitted = up.refitted;
         step.removed = up.removed;
         step.effects = up.effects;

@@ -57,6 +57,8 @@ pub(crate) struct Update {
     pub removed: Vec<Removal>,
     /// The model's effects after the step, at their values.
     pub effects: Vec<ModelEffect>,
+    /// The last joint fit of the model's effects (the one `refitted` reports), if any.
+    pub joint: Option<JointFit>,
 }
 
 /// An effect of the model during the update: the candidate, its values, the step that added
@@ -64,7 +66,7 @@ pub(crate) struct Update {
 type Member<'a> = (&'a dyn Candidate, Vec<f64>, usize);
 
 /// Fits `effects` jointly against the baseline's case, counting the simulations.
-fn fit_jointly(
+pub(crate) fn fit_jointly(
     ctx: &Context,
     effects: &[(&dyn Candidate, &[f64])],
     steps: Option<&[f64]>,
@@ -90,7 +92,7 @@ pub(crate) fn update(
     scores: &[CandidateScore],
 ) -> Result<Update, DiagnoseError> {
     let values: Vec<f64> = scores[named].parameters.iter().map(|p| p.value).collect();
-    let (members, refitted, removed, edit) = {
+    let (members, refitted, removed, edit, joint) = {
         let rivals: Vec<&dyn Candidate> = pool
             .remaining
             .iter()
@@ -99,7 +101,7 @@ pub(crate) fn update(
             .map(|(_, c)| c.as_ref())
             .collect();
         let new = pool.remaining[named].as_ref();
-        let (members, refitted, removed) =
+        let (members, refitted, removed, joint) =
             refit_and_eliminate(ctx, number, &pool.added, (new, &values), &rivals)?;
         let mut edit = ctx.baseline.derived_case();
         for m in &members {
@@ -109,7 +111,7 @@ pub(crate) fn update(
             .into_iter()
             .map(|(c, v, _)| (c.name().to_string(), v))
             .collect();
-        (members, refitted, removed, edit)
+        (members, refitted, removed, edit, joint)
     };
     admit(pool, number, named, scores, &removed);
     for (a, (name, v)) in pool.added.iter_mut().zip(&members) {
@@ -135,6 +137,7 @@ pub(crate) fn update(
         refitted,
         removed,
         effects,
+        joint,
     })
 }
 
@@ -198,7 +201,7 @@ fn admit(
 
 /// The model's effects with the new one, re-fitted jointly, the earlier ones eliminated
 /// while not needed and the best swap made: the members at their values, the joint fit's
-/// effects, and the removals.
+/// effects, the removals, and the last joint fit.
 #[allow(clippy::type_complexity)]
 fn refit_and_eliminate<'a>(
     ctx: &Context,
@@ -206,7 +209,15 @@ fn refit_and_eliminate<'a>(
     added: &'a [Added],
     (new, new_values): (&'a dyn Candidate, &[f64]),
     pool: &[&'a dyn Candidate],
-) -> Result<(Vec<Member<'a>>, Vec<RefitEffect>, Vec<Removal>), DiagnoseError> {
+) -> Result<
+    (
+        Vec<Member<'a>>,
+        Vec<RefitEffect>,
+        Vec<Removal>,
+        Option<JointFit>,
+    ),
+    DiagnoseError,
+> {
     let note = |m: &str| ctx.progress.note(m);
     let mut members: Vec<Member> = added
         .iter()
@@ -350,7 +361,7 @@ fn refit_and_eliminate<'a>(
             .collect(),
         None => Vec::new(),
     };
-    Ok((members, refitted, removed))
+    Ok((members, refitted, removed, joint))
 }
 
 /// The best swap of an earlier effect for one of its rivals still in the pool (module doc):

@@ -1,4 +1,4 @@
-//! The stepwise selection end to end (issue 14): two effects hidden at once, where the
+//! The stepwise selection end to end: two effects hidden at once, where the
 //! effect named first is only a stand-in for one found later, so a later step must swap it
 //! out or remove it. These are two of `scripts/diagnose-check.sh`'s pairs (seed 301, 200
 //! specimens), each a few tens of seconds in release.
