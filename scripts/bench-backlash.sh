@@ -2,8 +2,8 @@
 # bench-backlash.sh: throughput of the Fig. 16 study (jobs/paper-4.2.3.json, section 4.2.3)
 # with backlash against the same cases without, on 2 threads: samples/s of each (wall time,
 # start-up and writing included) and their ratio, medians of RUNS runs (default 5) since
-# the machine is shared and noisy. The target (the free-play issue): with backlash at least
-# 0.3 of the throughput without.
+# the machine is shared and noisy. The target: with backlash at least 0.3 of the throughput
+# without.
 #
 # Usage: scripts/bench-backlash.sh [RUNS]
 set -euo pipefail

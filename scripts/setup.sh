@@ -5,8 +5,9 @@
 #
 # - Debian packages: munge, slurmctld, slurmd, slurm-client (the real single-node Slurm
 #   cluster of the end-to-end test, see scripts/slurm/README.md) and librsvg2-bin
-#   (rsvg-convert, which the tests use to render the SVG plots to PNG), and fonts-dejavu-core
-#   (the font mc-merge's own PNG rendering and rsvg-convert draw text with).
+#   (rsvg-convert, which the tests use to render the SVG plots to PNG), fonts-dejavu-core
+#   (the font mc-merge's own PNG rendering and rsvg-convert draw text with), and chromium
+#   (the headless browser that opens mc-merge's report.html in scripts/browser-test.sh).
 # - A Python virtual environment for the Python package's tests, target/py-venv (under the
 #   git-ignored target/), with the pinned tools of python/requirements-test.txt (maturin,
 #   pytest, numpy) from PyPI; then, if PyPI has a wheel for this Python, OpenTURNS
@@ -18,7 +19,7 @@
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 
-packages=(munge slurmctld slurmd slurm-client librsvg2-bin fonts-dejavu-core)
+packages=(munge slurmctld slurmd slurm-client librsvg2-bin fonts-dejavu-core chromium)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # smoke-test.sh: the README's main command (truss-mc run-all) on a small job, checked end
-# to end: shards written, merged, report.json present, every SVG plot renders to a PNG
+# to end: shards written, merged, report.json, report.md and report.html present (the page
+# in a browser: scripts/browser-test.sh), every SVG plot renders to a PNG
 # (rsvg-convert parses and rasterises it; a malformed SVG fails), and mc-merge wrote its own
 # PNG beside each SVG, at twice its size. This is where CI checks those PNGs: its default
 # tests run without the png feature (see scripts/test.sh).
@@ -24,7 +25,9 @@ cat > "$WORK/job.json" <<'JOB'
 JOB
 "$TRUSS_MC" run-all --job "$WORK/job.json" --out "$WORK/run" --shards 4 --quiet > "$WORK/out.txt"
 grep -q "run-all: 4000 samples in 4 shards" "$WORK/out.txt" || { cat "$WORK/out.txt"; exit 1; }
-[[ -s "$WORK/run/report/report.json" ]] || { echo "smoke: no report.json" >&2; exit 1; }
+for report in report.json report.md report.html; do
+    [[ -s "$WORK/run/report/$report" ]] || { echo "smoke: no $report" >&2; exit 1; }
+done
 n=0
 mkdir "$WORK/check"
 for svg in "$WORK"/run/report/*.svg; do

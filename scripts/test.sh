@@ -16,7 +16,9 @@
 #    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
 #      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted;
 #    - scripts/smoke-test.sh: the README's main command on a small job, and its SVG plots
-#      rendered to PNG with rsvg-convert, and mc-merge's own PNGs checked.
+#      rendered to PNG with rsvg-convert, and mc-merge's own PNGs checked;
+#    - scripts/browser-test.sh: mc-merge's report.html opened in headless Chromium: every
+#      image loads, nothing is fetched, a screenshot is not blank, the page prints.
 # Needs what scripts/setup.sh installs (it is run first when something is missing).
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -25,7 +27,7 @@ cd "$REPO"
 # where its time went.
 phase() { echo "test: $1 (at ${SECONDS} s)" >&2; }
 
-command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && [ -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] && [ -x target/py-venv/bin/maturin ] || scripts/setup.sh
+command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && command -v chromium >/dev/null && [ -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] && [ -x target/py-venv/bin/maturin ] || scripts/setup.sh
 
 phase "cargo test --workspace (without the png feature)"
 # Without mc-merge's default feature png: resvg's build is about 90 s of CPU in the debug
@@ -55,5 +57,8 @@ scripts/slurm/e2e-test.sh
 
 phase "smoke test of the main command"
 scripts/smoke-test.sh
+
+phase "report.html in a browser"
+scripts/browser-test.sh
 
 phase "all passed"

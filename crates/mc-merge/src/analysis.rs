@@ -4,12 +4,12 @@
 use crate::bootstrap::{
     self, BootstrapConfig, QuantileReplicates, SortedSample, bootstrap_quantiles,
 };
-use crate::cli::Settings;
 use crate::gof::{self, CalibrationCache, GofConfig};
 use crate::load::CaseData;
 use crate::quantile::{order_statistic_interval, quantile_sorted};
 use crate::rayleigh::{self, ComponentStats};
 use crate::report::*;
+use crate::settings::Settings;
 use statrs::distribution::{Beta, ContinuousCDF};
 
 /// A case's report plus what the sweeps need: the target percentile, its interval and its

@@ -1,7 +1,7 @@
 //! The definitions of every statistic, in words, as written into `report.json`.
 
-use crate::cli::Settings;
 use crate::report::{BootstrapDefinition, Definitions, Real};
+use crate::settings::Settings;
 
 /// Units.
 pub const UNITS: &str = "angles θ_P and percentiles in rad (the table also prints arcsec, 1 rad = 648000/π arcsec); tan θ_x, tan θ_y dimensionless; σ (member length standard deviation) in mm; slopes in rad/mm; stages a count";

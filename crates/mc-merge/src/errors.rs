@@ -8,31 +8,6 @@ use shard_record::ScanError;
 use std::fmt;
 use std::path::PathBuf;
 
-/// The process exit codes of `mc-merge` (also listed in the crate doc and `--help`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ExitCodes;
-
-impl ExitCodes {
-    /// The merge verified its input and wrote its report.
-    pub const OK: u8 = truss_exit::OK;
-    /// An internal error (a bug): for example the report could not be serialised.
-    pub const INTERNAL: u8 = truss_exit::INTERNAL;
-    /// The command line is wrong (unknown flag, bad number, percentile outside 0..100).
-    pub const USAGE: u8 = truss_exit::USAGE;
-    /// A file named on the command line is not a regular file (a FIFO, a device).
-    pub const INVALID_INPUT: u8 = truss_exit::INVALID_INPUT;
-    /// A file or directory could not be read or written.
-    pub const IO: u8 = truss_exit::IO;
-    /// The report directory holds another job's report (or a file that is not a report), a
-    /// link or a non-file at an output's name, or another process is writing it.
-    pub const IN_THE_WAY: u8 = truss_exit::IN_THE_WAY;
-    /// The shards do not verify: torn, corrupt, incomplete, another job, a wrong digest,
-    /// a missing range, or overlapping copies that disagree.
-    pub const VERIFICATION: u8 = truss_exit::VERIFICATION;
-    /// Failed samples are present and `--allow-failed` was not given.
-    pub const FAILED_SAMPLES: u8 = truss_exit::FAILED_SAMPLES;
-}
-
 /// A run of global sample indices `start..end` that no shard holds, inside one case.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
 pub struct MissingRange {
@@ -235,23 +210,36 @@ fn failed_message(total: u64, cases: &[FailedCase]) -> String {
 }
 
 impl MergeError {
-    /// The process exit code for this error (see [`ExitCodes`]).
+    /// The exit code of `mc-merge` for this error, in the scheme every truss-mc binary shares
+    /// (`truss-exit`; the crate doc and `--help` list what each code means here): the one
+    /// place a failure of a merge becomes a code.
     pub fn exit_code(&self) -> u8 {
+        use run_dir::RunDirError;
+        use truss_exit::{
+            FAILED_SAMPLES, IN_THE_WAY, INTERNAL, INVALID_INPUT, IO, USAGE, VERIFICATION,
+        };
         match self {
-            MergeError::Usage { .. } => ExitCodes::USAGE,
-            MergeError::Shard(ScanError::Io { .. }) | MergeError::Io { .. } => ExitCodes::IO,
+            MergeError::Usage { .. } => USAGE,
+            MergeError::Shard(ScanError::Io { .. })
+            | MergeError::Io { .. }
+            | MergeError::Plot { .. } => IO,
             MergeError::NoShards { .. }
             | MergeError::Shard(_)
             | MergeError::OtherJob { .. }
             | MergeError::HeaderMismatch { .. }
             | MergeError::OverlapDisagrees { .. }
             | MergeError::DuplicateDiffers { .. }
-            | MergeError::Missing { .. } => ExitCodes::VERIFICATION,
-            MergeError::FailedSamples { .. } => ExitCodes::FAILED_SAMPLES,
-            MergeError::Plot { .. } => ExitCodes::IO,
-            MergeError::InTheWay { .. } => ExitCodes::IN_THE_WAY,
-            MergeError::Files(e) => e.exit_code(),
-            MergeError::Internal { .. } => ExitCodes::INTERNAL,
+            | MergeError::Missing { .. } => VERIFICATION,
+            MergeError::FailedSamples { .. } => FAILED_SAMPLES,
+            MergeError::InTheWay { .. } => IN_THE_WAY,
+            MergeError::Files(files) => match files {
+                RunDirError::Io { .. } => IO,
+                RunDirError::Link { .. }
+                | RunDirError::NotAFile { .. }
+                | RunDirError::Locked { .. } => IN_THE_WAY,
+                RunDirError::NotRegular { .. } => INVALID_INPUT,
+            },
+            MergeError::Internal { .. } => INTERNAL,
         }
     }
 }

@@ -30,9 +30,9 @@
 //! shards, is refused before anything is read (usage, exit 2): it would destroy a shard, or
 //! (a `.jsonl` file) be taken for one by the next merge.
 
-use crate::Settings;
 use crate::errors::MergeError;
 use crate::load::{LoadOptions, load, shard_files};
+use crate::settings::{Options, Settings};
 use shard_record::Record;
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
@@ -186,20 +186,14 @@ fn check_destination(paths: &[PathBuf], files: &[PathBuf], to: &Path) -> Result<
     Ok(())
 }
 
-/// `mc-merge … --export FILE`: verifies and exports, printing the row count to `out`; with
-/// `--out` as well, then merges as usual.
-pub fn run(options: &crate::Options, to: &Path, out: &mut dyn Write) -> Result<(), MergeError> {
+/// `mc-merge … --export FILE`: verifies and exports, printing the row count to `out` (the
+/// command line then merges as usual when `--out` is given as well).
+pub fn run(options: &Options, to: &Path, out: &mut dyn Write) -> Result<(), MergeError> {
     let rows = export(&options.paths, &options.settings, to)?;
-    writeln!(out, "exported {rows} samples to {}", to.display()).map_err(|source| {
-        MergeError::Io {
-            path: PathBuf::from("<stdout>"),
-            source,
-        }
-    })?;
-    if options.out.is_some() {
-        crate::run(options, out)?;
-    }
-    Ok(())
+    writeln!(out, "exported {rows} samples to {}", to.display()).map_err(|source| MergeError::Io {
+        path: PathBuf::from("<stdout>"),
+        source,
+    })
 }
 
 /// The start of the range in a shard's header line.

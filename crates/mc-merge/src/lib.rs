@@ -16,9 +16,11 @@
 //! mc-merge man
 //! ```
 //!
-//! Every numeric flag has a documented limit, refused naming the flag ([`cli`]).
+//! Every numeric flag has a documented limit, refused naming the flag ([`settings`] for the
+//! statistics, [`cli`] for the rest).
 //!
-//! The binary is a thin shell around [`run`]; the statistics are reusable functions:
+//! The binary is a thin shell around [`execute`] (a helper command, an export, or [`run`]: the
+//! merge with its table and files); the statistics are reusable functions:
 //! [`quantile`] (definition-1 percentiles, weighted percentiles, order-statistic interval),
 //! [`bootstrap`] (split-invariant Poisson bootstrap, percentile and BCa intervals), [`rayleigh`]
 //! (fit, χ² intervals, eq. 28), [`gof`] (KS and AD with estimated scale), [`sweep`] (line fits,
@@ -71,8 +73,9 @@
 //! ## 4. Output
 //!
 //! With `--out REPORT_DIR`: `report.json` (schema in [`report`], summary below, and the
-//! standalone JSON Schema `docs/report.schema.json`), and SVG and PNG plots ([`plot`]),
-//! each written atomically and never through a link into a directory that holds no other
+//! standalone JSON Schema `docs/report.schema.json`), SVG and PNG plots ([`plot`]), and
+//! for people `report.md` and a self-contained `report.html` ([`readable`]: the same
+//! results with their units, the plots linked or embedded), each written atomically and never through a link into a directory that holds no other
 //! job's report and that no other merge is writing; a rerun removes only the files it listed
 //! in its manifest ([`report_dir`]).
 //! Unless `--quiet`: a table on stdout (angles in rad and arcsec). With `--export FILE`: every
@@ -121,7 +124,7 @@
 //! serialise NaN or ∞. Angles in rad, σ in mm. The report holds nothing that depends on the
 //! split or the file order, so it is byte-identical for any split.
 //!
-//! ## 5. Exit codes ([`ExitCodes`])
+//! ## 5. Exit codes ([`MergeError::exit_code`])
 //!
 //! The scheme every truss-mc binary shares (`truss-exit`):
 //!
@@ -156,18 +159,21 @@ pub mod gof;
 pub mod load;
 pub mod plot;
 pub mod rayleigh;
+pub mod readable;
 pub mod report;
 pub mod report_dir;
+pub mod settings;
 pub mod sweep;
 pub mod table;
 
 /// The statistics live in `truss-stats`, shared with the diagnosis.
 pub use truss_stats::{bootstrap, quantile, rng};
 
-pub use cli::{Args, Options, Settings};
-pub use errors::{ExitCodes, MergeError};
+pub use cli::Args;
+pub use errors::MergeError;
 pub use load::{Dataset, LoadOptions};
 pub use report::Report;
+pub use settings::{Options, Settings};
 
 use analysis::{CaseAnalysis, analyse_case};
 use gof::CalibrationCache;
@@ -249,8 +255,29 @@ pub fn report_json(report: &Report) -> Result<String, MergeError> {
     Ok(s)
 }
 
+/// Does what the command line asks, writing to `out`: a helper command, an export, or a
+/// merge (the table and the files written, nothing with `--quiet`).
+pub fn execute(args: Args, out: &mut dyn Write) -> Result<(), MergeError> {
+    if let Some(helper) = &args.command {
+        return helper.print(out);
+    }
+    let export = args.export.clone();
+    let quiet = args.quiet;
+    let options = args.validate()?;
+    let mut sink = std::io::sink();
+    let out: &mut dyn Write = if quiet { &mut sink } else { out };
+    if let Some(to) = &export {
+        export::run(&options, to, out)?;
+        if options.out.is_none() {
+            return Ok(());
+        }
+    }
+    run(&options, out).map(|_| ())
+}
+
 /// Runs a merge as the command line asks: verify, compute, print the table to `out`, and with
-/// a report directory write `report.json` and the plots ([`report_dir`]: the directory is
+/// a report directory write `report.json`, the plots, `report.md` and `report.html`
+/// ([`readable`]) ([`report_dir`]: the directory is
 /// locked, another job's report directory is refused, every file written atomically and
 /// never through a link, only our own earlier files removed).
 pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError> {
@@ -261,10 +288,14 @@ pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError>
         let mut files = report_dir::open(dir, &merge.report.job_id)?;
         let path = files.write(report_dir::REPORT_FILE, json.as_bytes())?;
         text.push_str(&format!("\nwrote {}\n", path.display()));
-        if options.plots {
-            for p in plot::draw_all(&mut files, &merge.dataset.cases, &merge.report)? {
-                text.push_str(&format!("wrote {}\n", p.display()));
-            }
+        let plots = if options.plots {
+            plot::draw_all(&mut files, &merge.dataset.cases, &merge.report)?
+        } else {
+            vec![]
+        };
+        let readable = readable::write(&mut files, &merge.report, &merge.dataset.writers, &plots)?;
+        for p in plots.iter().chain(&readable) {
+            text.push_str(&format!("wrote {}\n", p.display()));
         }
         files.finish()?;
     }

@@ -61,7 +61,7 @@ impl Default for LoadOptions {
         Self {
             allow_partial: false,
             allow_failed: false,
-            threads: crate::cli::default_threads(),
+            threads: crate::settings::default_threads(),
         }
     }
 }
@@ -236,6 +236,21 @@ pub struct Dataset {
     pub cases: Vec<CaseData>,
     /// The files read, in the order read.
     pub files: Vec<PathBuf>,
+    /// The programs that wrote the files, as their headers name them, in order.
+    pub writers: Vec<ShardWriter>,
+}
+
+/// A program that wrote shard files of the dataset, as the files' begin lines name it.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub struct ShardWriter {
+    /// The program (`mc-shard`).
+    pub program: String,
+    /// Its version.
+    pub program_version: String,
+    /// The shard format version it wrote.
+    pub format_version: u32,
+    /// How many of the files it wrote.
+    pub files: usize,
 }
 
 impl Dataset {
@@ -590,6 +605,7 @@ pub fn load(files: &[PathBuf], options: LoadOptions) -> Result<Dataset, MergeErr
     }
     // 1. Headers, in file order: one job, the same cases.
     let mut reference: Option<Reference> = None;
+    let mut writers: std::collections::BTreeMap<(String, String, u32), usize> = Default::default();
     for path in files {
         let Some(begin) = peek_header(path)? else {
             // Let the strict reader name what is wrong with the header.
@@ -600,6 +616,13 @@ pub fn load(files: &[PathBuf], options: LoadOptions) -> Result<Dataset, MergeErr
                 message: "unreadable begin line".into(),
             }));
         };
+        *writers
+            .entry((
+                begin.program.clone(),
+                begin.program_version.clone(),
+                begin.format_version,
+            ))
+            .or_default() += 1;
         match &reference {
             None => {
                 reference = Some(Reference {
@@ -721,6 +744,17 @@ pub fn load(files: &[PathBuf], options: LoadOptions) -> Result<Dataset, MergeErr
         job_samples: reference.begin.job_samples,
         cases,
         files: files.to_vec(),
+        writers: writers
+            .into_iter()
+            .map(
+                |((program, program_version, format_version), files)| ShardWriter {
+                    program,
+                    program_version,
+                    format_version,
+                    files,
+                },
+            )
+            .collect(),
     };
     check_coverage(&data, options)?;
     Ok(data)

@@ -4,8 +4,8 @@
 //! string beside it. Numbers go through [`Real`], whose serialisation refuses NaN and ±∞, so a
 //! non-finite value can never reach the file silently (serde_json would write it as `null`).
 
-use crate::cli::Settings;
 use crate::errors::MissingRange;
+use crate::settings::Settings;
 use serde::Serialize;
 use serde::ser::{Error as _, Serializer};
 use std::collections::BTreeMap;

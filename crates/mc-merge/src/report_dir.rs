@@ -5,10 +5,10 @@
 //! - **Locked.** The directory is locked while a merge writes it (an OS advisory lock on
 //!   `.truss-mc.lock`, the kind the shards use); a second merge into it is refused at once
 //!   (exit 5), naming the holder's pid: wait for the first, then run again.
-//! - **Never through a link.** Every file (`report.json`, each plot) is written to a
-//!   temporary file with an unpredictable name in the directory, flushed to disk and renamed
-//!   over the old one: a reader, a crash or a full disk sees the old file or the new one,
-//!   never a torn file. A symbolic link, or anything but a regular file, at a name we write
+//! - **Never through a link.** Every file (`report.json`, each plot, `report.md`,
+//!   `report.html`) is written to a temporary file with an unpredictable name in the
+//!   directory, flushed to disk and renamed over the old one: a reader, a crash or a full
+//!   disk sees the old file or the new one, never a torn file. A symbolic link, or anything but a regular file, at a name we write
 //!   is refused (exit 5), naming it; the file it points at is not touched.
 //! - **Reused only for the same job.** If the directory holds a `report.json` of another
 //!   job, or one that is not an mc-merge report, the merge is refused (exit 5) and nothing

@@ -28,10 +28,11 @@
 //! is the point's own interval divided by the reference value, as the error bars of Fig. 9.
 
 use crate::analysis::{CaseAnalysis, replicate_interval};
-use crate::cli::{ARCSEC_PER_RAD, Settings};
 use crate::report::*;
+use crate::settings::Settings;
 use shard_record::parameters::{SIGMA, STAGES};
 use std::collections::BTreeMap;
+use truss_units::ARCSEC_PER_RAD;
 
 /// A least-squares fit's numbers.
 #[derive(Debug, Clone, Copy, PartialEq)]

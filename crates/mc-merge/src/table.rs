@@ -1,9 +1,9 @@
 //! The readable summary printed on stdout: one row per case, then the sweeps and the allowable σ.
 //! Angles in rad and arcsec.
 
-use crate::cli::ARCSEC_PER_RAD;
 use crate::report::{Figure, Report, short};
 use std::fmt::Write;
+use truss_units::ARCSEC_PER_RAD;
 
 fn rad(x: f64) -> String {
     format!("{x:.3e}")

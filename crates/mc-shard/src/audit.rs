@@ -126,18 +126,38 @@ pub enum AuditError {
     /// written.
     #[error(transparent)]
     Files(#[from] run_dir::RunDirError),
+    /// The audit found lines that differ from their re-solve ([`AuditReport::verdict`]).
+    #[error("audit: {} of {checked} re-solved lines differ from the shards (verification failed; details in {}): {}", .mismatches.len(), .report.display(), .mismatches.iter().take(5).map(|m| format!("{}:{}: index {} (case {:?}, sample {})", m.file.display(), m.line, m.index, m.case, m.sample)).collect::<Vec<_>>().join("; "))]
+    Mismatch {
+        /// The lines that differ.
+        mismatches: Vec<Mismatch>,
+        /// Lines compared.
+        checked: u64,
+        /// The audit.json written.
+        report: PathBuf,
+    },
 }
 
-impl AuditError {
-    /// The exit code (see `truss_exit`).
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            AuditError::Scan(ScanError::Io { .. }) | AuditError::Io { .. } => truss_exit::IO,
-            AuditError::Scan(_) | AuditError::NoShards(_) => truss_exit::VERIFICATION,
-            AuditError::OtherJob { .. } => truss_exit::IN_THE_WAY,
-            AuditError::Samples(_) => truss_exit::USAGE,
-            AuditError::Files(e) => e.exit_code(),
+impl AuditReport {
+    /// The audit's summary line; a line that differs from its re-solve is an error
+    /// ([`AuditError::Mismatch`]).
+    pub fn verdict(&self) -> Result<String, AuditError> {
+        if !self.mismatches.is_empty() {
+            return Err(AuditError::Mismatch {
+                mismatches: self.mismatches.clone(),
+                checked: self.samples_checked,
+                report: self.written_to.clone(),
+            });
         }
+        Ok(format!(
+            "audit: {} of {} sample lines in {} file(s) re-solved in {:.2} s (seed {}): all byte-identical; {}",
+            self.samples_checked,
+            self.lines_in_shards,
+            self.files.len(),
+            self.seconds,
+            self.seed,
+            self.written_to.display()
+        ))
     }
 }
 

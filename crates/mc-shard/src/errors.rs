@@ -1,5 +1,7 @@
-//! Errors of mc-shard, each carrying what is needed to find the fault.
+//! Errors of mc-shard's runner, each carrying what is needed to find the fault (the errors of
+//! a command, and their exit codes, are [`crate::commands`]').
 
+use run_dir::RunDirError;
 use std::path::PathBuf;
 use truss_job::JobError;
 
@@ -85,7 +87,6 @@ impl ShardError {
     /// Whether the file is in the way in a way a rerun does not cure (damaged, another job's,
     /// not a shard, a link or a non-file at its name): a cron worker sets such a shard aside.
     pub fn is_damage(&self) -> bool {
-        use run_dir::RunDirError;
         matches!(
             self,
             ShardError::Corrupt(_)

@@ -19,8 +19,12 @@
 //!
 //! ## Commands (see `mc-shard --help`)
 //!
+//! Their flags are parsed in [`cli`]; what each does, and the exit code of each failure
+//! ([`commands::exit_code`]), is [`commands`]'.
+//!
 //! - `mc-shard plan --job JOB.json` — job id, cases, sample count, an estimate of the CPU time and
-//!   a suggestion: this machine, and a cluster split only for a job of more than ten minutes.
+//!   a suggestion: this machine, and a cluster split only for a job of more than ten minutes
+//!   ([`plan`]).
 //! - `mc-shard run --job JOB.json --out DIR [--shard I/K | --range A..B] [--threads T]` —
 //!   one shard (selection in [`select`]); crash-safe and resumable ([`shard`]).
 //! - `mc-shard reproduce --job JOB.json --case NAME --sample K [--detail]` — the exact line
@@ -67,9 +71,11 @@
 pub mod audit;
 pub mod batch;
 pub mod cli;
+pub mod commands;
 pub mod errors;
 pub mod inputs;
 pub mod interrupt;
+pub mod plan;
 pub mod progress;
 pub mod reproduce;
 pub mod runner;

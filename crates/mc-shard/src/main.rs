@@ -1,17 +1,18 @@
 //! `mc-shard`: see the library's crate doc and `mc-shard --help`.
 
 use clap::Parser;
+use mc_shard::commands::{CommandError, exit_code};
 
 fn main() -> std::process::ExitCode {
     let cli = mc_shard::cli::Cli::parse();
     let mut out = truss_exit::Stdout::lock();
-    match mc_shard::cli::run(cli, &mut out) {
+    match mc_shard::commands::run(cli, &mut out) {
         Ok(()) => truss_exit::success("mc-shard", &mut out),
         // "interrupted: N samples kept; rerun …" is a notice, not an error.
-        Err(e @ mc_shard::cli::CliError::Interrupted { .. }) => {
+        Err(e @ CommandError::Interrupted { .. }) => {
             eprintln!("{e}");
-            std::process::ExitCode::from(e.exit_code())
+            std::process::ExitCode::from(exit_code(&e))
         }
-        Err(e) => truss_exit::finish("mc-shard", &e, e.exit_code(), &out),
+        Err(e) => truss_exit::finish("mc-shard", &e, exit_code(&e), &out),
     }
 }

@@ -61,3 +61,17 @@ pub fn shard_states(
         })
         .collect())
 }
+/// The sample lines in the shard files of the `shards` shards of `job` in `dir` (complete
+/// or partial): what a rerun keeps.
+pub fn kept_samples(job: &Job, dir: &std::path::Path, shards: u64) -> u64 {
+    shard_states(job, dir, shards).map_or(0, |states| {
+        states
+            .iter()
+            .map(|(r, s)| match s {
+                ShardState::Complete => r.len(),
+                ShardState::Partial(n) => *n,
+                ShardState::Missing | ShardState::Bad(_) | ShardState::Quarantined(_) => 0,
+            })
+            .sum()
+    })
+}

@@ -46,19 +46,6 @@ pub enum RunDirError {
 }
 
 impl RunDirError {
-    /// The exit code (`truss-exit`): 4 for an I/O failure, 5 for a file in the way (a link,
-    /// something else at an output's name, a locked directory), 3 for an input that is not
-    /// a regular file.
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            RunDirError::Io { .. } => truss_exit::IO,
-            RunDirError::Link { .. }
-            | RunDirError::NotAFile { .. }
-            | RunDirError::Locked { .. } => truss_exit::IN_THE_WAY,
-            RunDirError::NotRegular { .. } => truss_exit::INVALID_INPUT,
-        }
-    }
-
     /// An I/O error on `path`.
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         RunDirError::Io {

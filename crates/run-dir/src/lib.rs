@@ -26,9 +26,10 @@
 //!   and a device (`/dev/zero`) never ends; both are refused before they are opened
 //!   ([`RunDirError::NotRegular`]). Each reader documents its own size limit.
 //!
-//! Every error names the path and maps to the workspace's exit codes
-//! ([`RunDirError::exit_code`]): an I/O failure is 4, a file in the way (a link, a foreign
-//! file, a locked directory) 5, an input that is not a regular file 3.
+//! Every error names the path and says what kind of failure it is ([`RunDirError`]): an I/O
+//! failure, a file in the way (a link, a foreign file, a locked directory), or an input that
+//! is not a regular file. Each binary maps them to the workspace's exit codes (4, 5 and 3 of
+//! `truss-exit`) in its one exit-code function.
 
 pub mod errors;
 pub mod input;

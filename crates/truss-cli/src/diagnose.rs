@@ -1,11 +1,10 @@
 //! `truss diagnose` and `truss synth-measured`: argument parsing over the `truss_diagnose`
 //! library, which does the work.
 
-use crate::{CliError, EXIT_BAD_MODEL, EXIT_IO, EXIT_SOLVE_FAILED, EXIT_USAGE};
+use crate::CliError;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
-use truss_diagnose::DiagnoseError;
 
 /// Options of `truss diagnose`.
 #[derive(Debug, Args)]
@@ -72,21 +71,6 @@ pub struct SynthArgs {
     /// Also write measured member length errors to this CSV.
     #[arg(long)]
     pub members_out: Option<PathBuf>,
-}
-
-/// The exit code of a diagnosis error (see the crate doc).
-pub fn exit_code(e: &DiagnoseError) -> u8 {
-    if let DiagnoseError::Files(e) = e {
-        return e.exit_code();
-    }
-    if e.is_io() {
-        return EXIT_IO;
-    }
-    match e {
-        DiagnoseError::Usage(_) | DiagnoseError::NoCase { .. } => EXIT_USAGE,
-        DiagnoseError::Simulation { .. } => EXIT_SOLVE_FAILED,
-        _ => EXIT_BAD_MODEL,
-    }
 }
 
 /// Runs `truss diagnose`; prints the verdict and the files written.

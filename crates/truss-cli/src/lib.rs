@@ -1,5 +1,5 @@
-//! The `truss` command: generate the paper's prism, solve a model file, and (see the
-//! `diagnose` issue) compare simulation with measurements.
+//! The `truss` command: generate the paper's prism, solve a model file, compare simulation
+//! with measurements, and allocate member-length tolerances.
 //!
 //! ## Commands
 //!
@@ -30,7 +30,8 @@
 //!
 //! ## Exit codes
 //!
-//! The scheme every truss-mc binary shares (`truss-exit`):
+//! The scheme every truss-mc binary shares (`truss-exit`), mapped from the errors in one
+//! place ([`exit_code`]):
 //!
 //! | code | meaning |
 //! |---|---|
@@ -44,22 +45,15 @@
 //! | 7 | the solve failed (not converged, mechanism; the JSON result says why), or a diagnosis's simulation failed |
 
 pub mod diagnose;
+pub mod errors;
 pub mod solve;
 pub mod tolerance;
 
+pub use errors::{CliError, exit_code};
+
 use clap::{Args, Parser, Subcommand};
 use std::io::Write;
-use std::path::PathBuf;
 use truss_core::prism::{BacklashOptions, PrismOptions, TABLE1_DIAGONAL_LENGTH};
-
-/// Exit code: the solve failed.
-pub const EXIT_SOLVE_FAILED: u8 = truss_exit::FAILED_SAMPLES;
-/// Exit code: bad arguments.
-pub const EXIT_USAGE: u8 = truss_exit::USAGE;
-/// Exit code: invalid model, job or measured data.
-pub const EXIT_BAD_MODEL: u8 = truss_exit::INVALID_INPUT;
-/// Exit code: I/O error.
-pub const EXIT_IO: u8 = truss_exit::IO;
 
 /// Generate, solve and diagnose truss models. Units: mm, N, MPa, rad.
 #[derive(Debug, Parser)]
@@ -85,7 +79,7 @@ pub enum Command {
         kind: ModelKind,
     },
     /// Solve a model file's equilibrium and print the result as JSON.
-    Solve(SolveArgs),
+    Solve(solve::SolveArgs),
     /// Compare measured trusses with a job case's simulation: where they disagree, which
     /// effect is missing (fitted), the updated job, and the gap before and after.
     Diagnose(diagnose::DiagnoseArgs),
@@ -203,62 +197,6 @@ impl PrismArgs {
                 compression_ratio: self.joint_compression_ratio,
             }),
         }
-    }
-}
-
-/// Options of `truss solve`.
-#[derive(Debug, Args)]
-pub struct SolveArgs {
-    /// The model file.
-    pub model: PathBuf,
-    /// A member's length error, `ID=MM` (natural length = the model's + MM); repeatable.
-    #[arg(long = "length-error", value_name = "ID=MM")]
-    pub length_errors: Vec<String>,
-    /// Record and print every Newton iteration.
-    #[arg(long)]
-    pub iterations: bool,
-}
-
-/// What went wrong, classified for the exit code.
-#[derive(Debug, thiserror::Error)]
-pub enum CliError {
-    /// Bad arguments.
-    #[error("{0}")]
-    Usage(String),
-    /// An invalid model.
-    #[error(transparent)]
-    Model(truss_core::ModelError),
-    /// The solve failed (the JSON result was printed).
-    #[error("the solve failed: {0}")]
-    Solve(truss_core::SolveError),
-    /// Output could not be written.
-    #[error("cannot write output: {0}")]
-    Io(#[from] std::io::Error),
-    /// A diagnosis (or synthetic measurement) failed.
-    #[error(transparent)]
-    Diagnose(#[from] truss_diagnose::DiagnoseError),
-    /// A tolerance study failed.
-    #[error(transparent)]
-    Tolerance(#[from] truss_tolerance::ToleranceError),
-}
-
-impl From<truss_core::ModelError> for CliError {
-    fn from(e: truss_core::ModelError) -> Self {
-        CliError::Model(e)
-    }
-}
-
-/// The exit code for an error (see the crate doc).
-pub fn exit_code(e: &anyhow::Error) -> u8 {
-    match e.downcast_ref::<CliError>() {
-        Some(CliError::Usage(_)) => EXIT_USAGE,
-        Some(CliError::Model(truss_core::ModelError::Io { .. })) | Some(CliError::Io(_)) => EXIT_IO,
-        Some(CliError::Model(_)) => EXIT_BAD_MODEL,
-        Some(CliError::Solve(_)) => EXIT_SOLVE_FAILED,
-        Some(CliError::Diagnose(e)) => diagnose::exit_code(e),
-        Some(CliError::Tolerance(e)) => tolerance::exit_code(e),
-        // Anything unclassified is a bug, not an I/O error.
-        None => truss_exit::INTERNAL,
     }
 }
 

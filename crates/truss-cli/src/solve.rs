@@ -23,11 +23,26 @@
 //! in model order. The angles are absent when the model names no top surface. A failed
 //! solve prints `"converged": false` with `"error"`, and exits with code 7 (failed samples).
 
-use crate::{CliError, SolveArgs};
+use crate::CliError;
+use clap::Args;
 use serde::Serialize;
 use std::io::Write;
+use std::path::PathBuf;
 use truss_core::output::{EquilibriumById, IterationLine, UNITS, Units};
 use truss_core::{Model, SolveOptions, Solver};
+
+/// Options of `truss solve`.
+#[derive(Debug, Args)]
+pub struct SolveArgs {
+    /// The model file.
+    pub model: PathBuf,
+    /// A member's length error, `ID=MM` (natural length = the model's + MM); repeatable.
+    #[arg(long = "length-error", value_name = "ID=MM")]
+    pub length_errors: Vec<String>,
+    /// Record and print every Newton iteration.
+    #[arg(long)]
+    pub iterations: bool,
+}
 
 /// The JSON printed by `truss solve`.
 #[derive(Debug, Serialize)]

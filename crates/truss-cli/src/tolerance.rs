@@ -1,11 +1,10 @@
 //! `truss tolerance`: argument parsing over the `truss_tolerance` library, which does the
 //! work (sensitivity shares, the cheapest per-group σ for a θ_P budget, its verification).
 
-use crate::{CliError, EXIT_BAD_MODEL, EXIT_IO, EXIT_SOLVE_FAILED, EXIT_USAGE};
+use crate::CliError;
 use clap::Args;
 use std::io::Write;
 use std::path::PathBuf;
-use truss_tolerance::ToleranceError;
 
 /// Options of `truss tolerance`.
 #[derive(Debug, Args)]
@@ -46,20 +45,6 @@ pub struct ToleranceArgs {
     /// No progress on stderr.
     #[arg(long)]
     pub quiet: bool,
-}
-
-/// The exit code of a tolerance error (see the crate doc).
-pub fn exit_code(e: &ToleranceError) -> u8 {
-    match e {
-        ToleranceError::Job(e) if e.is_io() => EXIT_IO,
-        ToleranceError::Files(e) => e.exit_code(),
-        ToleranceError::Write { .. } | ToleranceError::Plot { .. } => EXIT_IO,
-        e if e.is_usage() => EXIT_USAGE,
-        ToleranceError::FailedSamples { .. } => EXIT_SOLVE_FAILED,
-        ToleranceError::Verification { .. } => truss_exit::VERIFICATION,
-        ToleranceError::Statistics(_) => truss_exit::INTERNAL,
-        _ => EXIT_BAD_MODEL,
-    }
 }
 
 /// Runs `truss tolerance`; prints the allocation and the files written.

@@ -31,28 +31,18 @@
 //! ([`ActiveSetFailure::LargeSlackSet`]).
 
 use crate::capacitance::Capacitance;
-use crate::structure::Structure;
+use crate::structure::{CableBasis, Structure};
 
-/// Woodbury data for one model: `Z = K₀⁻¹B` and `G = BᵀK₀⁻¹B` over its cables.
-#[derive(Debug, Clone)]
-pub(crate) struct CableBasis {
-    /// Member index of each cable.
-    pub cables: Vec<usize>,
-    /// `Z`, column per cable, each of length `free`.
-    pub z: Vec<f64>,
-    /// `G`, row-major `n_c × n_c`.
-    pub g: Vec<f64>,
-    /// `Gᵀ`, row-major (the columns of `G`, which rounding leaves not quite symmetric).
-    pub g_t: Vec<f64>,
-    /// `1/((1 − r_c)·k_c)` per cable, with nominal `k_c` \[mm/N\].
-    pub w_inv: Vec<f64>,
-    /// `σ_c` per cable: +1 tension-only (slack when `e < 0`), −1 compression-only (slack
-    /// when `e > 0`).
-    pub sense: Vec<f64>,
-    /// The largest slack set solved by the capacitance matrix: `⌊∛(3·n·b²)⌋`, where its
-    /// Cholesky (`|S|³/6` multiply–adds) costs as much as the banded one of `K_S` (`n·b²/2`,
-    /// `n` unknowns, `b = 3·(q + 1)` rows of band for `q` block off-diagonals).
-    pub max_slack: usize,
+/// Adds `scale·b_m` to `v` (`v` has the zero slot at index `free`).
+#[inline(always)]
+pub(crate) fn scatter_b(s: &Structure, m: usize, scale: f64, v: &mut [f64]) {
+    s.members[m].scatter_b(s.free, scale, v);
+}
+
+/// `b_mᵀ v` (`v` may omit the zero slot).
+#[inline(always)]
+pub(crate) fn gather_b(s: &Structure, m: usize, v: &[f64]) -> f64 {
+    s.members[m].gather_b(s.free, v)
 }
 
 /// A slack set whose capacitance matrix has a pivot below this fraction of its diagonal
@@ -60,104 +50,6 @@ pub(crate) struct CableBasis {
 /// stiffness of the member forces, absent from `K_S`, matters: chord steps with `K_S` do not
 /// converge there, so the solver goes straight to the true tangent.
 pub(crate) const SOFT_PIVOT_RATIO: f64 = 1e-3;
-
-/// Models with more cables than this solve each piece by factorising `K_S` instead: the
-/// capacitance matrix would cost more than the banded factorisation.
-pub(crate) const MAX_WOODBURY_CABLES: usize = 96;
-
-impl CableBasis {
-    /// Precomputes `Z` and `G` with the factorised `K₀` of `s`.
-    pub fn new(s: &Structure) -> Self {
-        let n = s.free;
-        let cables: Vec<usize> = (0..s.members.len())
-            .filter(|&m| s.members[m].is_cable)
-            .collect();
-        let nc = cables.len();
-        let mut z = vec![0.0; n * nc];
-        let mut w_inv = vec![0.0; nc];
-        let mut col = vec![0.0; n + 1];
-        for (k, &m) in cables.iter().enumerate() {
-            col.fill(0.0);
-            scatter_b(s, m, 1.0, &mut col);
-            s.nominal.solve_in_place(&mut col[..n]);
-            z[k * n..(k + 1) * n].copy_from_slice(&col[..n]);
-            let c = &s.members[m];
-            w_inv[k] = c.natural_length / ((1.0 - c.compression_ratio) * c.rigidity);
-        }
-        let mut g = vec![0.0; nc * nc];
-        for (a, &ma) in cables.iter().enumerate() {
-            for b in 0..nc {
-                g[a * nc + b] = gather_b(s, ma, &z[b * n..(b + 1) * n]);
-            }
-        }
-        let mut g_t = vec![0.0; nc * nc];
-        for a in 0..nc {
-            for b in 0..nc {
-                g_t[b * nc + a] = g[a * nc + b];
-            }
-        }
-        let sense = cables.iter().map(|&m| s.members[m].sense).collect();
-        let band = 3.0 * (s.bandwidth() as f64 + 1.0);
-        let max_slack = (3.0 * n as f64 * band * band).cbrt().floor() as usize;
-        Self {
-            cables,
-            z,
-            g,
-            g_t,
-            w_inv,
-            sense,
-            max_slack,
-        }
-    }
-}
-
-/// Adds `scale·b_m` to `v` (`v` has the zero slot at index `free`).
-#[inline(always)]
-pub(crate) fn scatter_b(s: &Structure, m: usize, scale: f64, v: &mut [f64]) {
-    let c = &s.members[m];
-    let n = &c.unit;
-    if c.link.masked {
-        for k in 0..3 {
-            v[c.link.dofs[k]] -= scale * n[k];
-            v[c.link.dofs[3 + k]] += scale * n[k];
-        }
-        v[s.free] = 0.0;
-        return;
-    }
-    let f = [scale * n[0], scale * n[1], scale * n[2]];
-    let (blocks, _) = v[..s.free].as_chunks_mut::<3>();
-    if let Some(x) = blocks.get_mut(c.link.ends[0]) {
-        for (x, f) in x.iter_mut().zip(&f) {
-            *x -= f;
-        }
-    }
-    if let Some(x) = blocks.get_mut(c.link.ends[1]) {
-        for (x, f) in x.iter_mut().zip(&f) {
-            *x += f;
-        }
-    }
-}
-
-/// `b_mᵀ v` (`v` may omit the zero slot).
-#[inline(always)]
-pub(crate) fn gather_b(s: &Structure, m: usize, v: &[f64]) -> f64 {
-    let c = &s.members[m];
-    let mut sum = 0.0;
-    if c.link.masked {
-        let at = |d: usize| if d < s.free { v[d] } else { 0.0 };
-        for k in 0..3 {
-            sum += c.unit[k] * (at(c.link.dofs[3 + k]) - at(c.link.dofs[k]));
-        }
-        return sum;
-    }
-    let (blocks, _) = v[..s.free].as_chunks::<3>();
-    let vi = blocks.get(c.link.ends[0]).copied().unwrap_or([0.0; 3]);
-    let vj = blocks.get(c.link.ends[1]).copied().unwrap_or([0.0; 3]);
-    for k in 0..3 {
-        sum += c.unit[k] * (vj[k] - vi[k]);
-    }
-    sum
-}
 
 /// The per-sample state of the active-set method: the slack set and its factorised
 /// capacitance matrix, which together apply `K_S⁻¹`.

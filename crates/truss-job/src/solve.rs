@@ -135,7 +135,16 @@ impl<'j> SampleSolver<'j> {
                     | SolveError::NonFinite { iteration, .. } => *iteration,
                     SolveError::Input(_) => 0,
                 },
-                Outcome::Failed(e.to_string()),
+                Outcome::Failed(if case.structure.near_the_limit() {
+                    format!(
+                        "{e} (the model's slack cables are solved at their limit, ratio 0, and \
+                         a stage held by them alone may have no resolved position: an explicit \
+                         compression_ratio such as 1e-4 regularises it; see the README, \
+                         \"Slack cables\")"
+                    )
+                } else {
+                    e.to_string()
+                }),
             ),
         };
         SampleResult {

@@ -30,4 +30,5 @@
 //! completions and man page.
 
 pub mod cli;
+pub mod commands;
 pub mod run_all;

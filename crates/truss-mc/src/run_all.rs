@@ -33,9 +33,10 @@
 //! rerun the same command to resume" and exits 130 (SIGINT) or 143 (SIGTERM). No child
 //! outlives it.
 
-use mc_shard::cli::kept_samples;
+use mc_shard::commands::CommandError;
 use mc_shard::interrupt::Signal;
 use mc_shard::progress::Progress;
+use mc_shard::status::kept_samples;
 use mc_shard::{Job, RunError};
 use shard_record::ShardRange;
 use std::io::Write;
@@ -46,16 +47,14 @@ use std::time::Duration;
 /// Why `run-all` stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum RunAllError {
-    /// The job, the shard directory or the arguments.
+    /// The job, the shard directory or the arguments; or the audit before the merge, which
+    /// could not be completed or found lines that differ from their re-solve.
     #[error(transparent)]
-    Run(#[from] RunError),
+    Shard(#[from] CommandError),
     /// Shard processes failed (each with its exit code and stderr); the code `run-all`
     /// exits with and the advice follow from the children's codes ([`worker_failure`]).
     #[error("{} shard process(es) failed: {}; {}", .0.len(), .0.iter().map(|(_, m)| m.as_str()).collect::<Vec<_>>().join("; "), worker_failure(.0).1)]
     Workers(Vec<(u8, String)>),
-    /// The audit before the merge could not be completed, or found lines that differ.
-    #[error("{0}")]
-    Audit(mc_shard::cli::CliError),
     /// The merge failed.
     #[error("merge failed: {0}{hint}", hint = merge_hint(.0))]
     Merge(mc_merge::MergeError),
@@ -112,9 +111,15 @@ pub fn worker_failure(failures: &[(u8, String)]) -> (u8, &'static str) {
     }
 }
 
+impl From<RunError> for RunAllError {
+    fn from(e: RunError) -> Self {
+        RunAllError::Shard(e.into())
+    }
+}
+
 /// What `run-all` adds to a merge error: for failed samples, that it takes `--allow-failed`.
 fn merge_hint(e: &mc_merge::MergeError) -> &'static str {
-    if e.exit_code() == truss_exit::FAILED_SAMPLES {
+    if matches!(e, mc_merge::MergeError::FailedSamples { .. }) {
         " (run-all takes --allow-failed too: rerun the same command with it; the finished shards are kept)"
     } else {
         ""
@@ -244,11 +249,10 @@ async fn run_and_merge(
         };
         let (job, out) = (job.clone(), options.out.clone());
         let auditing = tokio::task::spawn_blocking(move || {
-            let report = mc_shard::audit::audit(&job, &[out], &audit_options)
-                .map_err(|e| RunAllError::Audit(e.into()))?;
-            let mut line = Vec::new();
-            mc_shard::cli::audit_result(&report, &mut line).map_err(RunAllError::Audit)?;
-            Ok::<_, RunAllError>(line)
+            let report =
+                mc_shard::audit::audit(&job, &[out], &audit_options).map_err(CommandError::from)?;
+            let verdict = report.verdict().map_err(CommandError::from)?;
+            Ok::<_, RunAllError>(format!("{verdict}\n").into_bytes())
         });
         tokio::select! {
             done = auditing => match done {

@@ -93,6 +93,3 @@ pub mod verify;
 
 pub use errors::ToleranceError;
 pub use study::{Options, Tolerance, run};
-
-/// Arcseconds per radian.
-pub const ARCSEC_PER_RAD: f64 = 180.0 * 3600.0 / std::f64::consts::PI;

@@ -1,4 +1,5 @@
-//! SVG plots of the variance shares:
+//! SVG plots of the variance shares, in the plot style every truss-mc plot shares
+//! (`truss-plot`):
 //!
 //! Shares span many decades (a fixed bottom batten moves nothing), so the share axes are
 //! logarithmic.
@@ -15,22 +16,19 @@ use crate::study::Tolerance;
 use plotters::prelude::*;
 use run_dir::OutputDir;
 use std::path::PathBuf;
+use truss_plot::frame::{captioned, render, styled_mesh};
+use truss_plot::legend::{Legend, Swatch};
+use truss_plot::style::{CHART_HEIGHT, WIDTH, palette, sub, subscript_svg};
 
-type PlotResult = Result<(), Box<dyn std::error::Error>>;
+type Drawn = Result<String, Box<dyn std::error::Error>>;
 
-const SIZE: (u32, u32) = (960, 600);
-const FONT: &str = "sans-serif";
-
-fn palette(i: usize) -> RGBColor {
-    const C: [RGBColor; 6] = [
-        RGBColor(200, 30, 30),
-        RGBColor(30, 90, 200),
-        RGBColor(20, 140, 60),
-        RGBColor(150, 60, 170),
-        RGBColor(220, 130, 0),
-        RGBColor(0, 150, 160),
-    ];
-    C[i % C.len()]
+/// What the share axes measure.
+fn share_axis() -> String {
+    format!(
+        "share of Var tan {} + Var tan {} [-] (95 % interval, log scale)",
+        sub("θ", "x"),
+        sub("θ", "y")
+    )
 }
 
 fn whisker(x: f64, lo: f64, hi: f64, half: f64, c: RGBColor) -> Vec<PathElement<(f64, f64)>> {
@@ -41,9 +39,7 @@ fn whisker(x: f64, lo: f64, hi: f64, half: f64, c: RGBColor) -> Vec<PathElement<
     ]
 }
 
-fn groups_plot(svg: &mut String, t: &Tolerance) -> PlotResult {
-    let root = SVGBackend::with_string(svg, SIZE).into_drawing_area();
-    root.fill(&WHITE)?;
+fn groups_plot(t: &Tolerance) -> Drawn {
     let nl = t.sensitivity.nonlinear;
     let mut bars: Vec<(String, f64, (f64, f64))> = t
         .groups
@@ -55,48 +51,42 @@ fn groups_plot(svg: &mut String, t: &Tolerance) -> PlotResult {
     let (bottom, top) = log_range(&values);
     let n = bars.len();
     let labels: Vec<String> = bars.iter().map(|b| b.0.clone()).collect();
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("Share of the tilt's variance per group, case {}", t.case),
-            (FONT, 20),
-        )
-        .margin(14)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d(-0.5..(n as f64 - 0.5), (bottom..top).log_scale())?;
-    chart
-        .configure_mesh()
-        .disable_x_mesh()
-        .x_labels(n)
-        .x_label_formatter(&|x| {
-            let i = x.round();
-            if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
-                labels[i as usize].clone()
+    let caption = format!("Share of the tilt's variance per group, case {}", t.case);
+    render(WIDTH, CHART_HEIGHT, &Legend::default(), |_, area| {
+        let mut chart = captioned(area, caption)
+            .build_cartesian_2d(-0.5..(n as f64 - 0.5), (bottom..top).log_scale())?;
+        styled_mesh(&mut chart.configure_mesh())
+            .disable_x_mesh()
+            .x_labels(n)
+            .x_label_formatter(&|x| {
+                let i = x.round();
+                if (x - i).abs() < 1e-6 && i >= 0.0 && (i as usize) < labels.len() {
+                    labels[i as usize].clone()
+                } else {
+                    String::new()
+                }
+            })
+            .y_desc(share_axis())
+            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .draw()?;
+        let clamp = |v: f64| v.max(bottom);
+        for (i, (_, v, (lo, hi))) in bars.iter().enumerate() {
+            let c = if i + 1 == n {
+                RGBColor(150, 150, 150)
             } else {
-                String::new()
+                palette(i)
+            };
+            let x = i as f64;
+            chart.draw_series(std::iter::once(Rectangle::new(
+                [(x - 0.3, bottom), (x + 0.3, clamp(*v))],
+                c.mix(0.6).filled(),
+            )))?;
+            if lo.is_finite() && hi.is_finite() {
+                chart.draw_series(whisker(x, clamp(*lo), clamp(*hi), 0.1, BLACK))?;
             }
-        })
-        .y_desc("share of Var tan θ_x + Var tan θ_y [-] (95 % interval, log scale)")
-        .y_label_formatter(&|y| format!("{y:.0e}"))
-        .draw()?;
-    let clamp = |v: f64| v.max(bottom);
-    for (i, (_, v, (lo, hi))) in bars.iter().enumerate() {
-        let c = if i + 1 == n {
-            RGBColor(150, 150, 150)
-        } else {
-            palette(i)
-        };
-        let x = i as f64;
-        chart.draw_series(std::iter::once(Rectangle::new(
-            [(x - 0.3, bottom), (x + 0.3, clamp(*v))],
-            c.mix(0.6).filled(),
-        )))?;
-        if lo.is_finite() && hi.is_finite() {
-            chart.draw_series(whisker(x, clamp(*lo), clamp(*hi), 0.1, BLACK))?;
         }
-    }
-    root.present()?;
-    Ok(())
+        Ok(())
+    })
 }
 
 /// A log axis's range covering the positive `values` (a decade's margin below, 50 % above);
@@ -119,9 +109,7 @@ fn stage_position(id: &str) -> Option<(f64, f64)> {
     Some((stage, position))
 }
 
-fn members_plot(svg: &mut String, t: &Tolerance) -> PlotResult {
-    let root = SVGBackend::with_string(svg, SIZE).into_drawing_area();
-    root.fill(&WHITE)?;
+fn members_plot(t: &Tolerance) -> Drawn {
     let share = &t.sensitivity.fit.share;
     let intervals = &t.sensitivity.share_interval;
     let groups = t.groups.len().max(1) as f64;
@@ -158,52 +146,41 @@ fn members_plot(svg: &mut String, t: &Tolerance) -> PlotResult {
         .collect();
     let (bottom, top) = log_range(&values);
     let clamp = |v: f64| v.max(bottom);
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("Share of the tilt's variance per member, case {}", t.case),
-            (FONT, 20),
-        )
-        .margin(14)
-        .x_label_area_size(44)
-        .y_label_area_size(64)
-        .build_cartesian_2d((x_lo - 0.6)..(x_hi + 0.6), (bottom..top).log_scale())?;
-    chart
-        .configure_mesh()
-        .x_desc(if all_parsed {
-            "stage (members of one stage side by side: by group, then position)"
-        } else {
-            "member (order within its group)"
-        })
-        .y_desc("share of Var tan θ_x + Var tan θ_y [-] (95 % interval, log scale)")
-        .y_label_formatter(&|y| format!("{y:.0e}"))
-        .draw()?;
+    let mut legend = Legend::default();
     for (g, group) in t.groups.iter().enumerate() {
-        let c = palette(g);
-        let js: Vec<usize> = (0..t.members.len())
-            .filter(|&j| t.members[j].1 == g)
-            .collect();
-        chart
-            .draw_series(
+        legend.add(Swatch::Marker(palette(g), 4), group.name.clone());
+    }
+    let caption = format!("Share of the tilt's variance per member, case {}", t.case);
+    render(WIDTH, CHART_HEIGHT, &legend, |_, area| {
+        let mut chart = captioned(area, caption)
+            .build_cartesian_2d((x_lo - 0.6)..(x_hi + 0.6), (bottom..top).log_scale())?;
+        styled_mesh(&mut chart.configure_mesh())
+            .x_desc(if all_parsed {
+                "stage (members of one stage side by side: by group, then position)"
+            } else {
+                "member (order within its group)"
+            })
+            .y_desc(share_axis())
+            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .draw()?;
+        for g in 0..t.groups.len() {
+            let c = palette(g);
+            let js: Vec<usize> = (0..t.members.len())
+                .filter(|&j| t.members[j].1 == g)
+                .collect();
+            chart.draw_series(
                 js.iter()
                     .map(|&j| Circle::new((x_of(j), clamp(share[j])), 4, c.filled())),
-            )?
-            .label(group.name.clone())
-            .legend(move |(x, y)| Circle::new((x + 8, y), 4, c.filled()));
-        for &j in &js {
-            let (lo, hi) = intervals[j];
-            if lo.is_finite() && hi.is_finite() {
-                chart.draw_series(whisker(x_of(j), clamp(lo), clamp(hi), 0.02, c))?;
+            )?;
+            for &j in &js {
+                let (lo, hi) = intervals[j];
+                if lo.is_finite() && hi.is_finite() {
+                    chart.draw_series(whisker(x_of(j), clamp(lo), clamp(hi), 0.02, c))?;
+                }
             }
         }
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::MiddleRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    root.present()?;
-    Ok(())
+        Ok(())
+    })
 }
 
 /// The plots' file names.
@@ -212,15 +189,14 @@ pub const PLOTS: [&str; 2] = ["shares-groups.svg", "shares-members.svg"];
 /// Draws both plots into `out`; returns their paths.
 pub fn draw_all(t: &Tolerance, out: &mut OutputDir) -> Result<Vec<PathBuf>, ToleranceError> {
     let mut files = Vec::new();
-    type Draw = fn(&mut String, &Tolerance) -> PlotResult;
+    type Draw = fn(&Tolerance) -> Drawn;
     let plots: [(&str, Draw); 2] = [(PLOTS[0], groups_plot), (PLOTS[1], members_plot)];
     for (name, draw) in plots {
-        let mut svg = String::new();
-        draw(&mut svg, t).map_err(|e| ToleranceError::Plot {
+        let svg = draw(t).map_err(|e| ToleranceError::Plot {
             path: out.path().join(name),
             message: e.to_string(),
         })?;
-        files.push(out.write(name, svg.as_bytes())?);
+        files.push(out.write(name, subscript_svg(&svg).as_bytes())?);
     }
     Ok(files)
 }

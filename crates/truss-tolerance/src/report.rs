@@ -23,13 +23,14 @@
 //! (B = 2000) for θ_Pq.
 
 use crate::errors::ToleranceError;
+use crate::plot;
 use crate::setup::Study;
 use crate::study::Tolerance;
-use crate::{ARCSEC_PER_RAD, plot};
 use run_dir::OutputDir;
 use serde_json::{Map, Value, json};
 use std::fmt::Write as _;
 use std::path::PathBuf;
+use truss_units::ARCSEC_PER_RAD;
 
 /// A finite number, or null.
 fn num(x: f64) -> Value {

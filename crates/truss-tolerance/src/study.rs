@@ -7,8 +7,9 @@ use crate::sensitivity::{Sensitivity, sensitivity};
 use crate::setup::Study;
 use crate::simulate::{run_case, threads};
 use crate::verify::{Percentile, percentile};
-use crate::{ARCSEC_PER_RAD, plot, report};
+use crate::{plot, report};
 use std::path::PathBuf;
+use truss_units::ARCSEC_PER_RAD;
 
 /// The target's margin: the rescale aims the interval's upper end at θ*(1 − MARGIN), so that
 /// the residual non-homogeneity (see the crate doc) rarely tips a rescaled run over θ*.

@@ -4,12 +4,14 @@
 //!
 //! - the runner (`mc-shard`) never links the merge (`mc-merge`) nor an async runtime;
 //! - the merge never links the solver (`truss-core`) nor the job (`truss-job`);
-//! - the solver links nothing of ours; nor do the statistics and the wire format;
-//! - the run directory's file rules (`run-dir`) link only the exit codes, so every writer,
-//!   however low, can share them;
+//! - the solver links nothing of ours; nor do the statistics, the wire format, the run
+//!   directory's file rules (`run-dir`, so every writer, however low, can share them), the
+//!   unit conversions (`truss-units`) and the exit codes;
+//! - the plot style (`truss-plot`) links only the unit conversions, so the merge, the
+//!   diagnosis and the tolerance study can all draw with it;
 //! - the diagnosis links neither the runner, the merge nor the wire format;
-//! - the tolerance study links the solver, the job, the statistics and the file rules, and
-//!   nothing else of ours;
+//! - the tolerance study links the solver, the job, the statistics, the file rules, the
+//!   units and the plot style, and nothing else of ours;
 //! - the Python bindings link the runner's side (solver, job, wire format, runner), never the
 //!   merge, the orchestration, the diagnosis, the tolerance study or an async runtime.
 
@@ -79,10 +81,13 @@ fn dependencies_point_one_way() {
         "truss-tolerance",
         "run-dir",
         "truss-py",
+        "truss-units",
+        "truss-plot",
+        "truss-exit",
     ] {
         assert!(ours.contains(name), "workspace package {name} is missing");
     }
-    let forbidden: [(&str, &[&str]); 7] = [
+    let forbidden: [(&str, &[&str]); 11] = [
         (
             "mc-shard",
             &["mc-merge", "tokio", "plotters", "statrs", "truss-stats"],
@@ -91,6 +96,13 @@ fn dependencies_point_one_way() {
         ("truss-core", &[]),
         ("truss-stats", &[]),
         ("shard-record", &[]),
+        ("run-dir", &[]),
+        ("truss-units", &[]),
+        ("truss-exit", &[]),
+        (
+            "truss-plot",
+            &["truss-core", "truss-job", "truss-stats", "run-dir"],
+        ),
         (
             "truss-diagnose",
             &["mc-shard", "mc-merge", "shard-record", "truss-mc"],
@@ -123,20 +135,21 @@ fn dependencies_point_one_way() {
             );
         }
     }
-    // run-dir sits on the exit codes alone.
-    let files: Vec<String> = closure(&graph, "run-dir")
+    // The plot style sits on the unit conversions alone.
+    let plot: Vec<String> = closure(&graph, "truss-plot")
         .intersection(&ours)
         .cloned()
         .collect();
-    assert_eq!(files, ["truss-exit"]);
+    assert_eq!(plot, ["truss-units"]);
     // truss-job sits directly on the solver and on nothing else of ours.
     let job: Vec<String> = closure(&graph, "truss-job")
         .intersection(&ours)
         .cloned()
         .collect();
     assert_eq!(job, ["truss-core"]);
-    // truss-tolerance sits on the job, the solver, the statistics and the run directory's
-    // file rules: not the runner, the merge, the wire format or the diagnosis.
+    // truss-tolerance sits on the job, the solver, the statistics, the run directory's file
+    // rules, the units and the plot style: not the runner, the merge, the wire format or the
+    // diagnosis.
     let tolerance: Vec<String> = closure(&graph, "truss-tolerance")
         .intersection(&ours)
         .cloned()
@@ -146,9 +159,10 @@ fn dependencies_point_one_way() {
         [
             "run-dir",
             "truss-core",
-            "truss-exit",
             "truss-job",
-            "truss-stats"
+            "truss-plot",
+            "truss-stats",
+            "truss-units"
         ]
     );
 }

@@ -10,16 +10,18 @@
 //!
 //! Angles in µrad with an arcsec axis beside them.
 
-use super::frame::*;
-use super::style::*;
 use crate::load::CaseData;
 use crate::report::{CaseReport, Report};
 use plotters::prelude::*;
 use statrs::distribution::{Beta, ContinuousCDF};
+use truss_plot::frame::*;
+use truss_plot::legend::*;
+use truss_plot::style::*;
+use truss_units::{ARCSEC_PER_MICRORAD, MICRORAD_PER_RAD};
 
 /// The case's θ_P in µrad, ascending.
 fn sorted_micro(case: &CaseData) -> Vec<f64> {
-    let mut v: Vec<f64> = case.points().map(|p| p.theta * MICRO).collect();
+    let mut v: Vec<f64> = case.points().map(|p| p.theta * MICRORAD_PER_RAD).collect();
     v.sort_by(f64::total_cmp);
     v
 }
@@ -71,14 +73,14 @@ fn target_percentiles(rep: &CaseReport, pct: f64) -> (Option<f64>, Option<f64>) 
         .iter()
         .find(|p| p.percentile.0 == pct)
         .and_then(|p| p.value)
-        .map(|v| v.0 * MICRO);
+        .map(|v| v.0 * MICRORAD_PER_RAD);
     let ray = rep
         .rayleigh
         .percentiles
         .iter()
         .find(|p| p.percentile.0 == pct)
         .and_then(|p| p.value.get())
-        .map(|v| v * MICRO);
+        .map(|v| v * MICRORAD_PER_RAD);
     (emp, ray)
 }
 
@@ -106,10 +108,10 @@ pub fn theta(
         return Ok(None);
     }
     let pct = report.sweep.percentile.0;
-    let target = report.settings.target_angle * MICRO;
+    let target = report.settings.target_angle * MICRORAD_PER_RAD;
     let (hi, beyond) = axis_end(&thetas, target);
     let hist = histogram(&thetas, 0.0, hi, bin_count(thetas.len()));
-    let sigma = rep.rayleigh.sigma.get().map(|s| s * MICRO);
+    let sigma = rep.rayleigh.sigma.get().map(|s| s * MICRORAD_PER_RAD);
     let curve: Vec<(f64, f64)> = sigma
         .map(|s| {
             (0..=300)
@@ -221,7 +223,7 @@ pub fn tan(
     rep: &CaseReport,
 ) -> Result<Option<String>, Box<dyn std::error::Error>> {
     let sigma_t = match rep.rayleigh.sigma_t.get() {
-        Some(s) if s > 0.0 && rep.n >= 2 => s * MICRO,
+        Some(s) if s > 0.0 && rep.n >= 2 => s * MICRORAD_PER_RAD,
         _ => return Ok(None),
     };
     let mut legend = Legend::default();
@@ -238,10 +240,9 @@ pub fn tan(
             number(round_sig(sigma_t, 4))
         ),
     );
-    let svg = render(1200, 560, &legend, |_, area| {
-        let (title_area, body) = area.split_vertically(40);
-        title_area.titled(&title(rep, "slopes of the top surface"), (FONT, 20))?;
-        let panels = body.split_evenly((1, 2));
+    let height = TITLE_HEIGHT + PANEL_ROW_HEIGHT;
+    let svg = render(PANELS_WIDTH, height, &legend, |_, area| {
+        let panels = titled_panels(area, &title(rep, "slopes of the top surface"), (1, 2))?;
         let hi = 4.5 * sigma_t;
         for (k, panel) in panels.iter().enumerate() {
             let (axis, stats) = if k == 0 {
@@ -251,12 +252,18 @@ pub fn tan(
             };
             let values: Vec<f64> = case
                 .points()
-                .map(|p| if k == 0 { p.tan_x } else { p.tan_y } * MICRO)
+                .map(|p| if k == 0 { p.tan_x } else { p.tan_y } * MICRORAD_PER_RAD)
                 .collect();
             let caption = format!(
                 "mean {}, standard deviation {} (× 10⁻⁶)",
-                number(round_sig(stats.mean.get().unwrap_or(0.0) * MICRO, 3)),
-                number(round_sig(stats.std.get().unwrap_or(0.0) * MICRO, 4))
+                number(round_sig(
+                    stats.mean.get().unwrap_or(0.0) * MICRORAD_PER_RAD,
+                    3
+                )),
+                number(round_sig(
+                    stats.std.get().unwrap_or(0.0) * MICRORAD_PER_RAD,
+                    4
+                ))
             );
             let hist = histogram(&values, -hi, hi, bin_count(values.len()));
             let normal = |x: f64| {
@@ -264,21 +271,11 @@ pub fn tan(
                     / (sigma_t * (2.0 * std::f64::consts::PI).sqrt())
             };
             let ymax = hist.iter().map(|b| b.2).fold(normal(0.0), f64::max) * 1.05;
-            let mut chart = ChartBuilder::on(panel)
-                .caption(caption, (FONT, 16))
-                .margin(14)
-                .x_label_area_size(45)
-                .y_label_area_size(70)
-                .build_cartesian_2d(-hi..hi, 0.0..ymax)?;
-            chart
-                .configure_mesh()
+            let mut chart =
+                truss_plot::frame::panel(panel, caption).build_cartesian_2d(-hi..hi, 0.0..ymax)?;
+            styled_panel_mesh(&mut chart.configure_mesh())
                 .x_desc(format!("10⁶ · tan {} [-]  (≈ µrad)", sub("θ", axis)))
                 .y_desc("probability density [-]")
-                .x_label_formatter(&tick)
-                .y_label_formatter(&tick)
-                .light_line_style(LIGHT)
-                .axis_desc_style((FONT, 17))
-                .label_style((FONT, 14))
                 .draw()?;
             chart.draw_series(
                 hist.iter()
@@ -320,7 +317,7 @@ pub fn qq(
     rep: &CaseReport,
     report: &Report,
 ) -> Result<Option<String>, Box<dyn std::error::Error>> {
-    let Some(sigma) = rep.rayleigh.sigma.get().map(|s| s * MICRO) else {
+    let Some(sigma) = rep.rayleigh.sigma.get().map(|s| s * MICRORAD_PER_RAD) else {
         return Ok(None);
     };
     let thetas = sorted_micro(case);
@@ -435,8 +432,8 @@ pub fn exceedance(
         .collect();
     let hi = thetas[n - 1] * 1.04;
     let floor = 0.5 / nf;
-    let sigma = rep.rayleigh.sigma.get().map(|s| s * MICRO);
-    let target = report.settings.target_angle * MICRO;
+    let sigma = rep.rayleigh.sigma.get().map(|s| s * MICRORAD_PER_RAD);
+    let target = report.settings.target_angle * MICRORAD_PER_RAD;
     let pct = report.sweep.percentile.0;
     let mut marks: Vec<(f64, f64, RGBColor)> = vec![];
     for (k, p) in [pct / 100.0, 0.99, 0.999].into_iter().enumerate() {
@@ -524,7 +521,7 @@ pub fn running(
     rep: &CaseReport,
     report: &Report,
 ) -> Result<Option<String>, Box<dyn std::error::Error>> {
-    let in_order: Vec<f64> = case.points().map(|p| p.theta * MICRO).collect();
+    let in_order: Vec<f64> = case.points().map(|p| p.theta * MICRORAD_PER_RAD).collect();
     let n = in_order.len();
     let pct = report.sweep.percentile.0;
     let p = pct / 100.0;
@@ -550,7 +547,7 @@ pub fn running(
     if rows.len() < 2 {
         return Ok(None);
     }
-    let target = report.settings.target_angle * MICRO;
+    let target = report.settings.target_angle * MICRORAD_PER_RAD;
     let last = rows[rows.len() - 1];
     let (lo, hi) = rows
         .iter()

@@ -17,14 +17,14 @@
 //! - `stages-sweep`: the normalised percentile against the number of stages (Fig. 9).
 //!
 //! Angles are drawn in µrad with an arcsec axis beside them; slopes tan θ as 10⁶ · tan θ. The
-//! legend sits below each chart, its swatches drawn like their series (dashed, dotted).
+//! legend sits below each chart, its swatches drawn like their series (dashed, dotted). The
+//! style (palette, sizes, fonts, the frame and the legend) is `truss-plot`'s, shared with the
+//! diagnosis and the tolerance study.
 
 mod distribution;
-mod frame;
 #[cfg(feature = "png")]
 pub mod png;
 mod series;
-pub mod style;
 
 pub use distribution::{axis_end, bin_count, histogram};
 
@@ -112,7 +112,7 @@ impl Writer {
         let Some(svg) = drawn.map_err(|e| plot_error(&svg_name, e.to_string()))? else {
             return Ok(());
         };
-        let svg = style::subscript_svg(&svg);
+        let svg = truss_plot::style::subscript_svg(&svg);
         self.written.push(out.write(&svg_name, svg.as_bytes())?);
         #[cfg(feature = "png")]
         {

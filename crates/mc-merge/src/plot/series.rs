@@ -7,11 +7,13 @@
 //!   where the intervals are large enough to see;
 //! - [`stages`]: the normalised percentile against the number of stages (paper Fig. 9).
 
-use super::frame::*;
-use super::style::*;
 use crate::report::{Figure, Report};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
+use truss_plot::frame::*;
+use truss_plot::legend::*;
+use truss_plot::style::*;
+use truss_units::{ARCSEC_PER_MICRORAD, MICRORAD_PER_RAD};
 
 type Drawn = Result<Option<String>, Box<dyn std::error::Error>>;
 
@@ -34,7 +36,7 @@ fn interval_or_point(f: &Figure) -> Option<(f64, f64, f64)> {
 /// The σ-sweep plot; `None` without a σ-series with a positive σ.
 pub fn sigma(report: &Report) -> Drawn {
     let series = &report.sweep.sigma_series;
-    let target = report.settings.target_angle * MICRO;
+    let target = report.settings.target_angle * MICRORAD_PER_RAD;
     let pct = report.sweep.percentile.0;
     let conf = percent_label(report.settings.confidence);
     // (σ mm, value, lower, upper in µrad) per series, positive σ only (log axis).
@@ -46,7 +48,12 @@ pub fn sigma(report: &Report) -> Drawn {
                 .filter(|p| p.x.0 > 0.0)
                 .filter_map(|p| {
                     let (v, lo, hi) = interval_or_point(&p.value)?;
-                    (lo > 0.0).then_some((p.x.0, v * MICRO, lo * MICRO, hi * MICRO))
+                    (lo > 0.0).then_some((
+                        p.x.0,
+                        v * MICRORAD_PER_RAD,
+                        lo * MICRORAD_PER_RAD,
+                        hi * MICRORAD_PER_RAD,
+                    ))
                 })
                 .collect()
         })
@@ -71,7 +78,7 @@ pub fn sigma(report: &Report) -> Drawn {
     let (xlo, xhi, ylo, yhi) = (xlo / 1.3, xhi * 1.3, ylo / 1.3, yhi * 1.3);
     let slopes: Vec<Option<f64>> = series
         .iter()
-        .map(|s| s.through_origin.slope.get().map(|b| b * MICRO))
+        .map(|s| s.through_origin.slope.get().map(|b| b * MICRORAD_PER_RAD))
         .collect();
     // Relative deviations from the line through the origin, in percent.
     let deviations: Vec<Vec<(f64, f64, f64, f64)>> = points
@@ -235,8 +242,8 @@ pub fn sigma(report: &Report) -> Drawn {
             .y_label_formatter(&tick)
             .y_labels(5)
             .light_line_style(LIGHT)
-            .axis_desc_style((FONT, 16))
-            .label_style((FONT, 15))
+            .axis_desc_style((FONT, text::PANEL_CAPTION))
+            .label_style((FONT, text::LABEL))
             .draw()?;
         // The right-hand label area only keeps the panels aligned: no labels there.
         chart
@@ -276,7 +283,7 @@ pub fn sigma(report: &Report) -> Drawn {
 
 /// A tick label's style, anchored as given.
 fn label_style(h: HPos, v: VPos) -> TextStyle<'static> {
-    TextStyle::from((FONT, 15).into_font()).pos(Pos::new(h, v))
+    TextStyle::from((FONT, text::LABEL).into_font()).pos(Pos::new(h, v))
 }
 
 /// The ticks 1, 2 and 5 × 10^k in [lo, hi].

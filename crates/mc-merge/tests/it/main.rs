@@ -1,5 +1,5 @@
-//! mc-merge's integration tests, one binary: statistics, sweeps, the command line, plots and
-//! the report directory.
+//! mc-merge's integration tests, one binary: statistics, sweeps, the command line, plots, the
+//! readable reports and the report directory.
 
 mod cli;
 mod common;
@@ -7,6 +7,7 @@ mod export;
 #[path = "../../../run-dir/tests/support/hostile.rs"]
 mod hostile;
 mod plots;
+mod readable;
 mod report_dir;
 mod schema;
 mod shared_dir;

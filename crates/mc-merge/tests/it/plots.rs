@@ -1,6 +1,6 @@
 //! The plots (crate doc of `mc_merge::plot`): every plot is written as SVG and PNG, the SVG
 //! renders with an independent renderer (librsvg's `rsvg-convert`, as scripts/smoke-test.sh
-//! does), the PNG is a PNG at twice the SVG's size, and the text follows the rules of issue 18
+//! does), the PNG is a PNG at twice the SVG's size, and the text follows the plots' rules
 //! (real subscripts, no "1400.0" tick labels, angles in µrad and arcsec, no rad e-notation).
 //! A θ_P tail beyond the histogram's axis is counted in its legend.
 

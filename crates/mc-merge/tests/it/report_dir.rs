@@ -62,7 +62,10 @@ fn same_job_reuses_the_directory_and_clears_its_own_plots() {
     // Again without plots: the earlier plots do not stay beside the new report.
     let o = merge(shards.path(), out.path(), &["--no-plots"]);
     assert_merged(&o);
-    assert_eq!(listing(out.path()), ["notes.txt", "report.json"]);
+    assert_eq!(
+        listing(out.path()),
+        ["notes.txt", "report.html", "report.json", "report.md"]
+    );
 }
 
 /// Files named like our plots in a directory without a report are not ours: a diagnosis's

@@ -1,129 +1,18 @@
 //! `docs/report.schema.json`, the standalone JSON Schema of `report.json` for readers who do
 //! not read Rust, checked against real reports: a complete job with σ and stages sweeps, and a
 //! partial one with failed samples excluded and degenerate cases (0, 1, 2 samples, all angles
-//! zero), where figures are null with reasons. A small validator of the keywords the schema
-//! uses (draft 2020-12: type, properties, required, additionalProperties, items, minItems,
-//! maxItems, minimum, const, enum, $ref) does the check and refuses any other keyword, so the
-//! schema cannot say more than is checked. Without a `jsonschema` dependency: that crate would
-//! add a regex engine, an HTTP client's worth of features and a minute to the test build.
+//! zero), where figures are null with reasons. The check is `schema-check`'s (shared with
+//! mc-shard's shard-record schema test), which refuses any keyword it does not check, so the
+//! schema cannot say more than is checked.
 
 use crate::common::{SynthCase, SynthJob};
 use serde_json::Value;
 
 const SCHEMA: &str = include_str!("../../../../docs/report.schema.json");
 
-/// The keywords the validator understands; annotations are allowed and ignored.
-const KEYWORDS: [&str; 11] = [
-    "type",
-    "properties",
-    "required",
-    "additionalProperties",
-    "items",
-    "minItems",
-    "maxItems",
-    "minimum",
-    "const",
-    "enum",
-    "$ref",
-];
-const ANNOTATIONS: [&str; 5] = ["$schema", "$id", "title", "description", "$defs"];
-
-/// Errors of `value` against `schema` (JSON pointers and what is wrong).
-fn validate(root: &Value, schema: &Value, value: &Value, at: &str, errors: &mut Vec<String>) {
-    let s = schema.as_object().expect("a schema is an object");
-    for k in s.keys() {
-        assert!(
-            KEYWORDS.contains(&k.as_str()) || ANNOTATIONS.contains(&k.as_str()),
-            "schema keyword {k} at {at} is not checked by this validator"
-        );
-    }
-    if let Some(r) = s.get("$ref").and_then(Value::as_str) {
-        let name = r.strip_prefix("#/$defs/").expect("local $ref");
-        let target = &root["$defs"][name];
-        assert!(target.is_object(), "unresolved $ref {r}");
-        validate(root, target, value, at, errors);
-    }
-    if let Some(t) = s.get("type") {
-        let types: Vec<&str> = match t {
-            Value::String(one) => vec![one.as_str()],
-            Value::Array(many) => many.iter().map(|v| v.as_str().unwrap()).collect(),
-            _ => panic!("bad type at {at}"),
-        };
-        let is = |t: &str| match t {
-            "object" => value.is_object(),
-            "array" => value.is_array(),
-            "string" => value.is_string(),
-            "number" => value.is_number(),
-            "integer" => value.is_u64() || value.is_i64(),
-            "boolean" => value.is_boolean(),
-            "null" => value.is_null(),
-            other => panic!("unknown type {other}"),
-        };
-        if !types.iter().any(|t| is(t)) {
-            errors.push(format!("{at}: {value} is not of type {types:?}"));
-            return;
-        }
-    }
-    if let Some(c) = s.get("const")
-        && value != c
-    {
-        errors.push(format!("{at}: {value} is not {c}"));
-    }
-    if let Some(Value::Array(options)) = s.get("enum")
-        && !options.contains(value)
-    {
-        errors.push(format!("{at}: {value} is not one of {options:?}"));
-    }
-    if let (Some(min), Some(v)) = (s.get("minimum").and_then(Value::as_f64), value.as_f64())
-        && v < min
-    {
-        errors.push(format!("{at}: {v} is below {min}"));
-    }
-    if let Value::Object(map) = value {
-        let props = s.get("properties").and_then(Value::as_object);
-        if let Some(Value::Array(required)) = s.get("required") {
-            for r in required {
-                if !map.contains_key(r.as_str().unwrap()) {
-                    errors.push(format!("{at}: missing {r}"));
-                }
-            }
-        }
-        for (k, v) in map {
-            let path = format!("{at}/{k}");
-            match props.and_then(|p| p.get(k)) {
-                Some(sub) => validate(root, sub, v, &path, errors),
-                None => match s.get("additionalProperties") {
-                    Some(Value::Bool(false)) => errors.push(format!("{path}: not in the schema")),
-                    Some(sub @ Value::Object(_)) => validate(root, sub, v, &path, errors),
-                    _ => {}
-                },
-            }
-        }
-    }
-    if let Value::Array(items) = value {
-        let len = items.len() as u64;
-        if s.get("minItems")
-            .and_then(Value::as_u64)
-            .is_some_and(|m| len < m)
-            || s.get("maxItems")
-                .and_then(Value::as_u64)
-                .is_some_and(|m| len > m)
-        {
-            errors.push(format!("{at}: {len} items"));
-        }
-        if let Some(sub) = s.get("items") {
-            for (i, v) in items.iter().enumerate() {
-                validate(root, sub, v, &format!("{at}/{i}"), errors);
-            }
-        }
-    }
-}
-
 fn errors(report: &Value) -> Vec<String> {
     let schema: Value = serde_json::from_str(SCHEMA).unwrap();
-    let mut errors = vec![];
-    validate(&schema, &schema, report, "", &mut errors);
-    errors
+    schema_check::errors(&schema, report)
 }
 
 fn report(job: &SynthJob, drop_shard: Option<usize>, allow: bool) -> Value {

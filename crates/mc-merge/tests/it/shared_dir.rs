@@ -32,7 +32,7 @@ fn merge_into(shards: &Path, out: &Path, extra: &[&str]) -> Output {
 
 /// A link named like a plot, in a new report directory or in one mc-merge wrote before, is
 /// refused naming it (exit 5), and the file it points at keeps its bytes; so is a link
-/// named `report.json`.
+/// named `report.json`, `report.md` or `report.html`.
 #[test]
 fn links_named_like_outputs_are_refused() {
     let shards = tempfile::tempdir().unwrap();
@@ -43,6 +43,8 @@ fn links_named_like_outputs_are_refused() {
         ("theta_p-a.svg", false),
         ("qq-a.png", true),
         ("report.json", false),
+        ("report.md", false),
+        ("report.html", true),
     ] {
         let out = tempfile::tempdir().unwrap();
         if merged_before {

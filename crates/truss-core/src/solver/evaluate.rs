@@ -1,9 +1,19 @@
 //! Evaluating the out-of-balance force and the member states at a point, and small vector
 //! helpers shared by the solver's steps.
 
-use super::Evaluation;
 use crate::element::{AxialMember, AxialState};
 use crate::structure::{Link, Structure};
+
+/// Result of evaluating the out-of-balance force at a point.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Evaluation {
+    /// Max |r| over free DOFs \[N\].
+    pub residual: f64,
+    /// Max |N| over members \[N\].
+    pub force_scale: f64,
+    /// Strain energy Σ ½·k_e·e² \[N·mm\].
+    pub strain: f64,
+}
 
 /// `r = g(u) − f` and the member states at `u`; returns max |r| and max |N|.
 #[cfg(test)]

@@ -81,7 +81,7 @@ use crate::linearised::ActiveSet;
 use crate::measure::{Distortion, distortion};
 use crate::structure::Structure;
 use crate::{ModelError, SolveError};
-use evaluate::dot_n;
+use evaluate::{Evaluation, dot_n};
 use std::sync::Arc;
 
 mod evaluate;
@@ -305,17 +305,6 @@ struct StepState {
     step_slack: Vec<bool>,
     /// Cables pinned at their kink for the next model step.
     pinned: Vec<bool>,
-}
-
-/// Result of evaluating the out-of-balance force at a point.
-#[derive(Debug, Clone, Copy)]
-struct Evaluation {
-    /// Max |r| over free DOFs \[N\].
-    residual: f64,
-    /// Max |N| over members \[N\].
-    force_scale: f64,
-    /// Strain energy Σ ½·k_e·e² \[N·mm\].
-    strain: f64,
 }
 
 impl Solver {

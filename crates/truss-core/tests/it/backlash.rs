@@ -432,7 +432,7 @@ fn top_by_hand(stages: usize, delta: f64, g: f64, contact: f64) -> f64 {
     (0..stages).map(|s| a[s][n] / a[s][s]).sum()
 }
 
-/// The hand check: the 5-stage truss, every clearance `g`, no length errors but
+/// A hand check: the 5-stage truss, every clearance `g`, no length errors but
 /// every diagonal shortened by 0.05 mm. Every joint bears, each joint's force lies along its
 /// longeron with its offset `g` (plus the contact's penetration `F/k_t`) along that force,
 /// and the top surface is lower than without backlash by [`top_by_hand`]'s difference, to
@@ -563,17 +563,7 @@ fn fig16_statistics_with(ratio: f64, diagonal_ratio: f64) -> Statistics {
     let (mut thetas, mut tan_sq, mut mean) = (Vec::new(), 0.0, [0.0; 3]);
     let samples = 400;
     for _ in 0..samples {
-        let errors: Vec<f64> = model
-            .members()
-            .iter()
-            .map(|m| match m.group.as_str() {
-                "diagonal" => -3.0 * sigma * rng.uniform(),
-                _ => sigma * rng.normal(),
-            })
-            .collect();
-        let clearances: Vec<f64> = (0..model.joints().len())
-            .map(|_| 0.004 + 0.013 * rng.uniform())
-            .collect();
+        let (errors, clearances) = fig16_draw(&model, sigma, &mut rng);
         solver
             .solve_perturbed(Perturbation {
                 length_errors: &errors,
@@ -678,17 +668,7 @@ fn fig16_thetas(seed: u64, samples: usize, diagonal_ratio: f64) -> Vec<Option<(f
     let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
     (0..samples)
         .map(|_| {
-            let errors: Vec<f64> = model
-                .members()
-                .iter()
-                .map(|m| match m.group.as_str() {
-                    "diagonal" => -3.0 * sigma * rng.uniform(),
-                    _ => sigma * rng.normal(),
-                })
-                .collect();
-            let clearances: Vec<f64> = (0..model.joints().len())
-                .map(|_| 0.004 + 0.013 * rng.uniform())
-                .collect();
+            let (errors, clearances) = fig16_draw(&model, sigma, &mut rng);
             let report = solver
                 .solve_perturbed(Perturbation {
                     length_errors: &errors,

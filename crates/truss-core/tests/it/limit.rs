@@ -88,17 +88,7 @@ fn a_floating_sample_is_moved_by_a_nanonewton() {
     let sigma = 0.0067;
     let (mut floating, mut framed) = (Vec::new(), Vec::new());
     for _ in 0..200 {
-        let e: Vec<f64> = model
-            .members()
-            .iter()
-            .map(|m| match m.group.as_str() {
-                "diagonal" => -3.0 * sigma * rng.uniform(),
-                _ => sigma * rng.normal(),
-            })
-            .collect();
-        let g: Vec<f64> = (0..model.joints().len())
-            .map(|_| 0.004 + 0.013 * rng.uniform())
-            .collect();
+        let (e, g) = fig16_draw(&model, sigma, &mut rng);
         let mut solve = |loads: &[[f64; 3]]| {
             let report = solver
                 .solve_perturbed(Perturbation {

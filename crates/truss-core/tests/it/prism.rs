@@ -18,7 +18,7 @@ fn five_stages_have_18_nodes_and_63_members() {
     );
 }
 
-/// Ids, positions and Table 1's properties as the issue specifies them.
+/// Ids, positions and Table 1's properties as the prism generator's doc specifies them.
 #[test]
 fn ids_positions_and_table_1() {
     let model = PrismOptions::with_stages(5).model().unwrap();

@@ -116,12 +116,12 @@ impl Candidate for Backlash {
         if j == 1 {
             return format!(
                 "the joints' clearances scatter uniformly within ±{:.1} µm of their mean (some joints tighter, some looser)",
-                v * 1e3
+                v * truss_units::MICROMETRE_PER_MM
             );
         }
         format!(
             "each pin joint has on average about {:.1} µm of radial clearance (free play of its shaft in the hole)",
-            v * 1e3
+            v * truss_units::MICROMETRE_PER_MM
         )
     }
     /// The spread reaching 0: the joints may all have one clearance.

@@ -83,7 +83,7 @@ impl Candidate for LengthBias {
         format!(
             "the {} members are on average {:.1} µm {} than nominal",
             self.groups[j],
-            v.abs() * 1e3,
+            v.abs() * truss_units::MICROMETRE_PER_MM,
             if v >= 0.0 { "longer" } else { "shorter" }
         )
     }

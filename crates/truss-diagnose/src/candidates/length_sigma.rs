@@ -94,9 +94,9 @@ impl Candidate for LengthSigma {
         let (group, stated) = (&self.groups[j].0, self.parameters[j].null);
         format!(
             "the {group} members' lengths scatter by {:.1} µm (1 SD), {:.2} times the stated {:.1} µm",
-            v * 1e3,
+            v * truss_units::MICROMETRE_PER_MM,
             v / stated,
-            stated * 1e3
+            stated * truss_units::MICROMETRE_PER_MM
         )
     }
     fn trace(&self) -> Trace {

@@ -65,7 +65,7 @@ impl Candidate for DiagonalPretension {
     fn reading(&self, _j: usize, v: f64, _span: [f64; 3]) -> String {
         format!(
             "the diagonals are on average {:.1} µm shorter than nominal, pretensioning the frame",
-            v.abs() * 1e3
+            v.abs() * truss_units::MICROMETRE_PER_MM
         )
     }
     fn trace(&self) -> Trace {

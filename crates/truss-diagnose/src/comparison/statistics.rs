@@ -29,6 +29,7 @@ use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
 use truss_stats::bootstrap::{BootstrapConfig, SortedSample, bootstrap_quantiles};
 use truss_stats::rng::mix64;
 use truss_stats::two_sample::{self, kolmogorov_smirnov, moments};
+use truss_units::{ARCSEC_PER_RAD, MICROMETRE_PER_MM, MICRORAD_PER_RAD};
 
 /// Mean tolerance, in predicted standard deviations.
 pub const TOL_MEAN: f64 = 0.5;
@@ -43,7 +44,6 @@ const PERCENTILES: [f64; 4] = [0.5, 0.9, 0.95, 0.99];
 /// "p = 8e-13" on null data showed). So θ_P's 90th percentile needs 50 specimens, the 95th
 /// 100 and the 99th 500; below that the statistic is left out.
 pub const MIN_IN_TAIL: f64 = 5.0;
-const ARCSEC_PER_RAD: f64 = 206_264.806_247_096_36;
 
 /// A value with its 95 % interval.
 #[derive(Debug, Clone, Copy, Serialize)]
@@ -194,7 +194,7 @@ fn coordinate_column(c: &Coordinate) -> Column {
     Column {
         id: c.label(),
         unit: "µm",
-        scale: 1e3,
+        scale: MICROMETRE_PER_MM,
         subject: format!("node {} ({axis})", c.node_id),
         more,
         less,
@@ -415,16 +415,16 @@ fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
                 fmt(ratio),
                 fmt(lo),
                 fmt(hi),
-                fmt(qy * 1e6),
+                fmt(qy * MICRORAD_PER_RAD),
                 fmt(qy * ARCSEC_PER_RAD),
-                fmt(qx * 1e6)
+                fmt(qx * MICRORAD_PER_RAD)
             );
             Statistic {
                 id: format!("p{pct} theta_p"),
                 kind: "percentile",
                 unit: "µrad",
-                measured: qy * 1e6,
-                simulated: qx * 1e6,
+                measured: qy * MICRORAD_PER_RAD,
+                simulated: qx * MICRORAD_PER_RAD,
                 comparison: "ratio",
                 estimate: Estimate {
                     value: ratio,
@@ -598,17 +598,38 @@ pub fn compare(
     };
     let coords = columns.len();
     columns.push((
-        derived("piston", "µm", 1e3, "the top surface", "higher", "lower"),
+        derived(
+            "piston",
+            "µm",
+            MICROMETRE_PER_MM,
+            "the top surface",
+            "higher",
+            "lower",
+        ),
         piston(&measured.y),
         piston(&sim.x_noisy),
     ));
     columns.push((
-        derived("tan_theta_x", "µrad", 1e6, "tan θ_x", "larger", "smaller"),
+        derived(
+            "tan_theta_x",
+            "µrad",
+            MICRORAD_PER_RAD,
+            "tan θ_x",
+            "larger",
+            "smaller",
+        ),
         measured.tan_x.clone(),
         sim.tan_x.clone(),
     ));
     columns.push((
-        derived("tan_theta_y", "µrad", 1e6, "tan θ_y", "larger", "smaller"),
+        derived(
+            "tan_theta_y",
+            "µrad",
+            MICRORAD_PER_RAD,
+            "tan θ_y",
+            "larger",
+            "smaller",
+        ),
         measured.tan_y.clone(),
         sim.tan_y.clone(),
     ));

@@ -1,5 +1,5 @@
 //! SVG plots of the measured against the simulated distributions, before and after the
-//! effect is added:
+//! effect is added, in the plot style every truss-mc plot shares (`truss-plot`):
 //!
 //! - `theta_p-ecdf-before.svg`, `theta_p-ecdf-after.svg`: the empirical CDFs of θ_P \[µrad\]
 //!   (simulated with the instrument's noise).
@@ -11,15 +11,18 @@ use crate::comparison::simulate::Simulation;
 use crate::errors::DiagnoseError;
 use plotters::prelude::*;
 use run_dir::OutputDir;
+use truss_plot::frame::{captioned, panel, render, styled_mesh, styled_panel_mesh, titled_panels};
+use truss_plot::legend::{Legend, Swatch};
+use truss_plot::style::{
+    CHART_HEIGHT, MEASURED, PANEL_ROW_HEIGHT, PANELS_WIDTH, SIMULATED, TITLE_HEIGHT, WIDTH, sub,
+    subscript_svg, theta_p,
+};
+use truss_units::{MICROMETRE_PER_MM, MICRORAD_PER_RAD};
 
-const SIM: RGBColor = RGBColor(30, 90, 200);
-const MEAS: RGBColor = RGBColor(200, 30, 30);
-const FONT: &str = "sans-serif";
-
-type PlotResult = Result<(), Box<dyn std::error::Error>>;
+type Drawn = Result<String, Box<dyn std::error::Error>>;
 
 fn ecdf(v: &[f64]) -> Vec<(f64, f64)> {
-    let mut s: Vec<f64> = v.iter().map(|x| x * 1e6).collect();
+    let mut s: Vec<f64> = v.iter().map(|x| x * MICRORAD_PER_RAD).collect();
     s.sort_by(f64::total_cmp);
     let n = s.len() as f64;
     let mut out = Vec::with_capacity(2 * s.len() + 1);
@@ -31,103 +34,90 @@ fn ecdf(v: &[f64]) -> Vec<(f64, f64)> {
     out
 }
 
-fn ecdf_plot(svg: &mut String, measured: &Measured, sim: &Simulation, title: &str) -> PlotResult {
-    let root = SVGBackend::with_string(svg, (800, 560)).into_drawing_area();
-    root.fill(&WHITE)?;
+/// The measured and the simulated series, as the legend names them.
+fn legend(measured: usize, simulated: usize, swatch: fn(RGBColor) -> Swatch) -> Legend {
+    let mut legend = Legend::default();
+    legend.add(swatch(MEASURED), format!("measured (n = {measured})"));
+    legend.add(swatch(SIMULATED), format!("simulated (N = {simulated})"));
+    legend
+}
+
+fn ecdf_plot(measured: &Measured, sim: &Simulation, title: &str) -> Drawn {
     let hi = measured
         .theta_p
         .iter()
         .chain(&sim.theta_p)
         .fold(0.0f64, |a, &b| a.max(b))
-        * 1e6
+        * MICRORAD_PER_RAD
         * 1.02;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, (FONT, 20))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(56)
-        .build_cartesian_2d(0.0..hi.max(1e-9), 0.0..1.0)?;
-    chart
-        .configure_mesh()
-        .x_desc("θ_P [µrad]")
-        .y_desc("cumulative fraction")
-        .draw()?;
-    chart
-        .draw_series(LineSeries::new(ecdf(&sim.theta_p), SIM.stroke_width(2)))?
-        .label(format!("simulated (N = {})", sim.theta_p.len()))
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], SIM.stroke_width(2)));
-    chart
-        .draw_series(LineSeries::new(
+    let line = |c: RGBColor| Swatch::Line(c, 2, None);
+    let legend = legend(measured.theta_p.len(), sim.theta_p.len(), line);
+    render(WIDTH, CHART_HEIGHT, &legend, |_, area| {
+        let mut chart =
+            captioned(area, title.to_string()).build_cartesian_2d(0.0..hi.max(1e-9), 0.0..1.0)?;
+        styled_mesh(&mut chart.configure_mesh())
+            .x_desc(format!("{} [µrad]", theta_p()))
+            .y_desc("cumulative fraction")
+            .draw()?;
+        chart.draw_series(LineSeries::new(
+            ecdf(&sim.theta_p),
+            SIMULATED.stroke_width(2),
+        ))?;
+        chart.draw_series(LineSeries::new(
             ecdf(&measured.theta_p),
-            MEAS.stroke_width(2),
-        ))?
-        .label(format!("measured (n = {})", measured.theta_p.len()))
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], MEAS.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()?;
-    root.present()?;
-    Ok(())
+            MEASURED.stroke_width(2),
+        ))?;
+        Ok(())
+    })
 }
 
-fn scatter_plot(
-    svg: &mut String,
-    measured: &Measured,
-    sim: &Simulation,
-    top: [[usize; 3]; 3],
-    title: &str,
-) -> PlotResult {
-    let root = SVGBackend::with_string(svg, (1200, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let (upper, panels) = root.split_vertically(40);
-    upper.titled(title, (FONT, 20))?;
-    let cells = panels.split_evenly((2, 3));
+fn scatter_plot(measured: &Measured, sim: &Simulation, top: [[usize; 3]; 3], title: &str) -> Drawn {
     let d = measured.d();
     let m_rows: Vec<&[f64]> = measured.y.chunks_exact(d).collect();
     let s_rows: Vec<&[f64]> = sim.x_noisy.chunks_exact(d).take(1000).collect();
-    for (cell_index, cell) in cells.iter().enumerate() {
-        let (row, node) = (cell_index / 3, cell_index % 3);
-        let (ax, ay) = if row == 0 { (0, 1) } else { (0, 2) };
-        let (ix, iy) = (top[node][ax], top[node][ay]);
-        let pts = |rows: &[&[f64]]| -> Vec<(f64, f64)> {
-            rows.iter().map(|r| (r[ix] * 1e3, r[iy] * 1e3)).collect()
-        };
-        let (mp, sp) = (pts(&m_rows), pts(&s_rows));
-        let range = |k: usize| {
-            let vals = mp.iter().chain(&sp).map(|p| if k == 0 { p.0 } else { p.1 });
-            let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
-            let pad = ((hi - lo) * 0.05).max(1e-3);
-            (lo - pad)..(hi + pad)
-        };
-        let id = &measured.coords[top[node][0]].node_id;
-        let names = ["x", "y", "z"];
-        let mut chart = ChartBuilder::on(cell)
-            .caption(
-                format!("{id}: u_{} against u_{}", names[ay], names[ax]),
-                (FONT, 14),
-            )
-            .margin(8)
-            .x_label_area_size(32)
-            .y_label_area_size(48)
-            .build_cartesian_2d(range(0), range(1))?;
-        chart
-            .configure_mesh()
-            .x_desc(format!("u_{} [µm]", names[ax]))
-            .y_desc(format!("u_{} [µm]", names[ay]))
-            .draw()?;
-        chart.draw_series(
-            sp.iter()
-                .map(|&p| Circle::new(p, 2, SIM.mix(0.35).filled())),
-        )?;
-        chart.draw_series(mp.iter().map(|&p| Circle::new(p, 2, MEAS.filled())))?;
-    }
-    root.present()?;
-    Ok(())
+    let marker = |c: RGBColor| Swatch::Marker(c, 2);
+    let legend = legend(m_rows.len(), s_rows.len(), marker);
+    let height = TITLE_HEIGHT + 2 * PANEL_ROW_HEIGHT;
+    render(PANELS_WIDTH, height, &legend, |_, area| {
+        let cells = titled_panels(area, title, (2, 3))?;
+        for (cell_index, cell) in cells.iter().enumerate() {
+            let (row, node) = (cell_index / 3, cell_index % 3);
+            let (ax, ay) = if row == 0 { (0, 1) } else { (0, 2) };
+            let (ix, iy) = (top[node][ax], top[node][ay]);
+            let pts = |rows: &[&[f64]]| -> Vec<(f64, f64)> {
+                rows.iter()
+                    .map(|r| (r[ix] * MICROMETRE_PER_MM, r[iy] * MICROMETRE_PER_MM))
+                    .collect()
+            };
+            let (mp, sp) = (pts(&m_rows), pts(&s_rows));
+            let range = |k: usize| {
+                let vals = mp.iter().chain(&sp).map(|p| if k == 0 { p.0 } else { p.1 });
+                let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+                    (a.min(v), b.max(v))
+                });
+                let pad = ((hi - lo) * 0.05).max(1e-3);
+                (lo - pad)..(hi + pad)
+            };
+            let id = &measured.coords[top[node][0]].node_id;
+            let names = ["x", "y", "z"];
+            let caption = format!(
+                "{id}: {} against {}",
+                sub("u", names[ay]),
+                sub("u", names[ax])
+            );
+            let mut chart = panel(cell, caption).build_cartesian_2d(range(0), range(1))?;
+            styled_panel_mesh(&mut chart.configure_mesh())
+                .x_desc(format!("{} [µm]", sub("u", names[ax])))
+                .y_desc(format!("{} [µm]", sub("u", names[ay])))
+                .draw()?;
+            chart.draw_series(
+                sp.iter()
+                    .map(|&p| Circle::new(p, 2, SIMULATED.mix(0.35).filled())),
+            )?;
+            chart.draw_series(mp.iter().map(|&p| Circle::new(p, 2, MEASURED.filled())))?;
+        }
+        Ok(())
+    })
 }
 
 /// Draws the before (`suffix = "before"`) or after plots into `out`; returns the file names.
@@ -144,24 +134,21 @@ pub fn draw(
         message: err.to_string(),
     };
     let e = format!("theta_p-ecdf-{suffix}.svg");
-    let mut ecdf = String::new();
-    ecdf_plot(
-        &mut ecdf,
+    let ecdf = ecdf_plot(
         measured,
         sim,
-        &format!("θ_P: measured (red) and {label} (blue)"),
+        &format!("{}: measured (red) and {label} (blue)", theta_p()),
     )
     .map_err(|err| plot_error(&e, err))?;
     let s = format!("top-scatter-{suffix}.svg");
-    let mut scatter = String::new();
-    scatter_plot(
-        &mut scatter,
+    let scatter = scatter_plot(
         measured,
         sim,
         top,
         &format!("Top-node displacements: measured (red) and {label} (blue)"),
     )
     .map_err(|err| plot_error(&s, err))?;
+    let (ecdf, scatter) = (subscript_svg(&ecdf), subscript_svg(&scatter));
     out.write(&e, ecdf.as_bytes())?;
     out.write(&s, scatter.as_bytes())?;
     Ok(vec![e, s])

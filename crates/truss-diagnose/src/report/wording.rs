@@ -100,7 +100,7 @@ pub(super) fn plain_reading(
         c.reading(j, p.value, span)
     } else {
         format!(
-            "not determined by these data (they leave {:.0} % of its plausible range open): no reading is given",
+            "not determined by these data (its intervals leave up to {:.0} % of its plausible range open): no reading is given",
             100.0 * p.coverage(&c.parameters()[j])
         )
     }

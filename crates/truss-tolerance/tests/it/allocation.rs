@@ -21,7 +21,7 @@ fn iso(s: f64, members: usize, weight: f64) -> GroupModel {
 #[test]
 fn two_groups_match_the_closed_form() {
     let groups = [iso(4e-6, 18, 1.0), iso(1e-4, 15, 3.0)];
-    let target = 20.0 / truss_tolerance::ARCSEC_PER_RAD;
+    let target = 20.0 / truss_units::ARCSEC_PER_RAD;
     let q = 0.95;
     let sigmas = allocate(&groups, target, q).unwrap();
     let v = (target.tan() / rayleigh_factor(q)).powi(2);
@@ -75,7 +75,7 @@ fn the_allocation_is_the_cheapest_on_the_budget() {
 fn fixed_groups_use_their_budget_first() {
     let mut groups = [iso(4e-6, 18, 1.0), iso(1e-4, 15, 1.0)];
     let q = 0.95;
-    let target = 20.0 / truss_tolerance::ARCSEC_PER_RAD;
+    let target = 20.0 / truss_units::ARCSEC_PER_RAD;
     let v = (target.tan() / rayleigh_factor(q)).powi(2);
     groups[0].fixed = Some(0.5 * (v / 4e-6).sqrt());
     let sigmas = allocate(&groups, target, q).unwrap();

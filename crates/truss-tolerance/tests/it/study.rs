@@ -1,4 +1,4 @@
-//! The whole study end to end: the files and fields the issue lists, the allocation meeting
+//! The whole study end to end: the files and fields the crate doc lists, the allocation meeting
 //! the target at its upper bound after the homogeneity rescale, results independent of the
 //! thread count; the paper's 5-stage case with 20,000 samples in the slow tier.
 
@@ -16,7 +16,7 @@ fn small(path: std::path::PathBuf, out: std::path::PathBuf) -> Options {
 }
 
 #[test]
-fn the_study_writes_what_the_issue_lists_and_verifies() {
+fn the_study_writes_what_the_crate_doc_lists_and_verifies() {
     let dir = tempfile::tempdir().unwrap();
     let path = job(&dir, 2, &[("c", &both(0.0063)), ("other", &both(0.01))]);
     let out = dir.path().join("out");
@@ -26,7 +26,7 @@ fn the_study_writes_what_the_issue_lists_and_verifies() {
         serde_json::from_str(&std::fs::read_to_string(out.join("tolerance.json")).unwrap())
             .unwrap();
     let target = doc["target_rad"].as_f64().unwrap();
-    assert!((target * truss_tolerance::ARCSEC_PER_RAD - 20.0).abs() < 1e-9);
+    assert!((target * truss_units::ARCSEC_PER_RAD - 20.0).abs() < 1e-9);
     assert_eq!(doc["percentile"], 95.0);
     for g in ["batten", "longeron"] {
         let group = &doc["groups"][g];

@@ -84,3 +84,26 @@ pub fn file(
         joints: vec![],
     }
 }
+
+/// One sample of the paper's Fig. 16 case (§4.2.3) for a prism with backlash joints:
+/// battens and longerons N(0, σ²), diagonals U[−3σ, 0] (every member's numbers drawn in
+/// model order), then each joint's clearance U[0.004, 0.017] mm: (length errors, clearances)
+/// \[mm\].
+pub fn fig16_draw(
+    model: &truss_core::Model,
+    sigma: f64,
+    rng: &mut Normals,
+) -> (Vec<f64>, Vec<f64>) {
+    let errors = model
+        .members()
+        .iter()
+        .map(|m| match m.group.as_str() {
+            "diagonal" => -3.0 * sigma * rng.uniform(),
+            _ => sigma * rng.normal(),
+        })
+        .collect();
+    let clearances = (0..model.joints().len())
+        .map(|_| 0.004 + 0.013 * rng.uniform())
+        .collect();
+    (errors, clearances)
+}
