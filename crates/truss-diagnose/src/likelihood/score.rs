@@ -154,7 +154,7 @@ pub(crate) struct Memo {
     )>,
 }
 
-/// Most cases a [`Memo`] keeps (each n + member-observation values).
+/// Most cases the memo of ℓ's terms keeps (each n + member-observation values).
 pub const MEMO_CASES: usize = 512;
 
 impl Memo {
