@@ -34,6 +34,28 @@ fn job() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../jobs/diagnose-baseline.json")
 }
 
+/// Parameter `name` of `effect` in the final model's joint fit (`final_fit`: the numbers
+/// the report reads last, with their intervals).
+pub(crate) fn final_parameter<'a>(
+    v: &'a serde_json::Value,
+    effect: &str,
+    name: &str,
+) -> &'a serde_json::Value {
+    v["final_fit"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["name"] == effect)
+        .and_then(|e| {
+            e["parameters"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|p| p["name"] == name)
+        })
+        .unwrap_or_else(|| panic!("no {effect} {name} in {}", v["final_fit"]))
+}
+
 fn make(dir: &Path, name: &str, effect: &str, specimens: usize, seed: u64) -> PathBuf {
     make_with_members(dir, name, effect, specimens, seed, None)
 }

@@ -1,28 +1,7 @@
 //! What the data cannot tell apart, and what they do not determine: the final model's
 //! joint fit, its undetermined parameters and the rivals confounded with its effects.
 
-use super::{diagnose_with, job, make};
-
-/// A final-fit parameter of `effect`.
-fn final_parameter<'a>(
-    v: &'a serde_json::Value,
-    effect: &str,
-    name: &str,
-) -> &'a serde_json::Value {
-    v["final_fit"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|e| e["name"] == effect)
-        .and_then(|e| {
-            e["parameters"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .find(|p| p["name"] == name)
-        })
-        .unwrap_or_else(|| panic!("no {effect} {name} in {}", v["final_fit"]))
-}
+use super::{diagnose_with, final_parameter, job, make};
 
 /// Self-weight at 45° in the horizontal plane (g_x = g_y = −0.707 g) in 60 specimens,
 /// tried against gravity and a diagonal pretension: gravity is named, g_x and g_y are
