@@ -75,6 +75,15 @@
 //!    the case (same case name), which mc-shard and mc-merge run as usual.
 //! 4. **The gap shrinks**: each step's discrepancy before and after, and the baseline's
 //!    against the final model's, statistic by statistic.
+//! 5. **What the data cannot tell apart, and what they do not determine**
+//!    ([`selection::confound`]): the final model's effects fitted jointly once more, each
+//!    value with that fit's interval (profile where the Wald one is cut at the range); a
+//!    parameter whose interval covers most of its plausible range is reported "not
+//!    determined by these data", with no physical reading. Each significant rival is added
+//!    to the final model and all re-fitted: one that moves an effect's parameters out of
+//!    their intervals, or widens them two-fold, is listed as confounded with it (a
+//!    temperature field's offset and vertical gradient against a longeron length bias),
+//!    with the measurement that would separate them.
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
 //! plots of [`report::plot`], each written through a temporary file and never through a link (a
