@@ -81,7 +81,7 @@ pub fn run_diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<(), CliE
         measured: args.measured.clone(),
         measured_members: args.measured_members.clone(),
         out: args.out.clone(),
-        settings: truss_diagnose::diagnose::Settings {
+        settings: truss_diagnose::settings::Settings {
             samples: args.samples,
             measurement_sigma: args.measurement_sigma,
             quiet: args.quiet,

@@ -14,7 +14,7 @@
 //!
 //! ## Workflow
 //!
-//! 1. **Where** ([`compare`]). The baseline case is simulated with N samples (default
+//! 1. **Where** ([`comparison`], [`comparison::statistics`]). The baseline case is simulated with N samples (default
 //!    max(2000, 20·n), at most 10 000, for n specimens: the simulation's noise is at most
 //!    a twentieth of the data's in variance) under the job's seed and the case's name, so
 //!    every later simulation sees the same random words (common random numbers), with the
@@ -23,9 +23,9 @@
 //!    surface's height (piston), tan θ_x and tan θ_y, θ_P's percentiles, a KS test on θ_P and
 //!    an energy-distance test on the displacement vectors, each with a 95 % interval and a
 //!    sentence; Holm-adjusted p-values say which disagree.
-//! 2. **Which effect** ([`candidates`], [`likelihood`], [`fit`], [`score`], [`diagnose`]).
+//! 2. **Which effect** ([`candidates`], [`likelihood`], [`selection`]).
 //!    Each candidate's Gaussian synthetic likelihood ℓ is maximised over its parameters
-//!    (finite-difference derivatives with steps adapted to ℓ's own scale, [`derivatives`]);
+//!    (finite-difference derivatives with steps adapted to ℓ's own scale, [`likelihood::derivatives`]);
 //!    candidates are compared with the baseline by a likelihood-ratio test (χ²_k, Bonferroni
 //!    over the candidates, the statistic Λ = 2(ℓ̂ − ℓ₀)/(c·λ̄) deflated by c = 1 + n/N for
 //!    the simulation's own noise and by λ̄ = max(1, tr(A⁻¹B)/k) for misspecification) and
@@ -41,13 +41,13 @@
 //!      maximised ℓ: BIC may prefer it, but the data do not show it fits closer);
 //!    - `cannot_tell`: some candidate improves the fit but not both significantly and by
 //!      that margin; or none does, and the intervals are too wide to show that the baseline
-//!      agrees within tolerance (see [`compare`]): more specimens are needed;
+//!      agrees within tolerance (see [`comparison::statistics`]): more specimens are needed;
 //!    - `none`: no candidate improves the fit and the baseline agrees within tolerance;
 //!    - `unexplained`: no candidate improves the fit, yet the baseline disagrees (a
 //!      Holm-significant statistic, with at least 30 specimens; with fewer: `cannot_tell`).
 //!
 //!    The named effect's parameters (and those of candidates indistinguishable from it) get
-//!    95 % **profile-likelihood intervals** ([`profile`]): the values θⱼ where
+//!    95 % **profile-likelihood intervals** ([`likelihood::profile`]): the values θⱼ where
 //!    2(ℓ̂ − ℓ_p(θⱼ)) ≤ χ²₁(0.95)·c·λⱼ, ℓ_p the maximum over the other parameters, with the
 //!    test's adjustments (c as above, λⱼ = max(1, (A⁻¹BA⁻¹)ⱼⱼ/(A⁻¹)ⱼⱼ) the one-parameter
 //!    form of λ̄), found by root-finding on the profile with common random numbers and cut
@@ -56,28 +56,37 @@
 //!    where it is quadratic. For a statement about all k parameters at once, the joint
 //!    95 % region (threshold χ²_k(0.95)·c·λ̄) is projected on each parameter as well
 //!    (`joint_interval`). Every candidate also carries its Wald interval, c·A⁻¹BA⁻¹
-//!    ([`fit`]), reported beside the profile one.
+//!    ([`likelihood::fit`]), reported beside the profile one.
 //! 3. **Add it, and look again**: the named effect is added at its fitted values, every
 //!    effect of the model is re-fitted jointly, each effect added in an earlier step is
 //!    tested for removal given the others and tried swapped for a rival that explains the
-//!    same thing better jointly ([`stepwise`]), and step 2 runs again against the updated
-//!    model with the remaining candidates, and so on ([`step`], [`diagnose`]): stepwise
+//!    same thing better jointly ([`selection::update`]), and step 2 runs again against the updated
+//!    model with the remaining candidates, and so on ([`selection::step`], [`selection`]): stepwise
 //!    selection, until no candidate is significant and clearly better, or a named effect
 //!    spoils a model that agreed in distribution (the discrepancy grows beyond its noise,
-//!    or turns significant: it is then not added; [`step`]), or none is left. An effect
+//!    or turns significant: it is then not added; [`selection::step`]), or none is left. An effect
 //!    removed because another took over what it explained is listed as indistinguishable
 //!    from it, with the measurement that would separate them. The false
 //!    discovery rate over the steps is held at α/2 by ForwardStop on the steps'
-//!    Bonferroni-adjusted p-values ([`diagnose::forward_stop`]; removals only take effects
-//!    out); the other half of α = 0.05 is the comparison's ([`compare::LEVEL`]), so that on
+//!    Bonferroni-adjusted p-values ([`selection::forward_stop`]; removals only take effects
+//!    out); the other half of α = 0.05 is the comparison's ([`comparison::statistics::LEVEL`]), so that on
 //!    data missing nothing any verdict but agreement has a rate of at most α.
 //!    `DIR/updated-job.json` is the baseline job with every effect of the final model in
 //!    the case (same case name), which mc-shard and mc-merge run as usual.
 //! 4. **The gap shrinks**: each step's discrepancy before and after, and the baseline's
 //!    against the final model's, statistic by statistic.
+//! 5. **What the data cannot tell apart, and what they do not determine**
+//!    ([`selection::confound`]): the final model's effects fitted jointly once more, each
+//!    value with that fit's interval (profile where the Wald one is cut at the range); a
+//!    parameter whose interval covers most of its plausible range is reported "not
+//!    determined by these data", with no physical reading. Each significant rival is added
+//!    to the final model and all re-fitted: one that moves an effect's parameters out of
+//!    their intervals, or widens them two-fold, is listed as confounded with it (a
+//!    temperature field's offset and vertical gradient against a longeron length bias),
+//!    with the measurement that would separate them.
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
-//! plots of [`plot`], each written through a temporary file and never through a link (a
+//! plots of [`report::plot`], each written through a temporary file and never through a link (a
 //! link or a non-file at any of [`OUTPUTS`] is refused before the work), with the directory
 //! locked while they are written and listed in `.truss-diagnose.manifest` (crate
 //! `run-dir`). The measured files are read only if they are regular files of at most
@@ -86,10 +95,11 @@
 //! ## Candidate effects
 //!
 //! `backlash`, `gravity`, `thermal_gradient`, `length_bias`, `length_sigma`,
-//! `diagonal_pretension` (parameters and ranges in [`candidates`]). `backlash` turns the
+//! `diagonal_pretension`, registered in [`candidates::REGISTRY`] (each in a file of its own
+//! with its parameters and ranges; see [`candidates`]). `backlash` turns the
 //! prism's nodes into truss-core's pin joints whose clearances scatter uniformly among the
 //! joints about a fitted mean (its two parameters: the mean and the half-width, the spread
-//! resolved with the members measured; see [`candidates::Backlash`]); on node positions
+//! resolved with the members measured; see [`candidates::backlash::Backlash`]); on node positions
 //! alone its main trace, the top surface lowered as the diagonals pull the joints across
 //! their clearance, is much what a length error or a uniform temperature change leaves. The
 //! members measured one by one (`--measured-members`) show whether the members themselves
@@ -98,31 +108,21 @@
 //!
 //! ## Measured data
 //!
-//! See [`measured`]: CSV with a header, any column and row order, quoting and CRLF; bad rows
+//! See [`comparison::measured`]: CSV with a header, any column and row order, quoting and CRLF; bad rows
 //! (and rows with extra fields) are errors with their line; specimens missing a compared
 //! node are left out and counted; outlier rows (a coordinate beyond 10 robust SD) are left
 //! out and listed by specimen and line; member rows of specimens the node file lacks, and
 //! member errors beyond 1 % of the member's length, are refused. With
 //! `--measured-members` each specimen's own measured members enter its likelihood
-//! ([`conditional`]).
+//! ([`likelihood::conditional`]).
 
-pub mod baseline;
 pub mod candidates;
-pub mod compare;
-pub mod conditional;
-pub mod derivatives;
-pub mod diagnose;
+pub mod comparison;
 mod errors;
-pub mod fit;
 pub mod likelihood;
-pub mod measured;
-pub mod plot;
-pub mod profile;
 pub mod report;
-pub mod score;
-pub mod simulate;
-pub mod step;
-pub mod stepwise;
+pub mod selection;
+pub mod settings;
 pub mod synth;
 
 pub use errors::DiagnoseError;
@@ -143,7 +143,7 @@ pub struct DiagnoseOptions {
     /// Output directory.
     pub out: PathBuf,
     /// Settings.
-    pub settings: diagnose::Settings,
+    pub settings: settings::Settings,
     /// Draw plots.
     pub plots: bool,
 }
@@ -152,7 +152,7 @@ pub struct DiagnoseOptions {
 #[derive(Debug, Clone)]
 pub struct Summary {
     /// The verdict.
-    pub verdict: diagnose::Verdict,
+    pub verdict: selection::decide::Verdict,
     /// The first named effect or `none`.
     pub named_effect: String,
     /// Every effect added, in order.
@@ -207,21 +207,21 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     }
     // Before any work: no output may go through a link.
     run_dir::OutputDir::check(&options.out, &OUTPUTS)?;
-    let progress = diagnose::Progress::new(s.quiet);
-    let base = baseline::Baseline::read(&options.job, &options.case)?;
-    let data = measured::read(
+    let progress = settings::Progress::new(s.quiet);
+    let base = comparison::baseline::Baseline::read(&options.job, &options.case)?;
+    let data = comparison::measured::read(
         base.model(),
         &options.measured,
         options.measured_members.as_deref(),
         MIN_SPECIMENS,
     )?;
     warn_left_out(&data.report);
-    let d = diagnose::diagnose(&base, &data, s, &progress)?;
+    let d = selection::diagnose(&base, &data, s, &progress)?;
     let dir = &options.out;
     let mut out = run_dir::OutputDir::open(dir, WRITER)?;
     let mut plots = Vec::new();
     if options.plots {
-        plots.extend(plot::draw(
+        plots.extend(report::plot::draw(
             &mut out,
             "before",
             &data,
@@ -231,7 +231,9 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
         )?);
         if let Some(sim) = &d.simulations.1 {
             let label = format!("with {}", d.named_effects().join(" and "));
-            plots.extend(plot::draw(&mut out, "after", &data, sim, d.top, &label)?);
+            plots.extend(report::plot::draw(
+                &mut out, "after", &data, sim, d.top, &label,
+            )?);
         }
     }
     let mut files = vec![
@@ -265,7 +267,7 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
 }
 
 /// What reading the data left out, on stderr.
-fn warn_left_out(r: &measured::DataReport) {
+fn warn_left_out(r: &comparison::measured::DataReport) {
     let warn = |m: String| eprintln!("truss diagnose: warning: {m}");
     for o in &r.outliers {
         warn(format!("outlier left out: {}", o.words()));

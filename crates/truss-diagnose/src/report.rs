@@ -3,7 +3,7 @@
 //! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
 //! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 5)
+//! ## diagnosis.json (format `truss-diagnose`, version 6)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -33,13 +33,28 @@
 //!               discrepancy_noise_after (the energy distances' permutation noise), seconds}]
 //! effects     [{name, parameters [[name, unit, value]]}]   the final model's effects at
 //!              their final values (after the re-fits): what updated-job.json holds
-//! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null}]
+//! final_fit   [{name, parameters[]}]   the same effects fitted jointly, each parameter (as
+//!              below) with the joint fit's interval: Wald, profile where the Wald one is
+//!              cut at the range; for a model of one effect, its step's fit (profile
+//!              intervals); empty when no effect was added
+//! confounding [{effect, rival, parameters[] {name, unit, value, with_rival, interval,
+//!              moved, widening}, lr_statistic, p_value, delta_bic, separate_by}]   rivals
+//!              that, added to the final model and fitted jointly, move an effect's
+//!              parameters out of their intervals (moved) or widen their Wald intervals
+//!              two-fold or more (widening): the data cannot tell how that part of the
+//!              signal divides between the two; the rival is also listed in the
+//!              `indistinguishable` of the step that named the effect
+//! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
+//!              determined}]
 //!              (the first named effect's, as fitted in its step; for an effect swapped in,
 //!              the last joint re-fit's, Wald intervals)
 //!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
 //!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
 //!              indistinguishable from it, else "wald"; lower/upper null when not found;
 //!              an end at the range end is the range's (the interval is cut there)
+//!   determined false where the interval, or the Wald interval, covers at least half of the
+//!              plausible range (on the fit's scale): "not determined by these data", no
+//!              physical reading
 //!   joint_interval  where profiled: the joint 95 % region of all k parameters projected on
 //!              this one (same fields, threshold χ²_k(0.95)·c·λ̄): every parameter inside its
 //!              joint interval at once with 95 % confidence
@@ -61,8 +76,12 @@
 //!              model; after = before when no effect is added)
 //! method      {likelihood, fit, intervals, selection, verdicts, steps, statistics, discrepancy}
 //!             (in words)
-//! timing      {simulations, solves, seconds}
+//! timing      {simulations, solves, seconds, final_fit_seconds}
 //! ```
+//!
+//! Version 6 (from 5): `final_fit`, `confounding`, each parameter's `determined`,
+//! `timing.final_fit_seconds`; a confounded rival is also in its effect's step's
+//! `indistinguishable`.
 //!
 //! Within version 5, the `backlash` candidate's `parameters` became `clearance` (the
 //! joints' mean clearance) and `spread` (the half-width of their uniform scatter; before:
@@ -86,24 +105,31 @@
 //! charges the misspecification adjustment λ̄ in the penalty (k·λ̄·ln n) instead of dividing
 //! the likelihood ratio by it.
 
-use crate::baseline::Baseline;
-use crate::compare::Comparison;
-use crate::diagnose::{CandidateScore, Diagnosis, FittedParameter, Verdict};
-use crate::measured::{DataReport, Measured};
-use crate::step::{ModelEffect, RefitEffect, Step};
-use crate::stepwise::Removal;
+use crate::comparison::baseline::Baseline;
+use crate::comparison::measured::{DataReport, Measured};
+use crate::comparison::statistics::Comparison;
+use crate::likelihood::score::{CandidateScore, FittedParameter};
+use crate::selection::Diagnosis;
+use crate::selection::confound::Confounding;
+use crate::selection::decide::Verdict;
+use crate::selection::eliminate::Removal;
+use crate::selection::model::{ModelEffect, RefitEffect};
+use crate::selection::step::Step;
+use method::{METHOD, Method};
 use serde::Serialize;
 
 mod markdown;
+mod method;
+pub mod plot;
 mod wording;
 
+pub use crate::likelihood::score::{p_is, p_text};
 pub use markdown::markdown;
-pub use wording::{p_is, p_text};
 
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -135,31 +161,8 @@ struct Timing {
     simulations: usize,
     solves: usize,
     seconds: f64,
+    final_fit_seconds: f64,
 }
-
-#[derive(Serialize)]
-struct Method {
-    likelihood: &'static str,
-    fit: &'static str,
-    intervals: &'static str,
-    selection: &'static str,
-    verdicts: &'static str,
-    steps: &'static str,
-    statistics: &'static str,
-    discrepancy: &'static str,
-}
-
-/// The method, in words (also in the crate doc).
-const METHOD: Method = Method {
-    likelihood: "Gaussian synthetic likelihood of the specimens' displacement vectors at the compared coordinates: N(μ, Σ) with μ and Σ the mean and covariance of N simulated samples (common random numbers: same seed and case name as the baseline) plus (σ_m² + τ²)·I, τ = 0.1 µm; ℓ = Σ ln N(yᵢ; μ, Σ). With --measured-members, plus Σ ln N(e; E ε, Var ε + σ_m² + τ²) over the measured member length errors.",
-    fit: "each candidate's ℓ maximised over its plausible range (log scale for σ, |g| ≤ 1 for gravity) from the best of its null (the baseline) and a scan along each parameter, by a trust-region Newton method on the unit cube; gradient, curvature A and score variability B by finite differences whose step along each parameter is adapted to the likelihood's own scale (the central second difference about one unit of ℓ, i.e. a step of about one standard error; 1e-7 to 0.05 of the range).",
-    intervals: "95 % profile-likelihood intervals for the named effect and any indistinguishable from it: the values θ_j where 2(ℓ̂ − ℓ_p(θ_j)) ≤ χ²₁(0.95)·c·λ_j, ℓ_p the maximum over the other parameters, c = 1 + n/N for the simulation's own noise, λ_j = max(1, (A⁻¹BA⁻¹)_jj/(A⁻¹)_jj) for misspecification (Royall & Tsou 2003; the one-parameter form of the test's λ̄); ends found by safeguarded root-finding on √(2(ℓ̂ − ℓ_p)) with common random numbers, to 5 % in the threshold; an end that reaches the plausible range is cut there and flagged. For all k parameters at once, the joint 95 % region 2(ℓ̂ − ℓ(θ)) ≤ χ²_k(0.95)·c·λ̄ projected on each parameter (joint_interval; the same computation with that threshold). Every candidate also has the sandwich Wald interval t̂ ± 1.96·√(c·A⁻¹BA⁻¹) (wald_interval), which assumes ℓ quadratic; the verdict and checks use the profile interval.",
-    selection: "likelihood-ratio statistic Λ = 2(ℓ − ℓ₀)/(c·λ̄) against the baseline, c = 1 + n/N, λ̄ = max(1, tr(A⁻¹B)/k); p = P(χ²_k ≥ Λ), significant when p < 0.025/K (Bonferroni over the K candidates at α/2: the other half of α = 0.05 is the comparison's, so that data missing nothing get a verdict other than agreement at most 5 % of the time); ΔBIC = k·λ̄·ln n − 2(ℓ − ℓ₀)/c = λ̄·(k ln n − Λ) (n specimens), the BIC of a misspecified likelihood whose penalty counts the effective number of parameters tr(A⁻¹B) = k·λ̄ (Gao & Song 2010), so that candidates' likelihoods are compared unscaled. Named: the candidate with the lowest ΔBIC if it is significant and ΔBIC ≤ −2; indistinguishable: other candidates with ΔBIC within 2 of it, and significant candidates the named one does not fit significantly closer than by Vuong's test for non-nested models, z = Σ_u d_u/√(c·n·var d) < 1.96 with d_u the difference of the two maximised ℓ's terms for specimen u (its member observations included) (Vuong 1989): BIC then prefers the named one, but by its penalty or by a difference in ℓ within the specimens' own scatter, not by a fit the data show to be closer. Significant means better than the baseline, not present: when the baseline misses some effect, any candidate that mimics part of it improves on the baseline, and BIC chooses between them.",
-    verdicts: "named: as above. cannot_tell: some candidate improves the fit but not both significantly and by ΔBIC ≤ −2, or none improves it and the data cannot show the baseline agrees within tolerance. none: no candidate improves it and the baseline agrees within tolerance (every coordinate's mean within ±0.5 predicted SD, its SD and θ_P's median and 95th percentile within a factor 1.3, judged by their 95 % intervals). unexplained: no candidate improves it, yet the baseline disagrees (a Holm-significant statistic, with at least 30 specimens; with fewer, cannot_tell).",
-    statistics: "per coordinate, piston (mean top z), tan θ_x, tan θ_y: mean difference (Welch interval), SD ratio (interval on ln with kurtosis-corrected variance), covariances (fourth-moment variance); θ_P percentiles 50/90/95/99 (Hyndman–Fan definition 1) as ratios with Poisson-bootstrap intervals (B = 1000); KS on θ_P; energy distance with a permutation test (R = 199). The simulation carries the instrument's noise. Disagrees: Holm-adjusted p < 0.025 (half of α = 0.05; the candidates' tests have the other half). p-values under \"no difference\" use the simulated moments for both parts (the measured specimens are draws from the simulation under that hypothesis); the 95 % intervals are Welch's with Student's t.",
-    steps: "stepwise selection: step 1 tests every candidate against the baseline; a named effect is added at its fitted values, every effect of the model is re-fitted jointly (one trust-region Newton fit of all their parameters), each effect added in an earlier step is tested for removal given the others (Λ = 2(ℓ̂ − ℓ̂ without it)/(c·λ), removed, the least needed first, unless p < α/2 and ΔBIC ≤ −2), then tried swapped for a rival candidate of its own step (significant then and at least half its ΔBIC), the swap made when the swapped model's BIC is lower by 2 or more; then step 2 tests the remaining candidates against that model, and so on, until a step names nothing (no candidate significant at α/K and better by ΔBIC ≤ −2), or names an effect that, where the model before it agrees in distribution (energy test not significant at 0.025), makes the discrepancy grow beyond its noise (E_after − E_before > 1.96·√(s_before² + s_after²), s the energy distance's permutation RMS) or the energy test significant (then it is not added), or no candidate is left. A removed effect is listed as indistinguishable from the effect whose parameters moved furthest when it was removed. The false discovery rate over the steps is held at α by ForwardStop (G'Sell et al. 2016) on the steps' Bonferroni-adjusted p-values min(1, K·p): the named effects kept are the first k̂, k̂ = max{k : −(1/k)·Σ_{s≤k} ln(1 − p_s) ≤ α}, and removals only take effects out of the model.",
-    discrepancy: "energy distance (unbiased U-statistic, Székely & Rizzo 2004) between the measured and simulated displacement vectors, each coordinate divided by its measured SD: 0 when the distributions agree; its noise is the root mean square of the statistic over the R = 199 permutations.",
-};
 
 #[derive(Serialize)]
 struct Report<'a> {
@@ -181,6 +184,8 @@ struct Report<'a> {
     skipped: Vec<Skipped<'a>>,
     steps: Vec<StepReport<'a>>,
     effects: &'a [ModelEffect],
+    final_fit: &'a [RefitEffect],
+    confounding: &'a [Confounding],
     statistics: Statistics<'a>,
     discrepancy_before: f64,
     discrepancy_after: f64,
@@ -293,6 +298,8 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
             .collect(),
         steps: d.steps.iter().map(StepReport::of).collect(),
         effects: &d.effects,
+        final_fit: &d.final_fit,
+        confounding: &d.confounding,
         statistics: Statistics {
             before: &d.before,
             after: d.after.as_ref(),
@@ -304,6 +311,7 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
             simulations: d.work.0,
             solves: d.work.1,
             seconds: d.work.2,
+            final_fit_seconds: d.final_seconds,
         },
     };
     let mut s = serde_json::to_string_pretty(&report).expect("the report serialises");

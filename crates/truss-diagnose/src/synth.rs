@@ -12,11 +12,11 @@
 //! `S0001`, `S0002`, …; a sample whose solve fails is skipped. With a member file, every
 //! member with a length-error distribution is written as drawn (plus noise σ_m).
 
-use crate::baseline::Baseline;
 use crate::candidates::{library, parse_effect};
+use crate::comparison::baseline::Baseline;
+use crate::comparison::measured::Coordinate;
+use crate::comparison::simulate::{Noise, noise_normal, simulate, top_indices};
 use crate::errors::DiagnoseError;
-use crate::measured::Coordinate;
-use crate::simulate::{Noise, noise_normal, simulate, top_indices};
 use std::io::Write;
 use std::path::PathBuf;
 

@@ -1,4 +1,4 @@
-//! Hidden-effect checks (issue 7, "Test it on data in which the effect is hidden"): measured
+//! Hidden-effect checks (test it on data in which the effect is hidden): measured
 //! data made by `synth` from the baseline case of `jobs/diagnose-baseline.json` (the paper's
 //! 5-stage prism, σ = 6.3 µm on battens and longerons, section 3.1) with an effect the
 //! diagnosis is not told, under a seed independent of the job's, with 1 µm instrument noise;
@@ -17,19 +17,43 @@
 //! pairs of effects in which the stepwise selection must swap out or remove an effect it
 //! named first.
 //! `scripts/diagnose-check.sh` runs the full checks of the stepwise selection (null over ten
-//! seeds, each effect over five, five pairs over three seeds, backlash with and without
-//! members; 200 specimens, default N) with the release build; too slow for CI.
+//! seeds, each effect over three, pairs and mean shifts over three seeds, backlash with and
+//! without members; 200 specimens, default N) with the release build; too slow for CI.
 
+#[path = "hidden_effects/confounding.rs"]
+mod confounding;
 #[path = "hidden_effects/stepwise.rs"]
 mod stepwise;
 
 use std::path::{Path, PathBuf};
-use truss_diagnose::diagnose::Settings;
+use truss_diagnose::settings::Settings;
 use truss_diagnose::synth::{SynthOptions, synth};
 use truss_diagnose::{DiagnoseOptions, run};
 
 fn job() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../jobs/diagnose-baseline.json")
+}
+
+/// Parameter `name` of `effect` in the final model's joint fit (`final_fit`: the numbers
+/// the report reads last, with their intervals).
+pub(crate) fn final_parameter<'a>(
+    v: &'a serde_json::Value,
+    effect: &str,
+    name: &str,
+) -> &'a serde_json::Value {
+    v["final_fit"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["name"] == effect)
+        .and_then(|e| {
+            e["parameters"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|p| p["name"] == name)
+        })
+        .unwrap_or_else(|| panic!("no {effect} {name} in {}", v["final_fit"]))
 }
 
 fn make(dir: &Path, name: &str, effect: &str, specimens: usize, seed: u64) -> PathBuf {
@@ -367,7 +391,7 @@ fn member_measurements_narrow_a_length_effect() {
     check_narrower(&both, &alone);
 }
 
-/// The issue's backlash check on section 4.2.3's truss at σ = 0.033 mm (diagonals
+/// The backlash check on section 4.2.3's truss at σ = 0.033 mm (diagonals
 /// U[−0.099, 0] mm), 200 specimens with their members measured one by one, diagnosed
 /// against the rigid case `rigid-sigma-0.033` of `jobs/paper-4.2.3.json` with backlash and
 /// its two rivals ([`RIVALS`]):
@@ -445,7 +469,7 @@ fn hidden_backlash_is_named_with_member_measurements() {
     check_halved(&v);
 }
 
-/// Issue 14: conditioning each specimen's node term on its own measured members narrows the
+/// Conditioning each specimen's node term on its own measured members narrows the
 /// backlash clearance's interval, compared with the distribution-only use of the same
 /// member measurements, on the same data (paper clearances, 80 specimens, N = 1200, backlash
 /// against the length bias).
@@ -603,7 +627,7 @@ fn two_hidden_effects_are_both_named_fast() {
     assert!(!md.contains("p = 0.00e0"), "{md}");
 }
 
-/// The fast thermal check (issue 13's default-run version): a gradient of 0.002 K/mm along x
+/// The fast thermal check (the default run's version): a gradient of 0.002 K/mm along x
 /// and a uniform 2 K on 40 specimens, tried against the temperature field and a diagonal
 /// pretension:
 /// the field is named alone, the truth inside the joint region, the gap at least halved.
@@ -638,7 +662,7 @@ fn hidden_thermal_gradient_is_named_fast() {
     );
 }
 
-/// The fast member-measurement check (issue 13's default-run version): a longeron bias of
+/// The fast member-measurement check (the default run's version): a longeron bias of
 /// 3 µm on 40 specimens, with and without their members measured one by one: named either
 /// way, and the batten bias's interval at least halved with the members ([`check_narrower`]).
 #[test]
@@ -666,7 +690,7 @@ fn member_measurements_narrow_a_length_effect_fast() {
 /// barely see the battens' lengths, their measurements see them directly (600 and more
 /// observations). The longerons' bias the nodes see well: given each specimen's measured
 /// members its node positions say nothing more about the members' mean (the conditioned
-/// likelihood, [`truss_diagnose::conditional`]), so its interval comes from the member
+/// likelihood, [`truss_diagnose::likelihood::conditional`]), so its interval comes from the member
 /// observations alone and is about as wide as from the nodes alone (1.2 against 1.1 µm on
 /// 40 specimens, seed 22).
 fn check_narrower(both: &serde_json::Value, alone: &serde_json::Value) {
@@ -683,7 +707,7 @@ fn check_narrower(both: &serde_json::Value, alone: &serde_json::Value) {
     assert!(b < 0.5 * a, "batten: {b} with members, {a} without");
 }
 
-/// Issue 15's null check: data made from the baseline itself, 20 seeds at 100 specimens,
+/// The null check: data made from the baseline itself, 20 seeds at 100 specimens,
 /// every candidate but backlash (the slowest to simulate; its null behaviour is that of the
 /// others), N = 400. A false positive is any named effect or the verdict `unexplained`. The
 /// rate must not be significantly above α = 0.05: at most 3 of 20 (for a rate of exactly
@@ -752,7 +776,7 @@ fn one_bad_row_is_an_outlier_not_an_effect() {
     assert_eq!(v["named_effects"], serde_json::json!([]), "{}", v["reason"]);
 }
 
-/// Issue 15's refusals, each naming what is wrong: `--samples` above the documented 10 000,
+/// The refusals, each naming what is wrong: `--samples` above the documented 10 000,
 /// and `synth-measured` parameters outside their range or not finite (`clearance=-0.01`
 /// was silently taken as 0, `gradient_x=nan` gave an internal error).
 #[test]

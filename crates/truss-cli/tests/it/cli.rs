@@ -202,9 +202,11 @@ fn synth_measured_then_diagnose_names_the_hidden_effect() {
     assert!(d["indistinguishable"].is_array());
     assert!(d["statistics"]["after"]["statistics"].is_array());
     assert!(d["discrepancy_after"].as_f64().unwrap() < d["discrepancy_before"].as_f64().unwrap());
-    let updated =
-        truss_diagnose::baseline::Baseline::read(&report.join("updated-job.json"), "as-built")
-            .unwrap();
+    let updated = truss_diagnose::comparison::baseline::Baseline::read(
+        &report.join("updated-job.json"),
+        "as-built",
+    )
+    .unwrap();
     let fitted = d["parameters"][0]["value"].as_f64().unwrap();
     match updated.distributions().get("diagonal") {
         Some(mc_dist) => assert!((mc_dist.mean() - fitted).abs() < 1e-12),

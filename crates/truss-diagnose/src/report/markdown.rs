@@ -3,11 +3,15 @@
 //! step of the selection, the updated job, the baseline against the final model, what to
 //! measure or do next, the plots and the method.
 
-use super::METHOD;
-use super::wording::{code_list, g, parameter_text, plain_reading, spans};
-use crate::baseline::Baseline;
-use crate::diagnose::{Diagnosis, FittedParameter, Verdict};
-use crate::measured::Measured;
+use super::method::METHOD;
+use super::wording::{code_list, effect, g, parameter_text, plain_reading, push, spans};
+use crate::candidates::candidate::separating_measurement;
+use crate::comparison::baseline::Baseline;
+use crate::comparison::measured::Measured;
+use crate::likelihood::score::p_is;
+use crate::selection::Diagnosis;
+use crate::selection::confound::WIDENED;
+use crate::selection::decide::Verdict;
 use discrepancy::{before_after_section, disagreement_section, step_section};
 
 mod discrepancy;
@@ -24,7 +28,7 @@ pub fn markdown(
     data_section(&mut m, baseline, measured, d);
     disagreement_section(&mut m, d);
     for s in &d.steps {
-        step_section(&mut m, baseline, s);
+        step_section(&mut m, baseline, d, s);
     }
     for (n, why) in &d.skipped {
         push(&mut m, &format!("- `{n}` not tried: {why}."));
@@ -37,12 +41,6 @@ pub fn markdown(
     next_step_section(&mut m, measured, d);
     method_section(&mut m, d, plots);
     m
-}
-
-/// Appends `s` and a newline.
-fn push(m: &mut String, s: &str) {
-    m.push_str(s);
-    m.push('\n');
 }
 
 /// The title, the verdict and the fitted values.
@@ -69,68 +67,125 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
     );
     push(m, &format!("{}.\n", d.reason.trim_end_matches('.')));
     let span = spans(baseline);
-    for e in &d.effects {
-        let Some((s, c)) = d
+    for e in &d.final_fit {
+        let c = effect(d, &e.name);
+        let step = d
             .steps
             .iter()
             .filter(|s| s.kept)
-            .find_map(|s| s.named_score().filter(|c| c.name == e.name).map(|c| (s, c)))
-        else {
-            // Swapped in: its values and intervals are those of the last joint fit.
-            let fit = d
-                .steps
+            .find(|s| s.named_effect() == Some(e.name.as_str()));
+        let joint = d.final_fit.len() > 1
+            || step.is_none_or(|s| {
+                s.named_score().is_none_or(|n| {
+                    n.parameters
+                        .iter()
+                        .zip(&e.parameters)
+                        .any(|(a, b)| a.value != b.value)
+                })
+            });
+        push(
+            m,
+            &format!(
+                "Fitted `{}` ({}{}):\n",
+                e.name,
+                step.map_or("swapped in".to_string(), |s| format!(
+                    "named in step {}",
+                    s.number
+                )),
+                if joint {
+                    "; the final model's effects fitted jointly, with that fit's intervals"
+                } else {
+                    ""
+                }
+            ),
+        );
+        for (j, p) in e.parameters.iter().enumerate() {
+            let rivals: Vec<&String> = d
+                .confounding
                 .iter()
-                .filter(|s| s.kept)
-                .flat_map(|s| &s.refitted)
-                .rfind(|r| r.name == e.name);
-            push(
-                m,
-                &format!("Fitted `{}` (swapped in; the last joint re-fit):\n", e.name),
-            );
-            for p in fit.map_or(&[][..], |f| &f.parameters) {
-                push(
-                    m,
-                    &format!(
-                        "- {}: {}",
-                        parameter_text(p),
-                        plain_reading(&e.name, p, span)
-                    ),
-                );
-            }
-            push(m, "");
-            continue;
-        };
-        push(m, &format!("Fitted `{}` (step {}):\n", c.name, s.number));
-        // The final value where a later step re-fitted it.
-        let last = d
-            .effects
-            .iter()
-            .find(|e| e.name == c.name)
-            .map(|e| &e.parameters);
-        for p in &c.parameters {
-            let now = last
-                .and_then(|ps| ps.iter().find(|q| q.0 == p.name))
-                .map(|q| q.2)
-                .filter(|&v| v != p.value);
-            let reading = FittedParameter {
-                value: now.unwrap_or(p.value),
-                ..p.clone()
-            };
+                .filter(|k| k.effect == e.name && k.parameters.iter().any(|q| q.name == p.name))
+                .map(|k| &k.rival)
+                .collect();
             push(
                 m,
                 &format!(
-                    "- {}{}: {}",
-                    parameter_text(p),
-                    now.map_or(String::new(), |v| format!(
-                        "; {} {} after the later steps' re-fit",
-                        g(v),
-                        p.unit
-                    )),
-                    plain_reading(&c.name, &reading, span)
+                    "- {}: {}{}",
+                    parameter_text(c, j, p),
+                    plain_reading(c, j, p, span),
+                    if rivals.is_empty() {
+                        String::new()
+                    } else {
+                        format!(
+                            "; confounded with {} (below): this reading holds only without {}",
+                            code_list(&rivals, " and "),
+                            if rivals.len() == 1 { "it" } else { "them" }
+                        )
+                    }
                 ),
             );
         }
         push(m, "");
+    }
+    confounding_section(m, d);
+}
+
+/// What the data cannot tell apart within the final model: each rival confounded with an
+/// effect's parameters, and the measurement that would separate them.
+fn confounding_section(m: &mut String, d: &Diagnosis) {
+    for c in &d.confounding {
+        push(
+            m,
+            &format!(
+                "**Cannot be told apart: `{}` and `{}`.** With `{}` added and every effect fitted jointly, {} of `{}` {} confounded with it: {}; `{}` given the model: Λ = {:.1}, {}, ΔBIC = {:.1}. These data cannot say how that part of the signal divides between the two, so the values above are one reading of it. What would separate them: {}.\n",
+                c.effect,
+                c.rival,
+                c.rival,
+                code_list(
+                    &c.parameters.iter().map(|p| &p.name).collect::<Vec<_>>(),
+                    ", "
+                ),
+                c.effect,
+                if c.parameters.len() == 1 { "is" } else { "are" },
+                c.parameters
+                    .iter()
+                    .map(|p| {
+                        if p.moved && p.widening >= WIDENED {
+                            format!(
+                                "`{}` moves from {} to {} {}, outside its interval, which widens {:.1}-fold",
+                                p.name,
+                                g(p.value),
+                                g(p.with_rival),
+                                p.unit,
+                                p.widening
+                            )
+                        } else if p.moved {
+                            format!(
+                                "`{}` moves from {} to {} {}, outside its interval",
+                                p.name,
+                                g(p.value),
+                                g(p.with_rival),
+                                p.unit
+                            )
+                        } else {
+                            format!(
+                                "`{}`'s interval widens {:.1}-fold ({} to {} {})",
+                                p.name,
+                                p.widening,
+                                g(p.value),
+                                g(p.with_rival),
+                                p.unit
+                            )
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .join("; "),
+                c.rival,
+                c.lr_statistic,
+                p_is(c.p_value),
+                c.delta_bic,
+                c.separate_by
+            ),
+        );
     }
 }
 
@@ -217,23 +272,40 @@ fn updated_job_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
             )
         },
     );
+    let undetermined: Vec<String> =
+        d.final_fit
+            .iter()
+            .flat_map(|e| {
+                e.parameters.iter().filter(|p| !p.determined).map(move |p| {
+                    format!("`{}` of `{}` ({} {})", p.name, e.name, g(p.value), p.unit)
+                })
+            })
+            .collect();
+    if !undetermined.is_empty() {
+        push(
+            m,
+            &format!(
+                "Not determined by these data: {}. The updated job holds the best-fitting value, but the data leave most of the plausible range open: treat it as unknown.\n",
+                undetermined.join(", ")
+            ),
+        );
+    }
 }
 
 /// `## Next step`: what to measure or do next.
 fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
     push(m, "## Next step\n");
     let mut advice = Vec::new();
-    let joint_like = ["length_bias", "diagonal_pretension"];
     for s in &d.steps {
         let Some(named) = s.named_effect() else {
             continue;
         };
-        let mixes_backlash = (named == "backlash"
-            && s.indistinguishable
-                .iter()
-                .any(|o| joint_like.contains(&o.as_str())))
-            || (joint_like.contains(&named) && s.indistinguishable.iter().any(|o| o == "backlash"));
-        if mixes_backlash && measured.members.is_none() {
+        let a = effect(d, named);
+        let mistaken = s.indistinguishable.iter().any(|o| {
+            let b = effect(d, o);
+            a.mistaken_without_members(b.trace()) || b.mistaken_without_members(a.trace())
+        });
+        if mistaken && measured.members.is_none() {
             advice.push(format!(
                 "Step {}: `{named}` and {} fit the node positions equally well: joint free play shortens the truss much as a member-length error does. Measure the member lengths one by one (longerons and diagonals, to a few µm) and run again with `--measured-members`: then they separate.",
                 s.number,
@@ -248,7 +320,7 @@ fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
                     .iter()
                     .map(|n| format!(
                         "from `{n}`, {}",
-                        crate::stepwise::separating_measurement(named, n)
+                        separating_measurement(a, effect(d, n))
                     ))
                     .collect::<Vec<_>>()
                     .join("; ")

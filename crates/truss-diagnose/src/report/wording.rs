@@ -1,32 +1,12 @@
-//! How the diagnosis's numbers read in words, for `diagnosis.md` and the verdicts' reasons:
-//! p-values, numbers and intervals to a few significant digits, and a fitted parameter
-//! with its 95 % interval and what its value means for the hardware (a temperature
-//! difference across the truss, a member-length error in µm, a joint's clearance).
+//! How the diagnosis's numbers read in words, for `diagnosis.md`: numbers and intervals to
+//! a few significant digits, and a fitted parameter with its 95 % interval and what its
+//! value means for the hardware, in its candidate's own words (a temperature difference
+//! across the truss, a member-length error in µm, a joint's clearance).
 
-use crate::baseline::Baseline;
-use crate::diagnose::FittedParameter;
-
-/// A p-value for people: `p < 1e-16` below what a double can tell from 0 after
-/// `1 − CDF`, else two significant digits.
-pub fn p_text(p: f64) -> String {
-    if p < 1e-16 {
-        "< 1e-16".into()
-    } else if p >= 0.01 {
-        format!("{p:.2}")
-    } else {
-        format!("{p:.1e}")
-    }
-}
-
-/// `p = 0.03` or `p < 1e-16`.
-pub fn p_is(p: f64) -> String {
-    let t = p_text(p);
-    if t.starts_with('<') {
-        format!("p {t}")
-    } else {
-        format!("p = {t}")
-    }
-}
+use crate::candidates::candidate::Candidate;
+use crate::comparison::baseline::Baseline;
+use crate::likelihood::score::FittedParameter;
+use crate::selection::Diagnosis;
 
 pub(super) fn g(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
@@ -50,7 +30,10 @@ pub(super) fn interval_text(lower: f64, upper: f64) -> String {
     }
 }
 
-pub(super) fn parameter_text(p: &FittedParameter) -> String {
+/// Parameter `j` of effect `c` with its value and 95 % interval, and what it means where
+/// its interval reaches its null, if that is a result of the effect's own
+/// ([`Candidate::unresolved`]).
+pub(super) fn parameter_text(c: &dyn Candidate, j: usize, p: &FittedParameter) -> String {
     let i = &p.interval;
     let end = |v: Option<f64>| v.map_or("?".to_string(), g);
     // The joint region's projection, where it differs from the parameter's own interval
@@ -83,15 +66,10 @@ pub(super) fn parameter_text(p: &FittedParameter) -> String {
             }
         )
     };
-    // Backlash's spread (the half-width of the joints' clearances): where its interval
-    // reaches 0 the data cannot tell scattered clearances from equal ones.
-    let unresolved = if p.name == "spread"
-        && (i.lower.is_none_or(|l| l <= 0.0) || i.lower_at_range_end)
-    {
-        " — spread: not resolved by these data (its interval reaches 0: the joints may all have the same clearance, which the fitted `clearance` then stands for)"
-    } else {
-        ""
-    };
+    let unresolved = c
+        .unresolved(j)
+        .filter(|_| i.lower.is_none_or(|l| l <= p.null) || i.lower_at_range_end)
+        .unwrap_or("");
     format!("{} = {} {}{iv}{unresolved}", p.name, g(p.value), p.unit)
 }
 
@@ -110,62 +88,21 @@ pub(super) fn spans(baseline: &Baseline) -> [f64; 3] {
     out
 }
 
-/// A fitted parameter in plain words: what it means for the hardware.
-pub(super) fn plain_reading(effect: &str, p: &FittedParameter, span: [f64; 3]) -> String {
-    let v = p.value;
-    let um = |mm: f64| format!("{:.1} µm", mm * truss_units::MICROMETRE_PER_MM);
-    let name = p.name.as_str();
-    match (effect, name) {
-        ("thermal_gradient", "offset") => format!(
-            "the whole truss about {:.2} K {} than the stated conditions",
-            v.abs(),
-            if v >= 0.0 { "warmer" } else { "cooler" }
-        ),
-        ("thermal_gradient", _) => {
-            let a = match name {
-                "gradient_x" => 0,
-                "gradient_y" => 1,
-                _ => 2,
-            };
-            format!(
-                "about {:.2} K of temperature difference across the {:.0} mm the truss spans along {}",
-                (v * span[a]).abs(),
-                span[a],
-                ["x", "y", "z"][a]
-            )
-        }
-        ("gravity", _) => format!(
-            "self-weight of {:.2} g along {}{} (a ground test's gravity direction)",
-            v.abs(),
-            if v >= 0.0 { "+" } else { "−" },
-            &name[2..]
-        ),
-        ("length_bias", _) => format!(
-            "the {} members are on average {} {} than nominal",
-            name.trim_start_matches("bias."),
-            um(v.abs()),
-            if v >= 0.0 { "longer" } else { "shorter" }
-        ),
-        ("length_sigma", _) => format!(
-            "the {} members' lengths scatter by {} (1 SD), {:.2} times the stated {}",
-            name.trim_start_matches("sigma."),
-            um(v),
-            v / p.null,
-            um(p.null)
-        ),
-        ("diagonal_pretension", _) => format!(
-            "the diagonals are on average {} shorter than nominal, pretensioning the frame",
-            um(v.abs())
-        ),
-        ("backlash", "spread") => format!(
-            "the joints' clearances scatter uniformly within ±{} of their mean (some joints tighter, some looser)",
-            um(v)
-        ),
-        ("backlash", _) => format!(
-            "each pin joint has on average about {} of radial clearance (free play of its shaft in the hole)",
-            um(v)
-        ),
-        _ => String::new(),
+/// Parameter `j` of effect `c` in plain words: what its value means for the hardware
+/// ([`Candidate::reading`]); none where the data do not determine it.
+pub(super) fn plain_reading(
+    c: &dyn Candidate,
+    j: usize,
+    p: &FittedParameter,
+    span: [f64; 3],
+) -> String {
+    if p.determined {
+        c.reading(j, p.value, span)
+    } else {
+        format!(
+            "not determined by these data (its intervals leave up to {:.0} % of its plausible range open): no reading is given",
+            100.0 * p.coverage(&c.parameters()[j])
+        )
     }
 }
 
@@ -176,4 +113,16 @@ pub(super) fn code_list(names: &[impl std::fmt::Display], separator: &str) -> St
         .map(|n| format!("`{n}`"))
         .collect::<Vec<_>>()
         .join(separator)
+}
+
+/// The library's candidate named `name`: every effect a report names is one of them.
+pub(super) fn effect<'a>(d: &'a Diagnosis, name: &str) -> &'a dyn Candidate {
+    d.candidate(name)
+        .expect("every effect the diagnosis names is in its library")
+}
+
+/// Appends `s` and a newline.
+pub(super) fn push(m: &mut String, s: &str) {
+    m.push_str(s);
+    m.push('\n');
 }

@@ -1,9 +1,9 @@
-//! The stepwise selection end to end (issue 14): two effects hidden at once, where the
+//! The stepwise selection end to end: two effects hidden at once, where the
 //! effect named first is only a stand-in for one found later, so a later step must swap it
 //! out or remove it. These are two of `scripts/diagnose-check.sh`'s pairs (seed 301, 200
 //! specimens), each a few tens of seconds in release.
 
-use super::{diagnose, make};
+use super::{diagnose, final_parameter, make};
 
 /// The record of `effect` leaving the model, which must have added it at an earlier step.
 fn removal<'a>(v: &'a serde_json::Value, effect: &str) -> &'a serde_json::Value {
@@ -24,29 +24,10 @@ fn removal<'a>(v: &'a serde_json::Value, effect: &str) -> &'a serde_json::Value 
 }
 
 /// Each `(effect, parameter, truth)` inside the final model's 95 % interval of that
-/// parameter (the last kept step's joint re-fit).
+/// parameter (its joint fit's, [`final_parameter`]).
 fn check_truths(v: &serde_json::Value, truths: &[(&str, &str, f64)]) {
-    let step = v["steps"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .rev()
-        .find(|s| s["kept"] == true)
-        .unwrap();
     for &(effect, name, truth) in truths {
-        let p = step["refitted"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|e| e["name"] == effect)
-            .and_then(|e| {
-                e["parameters"]
-                    .as_array()
-                    .unwrap()
-                    .iter()
-                    .find(|p| p["name"] == name)
-            })
-            .unwrap_or_else(|| panic!("{effect}.{name} not in the final model"));
+        let p = final_parameter(v, effect, name);
         let f = |x: &serde_json::Value| x.as_f64().unwrap();
         let (lo, hi) = (f(&p["interval"]["lower"]), f(&p["interval"]["upper"]));
         assert!(

@@ -3,14 +3,15 @@
 //! and removed and how much of the gap it closed, and the baseline against the final model
 //! statistic by statistic, with what still disagrees.
 
-use super::push;
-use crate::baseline::Baseline;
-use crate::compare::Statistic;
-use crate::diagnose::{CandidateScore, Diagnosis};
+use crate::comparison::baseline::Baseline;
+use crate::comparison::statistics::Statistic;
+use crate::likelihood::score::CandidateScore;
+use crate::likelihood::score::{p_is, p_text};
 use crate::report::wording::{
-    g, interval_text, p_is, p_text, parameter_text, plain_reading, spans,
+    effect, g, interval_text, parameter_text, plain_reading, push, spans,
 };
-use crate::step::Step;
+use crate::selection::Diagnosis;
+use crate::selection::step::Step;
 
 /// A statistic's row: id, unit, measured, simulated, comparison with its interval, verdict.
 fn statistic_cells(s: &Statistic) -> String {
@@ -88,7 +89,7 @@ pub(super) fn disagreement_section(m: &mut String, d: &Diagnosis) {
 
 /// `## Step s`: the candidates against the current model, the decision, the fit, and the
 /// discrepancy before and after.
-pub(super) fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
+pub(super) fn step_section(m: &mut String, baseline: &Baseline, d: &Diagnosis, s: &Step) {
     let title = match (s.named_effect(), s.kept) {
         (Some(n), true) => format!("`{n}` added"),
         (Some(n), false) => format!("`{n}` named but not kept"),
@@ -111,6 +112,7 @@ pub(super) fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
     let mut order: Vec<&CandidateScore> = s.candidates.iter().collect();
     order.sort_by(|a, b| a.delta_bic.total_cmp(&b.delta_bic));
     for c in order {
+        let effect = effect(d, &c.name);
         push(
             m,
             &format!(
@@ -126,7 +128,8 @@ pub(super) fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
                 c.error.clone().unwrap_or_else(|| c
                     .parameters
                     .iter()
-                    .map(parameter_text)
+                    .enumerate()
+                    .map(|(j, p)| parameter_text(effect, j, p))
                     .collect::<Vec<_>>()
                     .join("; "))
             ),
@@ -138,13 +141,14 @@ pub(super) fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
     );
     if let Some(c) = s.named_score() {
         let span = spans(baseline);
-        for p in &c.parameters {
+        let effect = effect(d, &c.name);
+        for (j, p) in c.parameters.iter().enumerate() {
             push(
                 m,
                 &format!(
                     "- {}: {}",
-                    parameter_text(p),
-                    plain_reading(&c.name, p, span)
+                    parameter_text(effect, j, p),
+                    plain_reading(effect, j, p, span)
                 ),
             );
         }
@@ -156,6 +160,7 @@ pub(super) fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
             "The model's effects re-fitted jointly (95 % Wald intervals of the joint fit):\n",
         );
         for c in &s.refitted {
+            let effect = effect(d, &c.name);
             push(
                 m,
                 &format!(
@@ -163,7 +168,8 @@ pub(super) fn step_section(m: &mut String, baseline: &Baseline, s: &Step) {
                     c.name,
                     c.parameters
                         .iter()
-                        .map(parameter_text)
+                        .enumerate()
+                        .map(|(j, p)| parameter_text(effect, j, p))
                         .collect::<Vec<_>>()
                         .join("; ")
                 ),

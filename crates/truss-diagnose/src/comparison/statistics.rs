@@ -22,8 +22,8 @@
 //! mean within ±[`TOL_MEAN`] predicted standard deviations, every coordinate's scatter and the
 //! median and 95th percentile of θ_P within a factor [`TOL_RATIO`] of the prediction.
 
-use crate::measured::{Coordinate, Measured};
-use crate::simulate::Simulation;
+use crate::comparison::measured::{Coordinate, Measured};
+use crate::comparison::simulate::Simulation;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
 use truss_stats::bootstrap::{BootstrapConfig, SortedSample, bootstrap_quantiles};
@@ -157,7 +157,7 @@ impl Welch {
 ///
 /// The measured moments are not used here: at n = 30 a fourth moment (a covariance's or a
 /// standard deviation's variance) is underestimated more often than not, and on data made
-/// from the baseline itself (issue 15's null check) the top nodes' x/y covariances reached
+/// from the baseline itself (the null check) the top nodes' x/y covariances reached
 /// p ≈ 7e-5 from 30 specimens, where their variance under the model gives p ≈ 3e-3. The
 /// 95 % intervals stay Welch's (measured and simulated moments, [`Welch`]): they describe
 /// the size of a difference where one exists.
@@ -545,11 +545,11 @@ pub fn energy_test(y: &[f64], x: &[f64], d: usize, scale: &[f64]) -> EnergyTest 
 }
 
 /// The comparison's family-wise level: a statistic disagrees when its Holm-adjusted p is
-/// below it. Half of the verdict's α = 0.05 ([`crate::diagnose::Settings::alpha`]): a verdict other
+/// below it. Half of the verdict's α = 0.05 ([`crate::settings::Settings::alpha`]): a verdict other
 /// than "the model agrees" on data that miss nothing can come from either of two families
 /// of tests (the comparison here, which alone can say `unexplained`, and the candidates'
 /// likelihood-ratio tests, which name an effect), so each family gets α/2 and their union
-/// α (Bonferroni). Issue 15's null check counts both.
+/// α (Bonferroni). The null check counts both.
 pub const LEVEL: f64 = 0.025;
 
 /// Holm's step-down adjustment over the comparison's statistics.
@@ -650,7 +650,7 @@ pub fn compare(
     stats.push(cov_statistic(ca, cb, ya, yb, xa, xb));
     stats.extend(percentile_statistics(&measured.theta_p, &sim.theta_p));
     stats.push(ks_statistic(&measured.theta_p, &sim.theta_p));
-    let floor = (sigma_m * sigma_m + crate::likelihood::RESOLUTION.powi(2)).sqrt();
+    let floor = (sigma_m * sigma_m + crate::likelihood::gaussian::RESOLUTION.powi(2)).sqrt();
     let scale: Vec<f64> = (0..d)
         .map(|j| moments(&columns[j].1).sd.max(floor))
         .collect();
@@ -740,7 +740,7 @@ mod tests {
     fn energy_distance_sees_a_shift_and_not_noise() {
         let gauss = |seed: u64, n: usize, shift: f64| -> Vec<f64> {
             (0..n * 2)
-                .map(|i| crate::simulate::noise_normal(seed, i as u64, 0) + shift)
+                .map(|i| crate::comparison::simulate::noise_normal(seed, i as u64, 0) + shift)
                 .collect()
         };
         let y = gauss(1, 100, 0.0);
@@ -767,7 +767,7 @@ mod tests {
     fn energy_noise_is_the_spread_under_the_null() {
         let gauss = |seed: u64, n: usize| -> Vec<f64> {
             (0..n * 2)
-                .map(|i| crate::simulate::noise_normal(seed, i as u64, 0))
+                .map(|i| crate::comparison::simulate::noise_normal(seed, i as u64, 0))
                 .collect()
         };
         let tests: Vec<EnergyTest> = (0..40)

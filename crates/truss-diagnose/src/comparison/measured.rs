@@ -179,7 +179,7 @@ pub struct Measured {
 
 impl Measured {
     /// The cluster of each unit term of ℓ (each specimen's, then each member observation's,
-    /// as [`crate::score`] lists them): one per truss ([`MemberData::truss`]), a specimen's
+    /// as [`crate::likelihood::score`] lists them): one per truss ([`MemberData::truss`]), a specimen's
     /// node positions with its own member observations.
     pub fn clusters(&self) -> Vec<usize> {
         let mut out: Vec<usize> = (0..self.n()).collect();

@@ -6,9 +6,9 @@
 //! - `top-scatter-before.svg`, `top-scatter-after.svg`: per top-surface node, the x–y and
 //!   x–z displacement scatter \[µm\] of the specimens over up to 1000 simulated samples.
 
+use crate::comparison::measured::Measured;
+use crate::comparison::simulate::Simulation;
 use crate::errors::DiagnoseError;
-use crate::measured::Measured;
-use crate::simulate::Simulation;
 use plotters::prelude::*;
 use run_dir::OutputDir;
 use truss_plot::frame::{captioned, panel, render, styled_mesh, styled_panel_mesh, titled_panels};

@@ -10,7 +10,7 @@
 //! ln p(yᵢ, êᵢ) = ln p(yᵢ | êᵢ) + Σ_{m ∈ P} ln p(ê_{i,m})
 //! ```
 //!
-//! The second part is the member term of [`crate::likelihood`] (each measured member's
+//! The second part is the member term of [`crate::likelihood::gaussian`] (each measured member's
 //! length error against the case's distribution of it). The first is the Gaussian
 //! conditional of the case's joint distribution of (x, ê), estimated from the same `N`
 //! simulated samples as the marginal one: every sample's length errors of the members in `P`
@@ -38,10 +38,10 @@
 //! member errors would hide (a joint clearance of a few micrometres) stands out, and a
 //! length effect shows in the member term, where it belongs, rather than in the node term.
 
+use crate::comparison::measured::Measured;
+use crate::comparison::simulate::{Simulation, noise_normal};
 use crate::errors::DiagnoseError;
-use crate::likelihood::{Gaussian, RESOLUTION};
-use crate::measured::Measured;
-use crate::simulate::{Simulation, noise_normal};
+use crate::likelihood::gaussian::{Gaussian, RESOLUTION};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeMap;
 use truss_core::Model;
@@ -209,7 +209,7 @@ impl Regression {
         }
         let chol = nalgebra::Cholesky::new(cov.clone())
             .ok_or_else(|| failed("the residual covariance is not positive definite".into()))?;
-        let log_det = crate::likelihood::log_det(&chol);
+        let log_det = crate::likelihood::gaussian::log_det(&chol);
         Ok(Self {
             kept,
             e_mean,

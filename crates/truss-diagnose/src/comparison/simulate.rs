@@ -12,8 +12,8 @@
 //! a pure function of (seed, k, j), so every derived case sees the same noise (common random
 //! numbers here too) and the result does not depend on the thread count.
 
+use crate::comparison::measured::Coordinate;
 use crate::errors::DiagnoseError;
-use crate::measured::Coordinate;
 use truss_core::measure::distortion;
 use truss_job::Engine;
 use truss_job::Job;
@@ -38,7 +38,7 @@ pub struct Simulation {
     /// θ_P of the noisy positions \[rad\].
     pub theta_p: Vec<f64>,
     /// The sample index of each converged row (rows of `x`), for draws made again from
-    /// the same streams (the member length errors of [`crate::conditional`]).
+    /// the same streams (the member length errors of [`crate::likelihood::conditional`]).
     pub indices: Vec<u64>,
     /// Samples whose solve failed (left out).
     pub failed: usize,

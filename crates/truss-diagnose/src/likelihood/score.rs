@@ -2,15 +2,16 @@
 //! likelihood-ratio test against the baseline, and its intervals (Wald for every candidate,
 //! profile likelihood for those the verdict rests on).
 
-use crate::baseline::{Baseline, CaseEdit};
-use crate::candidates::Candidate;
-use crate::derivatives::Terms;
+use crate::candidates::candidate::Candidate;
+use crate::candidates::parameter::Parameter;
+use crate::comparison::baseline::{Baseline, CaseEdit};
+use crate::comparison::measured::Measured;
+use crate::comparison::simulate::{Simulation, simulate};
 use crate::errors::DiagnoseError;
-use crate::fit::{Fit, Interval, Options, adjustments, maximise, wald_intervals};
-use crate::likelihood::{Gaussian, member_log_likelihood};
-use crate::measured::Measured;
-use crate::profile::{Intervals, Problem, Profile, profile_intervals};
-use crate::simulate::{Simulation, simulate};
+use crate::likelihood::derivatives::Terms;
+use crate::likelihood::fit::{Fit, Interval, Options, adjustments, maximise, wald_intervals};
+use crate::likelihood::gaussian::{Gaussian, member_log_likelihood};
+use crate::likelihood::profile::{Intervals, Problem, Profile, profile_intervals};
 use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 use std::time::Instant;
@@ -31,13 +32,48 @@ pub struct FittedParameter {
     pub wald_interval: Interval,
     /// Where profiled: the projection of the joint 95 % profile-likelihood region of all
     /// the candidate's k parameters (threshold χ²_k(0.95)·c·λ̄), so that every parameter
-    /// lies in its joint interval at once with 95 % confidence ([`crate::profile`]).
+    /// lies in its joint interval at once with 95 % confidence ([`crate::likelihood::profile`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub joint_interval: Option<Interval>,
     /// The plausible range searched.
     pub range: [f64; 2],
     /// The value at which the candidate is the baseline.
     pub null: f64,
+    /// Whether the data determine it: `false` where its 95 % interval, or its Wald
+    /// interval, covers at least [`UNDETERMINED`] of its plausible range
+    /// ([`FittedParameter::coverage`]). An undetermined parameter's value is the best fit,
+    /// with no physical reading.
+    pub determined: bool,
+}
+
+/// The share of its plausible range that a parameter's 95 % interval must cover for the
+/// parameter to be reported "not determined by these data": most of it.
+pub const UNDETERMINED: f64 = 0.5;
+
+/// The share of `p`'s plausible range that `interval` covers, on the fit's scale
+/// ([`Parameter::internal`]); an end not found counts as the range's.
+pub fn coverage(p: &Parameter, interval: &Interval) -> f64 {
+    let lower = interval.lower.map_or(0.0, |v| p.internal(v));
+    let upper = interval.upper.map_or(1.0, |v| p.internal(v));
+    (upper.min(1.0) - lower.max(0.0)).max(0.0)
+}
+
+impl FittedParameter {
+    /// The share of the plausible range of parameter `p` (this one's) that the data leave
+    /// open: the larger of its interval's and its Wald interval's [`coverage`]. The Wald
+    /// interval is the likelihood's own curvature, without the feasible set: where a
+    /// profile's ends are set by a constraint that couples the parameter to others
+    /// (gravity's \|g\| ≤ 1 holding g_z small because g_x and g_y are large), the interval
+    /// is narrow while the data say nothing of the parameter itself.
+    pub fn coverage(&self, p: &Parameter) -> f64 {
+        coverage(p, &self.interval).max(coverage(p, &self.wald_interval))
+    }
+
+    /// Sets the interval the report uses, and whether the parameter is determined.
+    pub fn set_interval(&mut self, p: &Parameter, interval: Interval) {
+        self.interval = interval;
+        self.determined = self.coverage(p) < UNDETERMINED;
+    }
 }
 
 /// One candidate's fit and score.
@@ -82,6 +118,65 @@ pub struct CandidateScore {
     pub error: Option<String>,
 }
 
+/// A p-value for people: `p < 1e-16` below what a double can tell from 0 after
+/// `1 − CDF`, else two significant digits.
+pub fn p_text(p: f64) -> String {
+    if p < 1e-16 {
+        "< 1e-16".into()
+    } else if p >= 0.01 {
+        format!("{p:.2}")
+    } else {
+        format!("{p:.1e}")
+    }
+}
+
+/// `p = 0.03` or `p < 1e-16`.
+pub fn p_is(p: f64) -> String {
+    let t = p_text(p);
+    if t.starts_with('<') {
+        format!("p {t}")
+    } else {
+        format!("p = {t}")
+    }
+}
+
+/// ℓ's terms of the cases already simulated, by job id (the SHA-256 of the derived job's
+/// canonical form: its case, N and seed), so that a case met again (the current model at
+/// every candidate's null, a point a later fit passes through) is not simulated again.
+/// With common random numbers a case's terms are a function of its job alone, so a
+/// remembered value is exactly the one a new simulation would give. At most
+/// [`MEMO_CASES`] are kept, the oldest forgotten first.
+#[derive(Default)]
+pub(crate) struct Memo {
+    terms: std::cell::RefCell<(
+        std::collections::HashMap<String, Terms>,
+        std::collections::VecDeque<String>,
+    )>,
+}
+
+/// Most cases the memo of ℓ's terms keeps (each n + member-observation values).
+pub const MEMO_CASES: usize = 512;
+
+impl Memo {
+    /// The terms of job `id`, if remembered.
+    pub fn get(&self, id: &str) -> Option<Terms> {
+        self.terms.borrow().0.get(id).cloned()
+    }
+
+    /// Remembers the terms of job `id`.
+    pub fn put(&self, id: &str, terms: &Terms) {
+        let (map, order) = &mut *self.terms.borrow_mut();
+        if map.insert(id.to_string(), terms.clone()).is_none() {
+            order.push_back(id.to_string());
+        }
+        while order.len() > MEMO_CASES {
+            if let Some(old) = order.pop_front() {
+                map.remove(&old);
+            }
+        }
+    }
+}
+
 /// ℓ of the measured data under an edited case: the current model of a forward-selection
 /// step (`start`: the baseline with the effects added so far) with one candidate applied.
 pub(crate) struct Evaluator<'a> {
@@ -92,7 +187,10 @@ pub(crate) struct Evaluator<'a> {
     pub sigma_m: f64,
     /// Condition the node terms on the specimens' measured members.
     pub condition: bool,
+    /// Simulations run (cases found in `memo` not counted).
     pub simulations: std::cell::Cell<usize>,
+    /// The terms of cases already simulated, if shared.
+    pub memo: Option<&'a Memo>,
 }
 
 impl Evaluator<'_> {
@@ -103,17 +201,24 @@ impl Evaluator<'_> {
 
     fn log_likelihood(&self, edit: &CaseEdit) -> Result<Terms, DiagnoseError> {
         let job = self.job(edit)?;
+        if let Some(terms) = self.memo.and_then(|m| m.get(&job.id)) {
+            return Ok(terms);
+        }
         let sim = simulate(&job, &self.measured.coords, self.samples, None)?;
         self.simulations.set(self.simulations.get() + 1);
-        self.score(&job, &sim)
+        let terms = self.score(&job, &sim)?;
+        if let Some(m) = self.memo {
+            m.put(&job.id, &terms);
+        }
+        Ok(terms)
     }
 
     /// The terms of ℓ: each specimen's, then each member observation's.
     /// With member measurements, each specimen's node term is conditioned on its own
-    /// measured members ([`crate::conditional`]).
+    /// measured members ([`crate::likelihood::conditional`]).
     pub fn score(&self, job: &truss_job::Job, sim: &Simulation) -> Result<Terms, DiagnoseError> {
         let mut terms = if self.condition && self.measured.members.is_some() {
-            crate::conditional::log_densities(
+            crate::likelihood::conditional::log_densities(
                 job,
                 self.baseline.model(),
                 sim,
@@ -263,6 +368,7 @@ pub(crate) fn score_of(c: &dyn Candidate, fit: &Fit, test: &Test) -> CandidateSc
                 name: p.name.clone(),
                 unit: p.unit,
                 value,
+                determined: coverage(p, &wald) < UNDETERMINED,
                 interval: wald.clone(),
                 wald_interval: wald,
                 joint_interval: None,
@@ -334,7 +440,7 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
     }
 }
 
-/// Profile-likelihood intervals for a fitted candidate ([`crate::profile`]); where a profile
+/// Profile-likelihood intervals for a fitted candidate ([`crate::likelihood::profile`]); where a profile
 /// finds a higher point the candidate is fitted again from there and scored anew (at most
 /// twice). A profile that fails, or still finds a higher point after that, leaves the Wald
 /// intervals and says why in the progress notes.
@@ -426,8 +532,15 @@ pub(crate) fn profile_candidate(
     }) = outcome
     {
         let joint = joint.into_iter().map(Some).chain(std::iter::repeat(None));
-        for ((p, i), jt) in fitted.score.parameters.iter_mut().zip(marginal).zip(joint) {
-            p.interval = i;
+        for (((p, q), i), jt) in fitted
+            .score
+            .parameters
+            .iter_mut()
+            .zip(c.parameters())
+            .zip(marginal)
+            .zip(joint)
+        {
+            p.set_interval(q, i);
             p.joint_interval = jt;
         }
     }
@@ -435,4 +548,18 @@ pub(crate) fn profile_candidate(
     fitted.score.profile_evaluations = spent;
     fitted.score.seconds = seconds + clock.elapsed().as_secs_f64();
     fitted.fit = Some(fit);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// p-values for people: below what a double tells from 0, `< 1e-16`, never `0.00e0`.
+    #[test]
+    fn p_values_read_plainly() {
+        assert_eq!(p_text(0.0), "< 1e-16");
+        assert_eq!(p_is(1e-20), "p < 1e-16");
+        assert_eq!(p_is(0.034), "p = 0.03");
+        assert_eq!(p_text(2.5e-7), "2.5e-7");
+    }
 }

@@ -6,7 +6,7 @@
 //! logarithmic for a scale), where the log-likelihood is smooth because every evaluation uses
 //! the same random numbers. From the best of the null point (the baseline) and a scan along
 //! each axis (`diagnose::SCAN`), a trust-region Newton method: gradient and Hessian by finite
-//! differences with steps adapted to the likelihood's scale ([`crate::derivatives`]), the step
+//! differences with steps adapted to the likelihood's scale ([`crate::likelihood::derivatives`]), the step
 //! `s = (A + μI)⁻¹g` with `A = −H` and the smallest `μ ≥ 0` that makes `A + μI` positive
 //! definite and `|s|` at most the trust radius (0.3 at first, doubled after a good step,
 //! quartered after a failed one), clipped to the cube (and projected where the box is not the
@@ -24,12 +24,12 @@
 //! interval of each is `t̂ ± 1.96·√covᵢᵢ` mapped back to the parameter (so a scale's interval
 //! is symmetric in its logarithm). Where `A` is not positive definite the interval is
 //! undetermined. These rest on ℓ being quadratic over the interval; the diagnosis reports
-//! them next to the profile-likelihood intervals of [`crate::profile`], which do not, and
+//! them next to the profile-likelihood intervals of [`crate::likelihood::profile`], which do not, and
 //! uses the latter for the named effect.
 
-use crate::candidates::Parameter;
-use crate::derivatives::{INITIAL_STEP, Objective, derivatives, total};
+use crate::candidates::parameter::Parameter;
 use crate::errors::DiagnoseError;
+use crate::likelihood::derivatives::{INITIAL_STEP, Objective, derivatives, total};
 use nalgebra::{DMatrix, DVector};
 
 /// Smallest gain in ℓ that counts as progress.
@@ -46,7 +46,7 @@ pub struct Fit {
     pub log_likelihood: f64,
     /// A = −∂²ℓ/∂t² there (internal coordinates); empty (0 × 0) when not asked for.
     pub curvature: DMatrix<f64>,
-    /// B, the variability of the per-unit scores there ([`crate::derivatives`]); empty when
+    /// B, the variability of the per-unit scores there ([`crate::likelihood::derivatives`]); empty when
     /// not asked for.
     pub variability: DMatrix<f64>,
     /// The finite-difference steps last used, per parameter (internal coordinates).
@@ -65,7 +65,7 @@ pub struct Options<'a> {
     /// Whether `A` and `B` are wanted at the maximum (an inner maximisation of a profile
     /// needs only ℓ).
     pub curvature: bool,
-    /// The cluster of each unit term of ℓ for `B` ([`crate::derivatives`]); `None`: every
+    /// The cluster of each unit term of ℓ for `B` ([`crate::likelihood::derivatives`]); `None`: every
     /// unit its own.
     pub clusters: Option<&'a [usize]>,
 }
@@ -91,7 +91,7 @@ pub struct Interval {
     pub lower_at_range_end: bool,
     /// Whether the upper end is the plausible range's.
     pub upper_at_range_end: bool,
-    /// `profile` ([`crate::profile`]) or `wald` (this module).
+    /// `profile` ([`crate::likelihood::profile`]) or `wald` (this module).
     pub method: &'static str,
     /// For a profile interval, the threshold `q` of `2(ℓ̂ − ℓ_p) ≤ q`.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -373,7 +373,7 @@ pub fn wald_intervals(fit: &Fit, parameters: &[Parameter], inflation: f64) -> Ve
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::derivatives::Terms;
+    use crate::likelihood::derivatives::Terms;
 
     /// A concave quadratic with its maximum inside the cube is found in a few iterations, and
     /// the Wald interval is the exact one of a normal likelihood: for ℓ = −(t − m)²/(2s²),

@@ -18,7 +18,7 @@
 //! by using imperfect models: robust adjusted likelihood functions"), the one-parameter form
 //! of the test's `λ̄ = tr(A⁻¹B)/k`, and like it never below 1 (an interval never narrower
 //! than the model's own); 1 when `A` is not positive definite. Where ℓ is quadratic the
-//! interval is exactly the sandwich Wald interval of [`crate::fit`]; where it is not (slack
+//! interval is exactly the sandwich Wald interval of [`crate::likelihood::fit`]; where it is not (slack
 //! cables, a fit near the edge of the plausible range, a scale) it follows ℓ itself and is
 //! the same in any parametrisation. An end that reaches the plausible range is cut there and
 //! flagged (`lower_at_range_end`, `upper_at_range_end`).
@@ -50,16 +50,16 @@
 //! points its parameter's own end found.
 //!
 //! Each profile point maximises ℓ over the other parameters with the trust-region Newton
-//! method of [`crate::fit`] (tolerance [`crate::fit::TOLERANCE`], the fit's finite-difference
+//! method of [`crate::likelihood::fit`] (tolerance [`crate::likelihood::fit::TOLERANCE`], the fit's finite-difference
 //! steps), started from the nearest point already found shifted along the quadratic
 //! prediction `−A₋ⱼ₋ⱼ⁻¹A₋ⱼⱼ·Δθⱼ`. Should a profile point have ℓ above `ℓ̂` by more than the
 //! tolerance, the fit was not the maximum: [`Profile::Higher`] gives the point, from which
 //! the caller fits again.
 
-use crate::candidates::Parameter;
-use crate::derivatives::{MAX_STEP, Objective, total};
+use crate::candidates::parameter::Parameter;
 use crate::errors::DiagnoseError;
-use crate::fit::{Fit, Interval, Options, TOLERANCE, adjustments, maximise};
+use crate::likelihood::derivatives::{MAX_STEP, Objective, total};
+use crate::likelihood::fit::{Fit, Interval, Options, TOLERANCE, adjustments, maximise};
 use nalgebra::{DMatrix, DVector};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
@@ -379,6 +379,18 @@ pub fn profile_intervals(
     f: &mut Objective,
     joint: bool,
 ) -> Result<Profile, DiagnoseError> {
+    let all: Vec<usize> = (0..fit.internal.len()).collect();
+    profile_some(fit, problem, f, joint, &all)
+}
+
+/// [`profile_intervals`] of the parameters `which` only (their intervals in that order).
+pub fn profile_some(
+    fit: &Fit,
+    problem: &Problem,
+    f: &mut Objective,
+    joint: bool,
+    which: &[usize],
+) -> Result<Profile, DiagnoseError> {
     let k = fit.internal.len();
     let a = &fit.curvature;
     let a_inv = nalgebra::Cholesky::new(a.clone()).map(|c| c.inverse());
@@ -394,7 +406,7 @@ pub fn profile_intervals(
     };
     let mut marginal = Vec::with_capacity(k);
     let mut projected = Vec::with_capacity(k);
-    for j in 0..k {
+    for &j in which {
         let q = CHI2_1_95 * problem.inflation * lambdas[j].max(1.0);
         let scale = match &a_inv {
             Some(inv) => inv[(j, j)].sqrt(),
@@ -467,7 +479,7 @@ fn conditional_slope(a: &DMatrix<f64>, j: usize) -> DVector<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::wald_intervals;
+    use crate::likelihood::fit::wald_intervals;
 
     fn parameter(name: &str) -> Parameter {
         Parameter {

@@ -1,0 +1,508 @@
+//! The selection: find the strongest missing effect, add it, look again at what is left,
+//! and repeat until nothing significant remains ([`diagnose`]).
+//!
+//! Each step ([`step`]) passes through four stages in order: it compares the current model
+//! (the baseline with the effects added so far) with the measurements, fits and tests every
+//! remaining candidate against it ([`crate::likelihood::score`]), decides from the tests and
+//! BIC ([`decide`]; the named candidate and those indistinguishable from it get
+//! profile-likelihood intervals, [`crate::likelihood::profile`], and should a profile find a
+//! higher maximum the verdict is decided again on the new fits), and updates the model
+//! ([`update`]): the named effect is added at its fitted values, every effect of the model
+//! is re-fitted jointly, the effects added earlier are tested for removal given the others
+//! and tried swapped for a rival. The selection stops at the first step that names nothing
+//! (no candidate both significant at α/K and better by ΔBIC ≤ −2), at a named effect that
+//! makes the fit worse where the likelihood does not look (judged by the next step's
+//! comparison: the model agreed in distribution, and with the effect the discrepancy, the
+//! energy distance of the displacement vectors, grows beyond its noise or turns
+//! significant: then it is not added; [`step`]), or when no candidate is left. The false
+//! discovery rate over the steps is controlled by [`forward_stop`] on the steps'
+//! Bonferroni-adjusted p-values: named effects beyond its k̂ are not kept, and the final
+//! model is the one after the k̂-th kept step, with the removals and swaps of the steps up
+//! to it.
+//!
+//! ## The false discovery rate
+//!
+//! ForwardStop ([`forward_stop`]) runs on the adjusted p-values of the
+//! steps in the order they named effects, whatever was removed later: the number of steps
+//! it keeps is decided as without removals, and the final model is that after the last kept
+//! step, with the removals of the kept steps. Removal only takes effects out of the model,
+//! so the effects finally named are a subset of those ForwardStop accepts: the number of
+//! false discoveries among them is never larger, and the probability of any false discovery
+//! is at most that of forward selection alone.
+
+pub mod confound;
+pub mod decide;
+pub mod eliminate;
+pub mod model;
+pub mod step;
+pub mod update;
+
+use crate::candidates::{Library, library_for, names};
+use crate::comparison::baseline::{Baseline, CaseEdit};
+use crate::comparison::measured::Measured;
+use crate::comparison::simulate::{Noise, Simulation, top_indices};
+use crate::comparison::statistics::Comparison;
+use crate::errors::DiagnoseError;
+use crate::likelihood::score::p_text;
+use crate::settings::{NOISE_SEED, Progress, Settings};
+use decide::Verdict;
+use model::{ComparedModel, Context, ModelEffect, Pool};
+use step::Step;
+
+/// A complete diagnosis: the steps of the stepwise selection and the final model.
+pub struct Diagnosis {
+    /// The overall verdict: `named` when an effect was added, else step 1's.
+    pub verdict: Verdict,
+    /// Why, in a sentence or two.
+    pub reason: String,
+    /// The steps, in order; the last one named nothing, or its effect was not kept, or no
+    /// candidate was left.
+    pub steps: Vec<Step>,
+    /// Candidates not applicable to this case, with why.
+    pub skipped: Vec<(String, String)>,
+    /// Every candidate the library has for this case (the reports read their words here).
+    pub library: Vec<Box<dyn crate::candidates::Candidate>>,
+    /// ℓ₀ of the baseline.
+    pub baseline_log_likelihood: f64,
+    /// The baseline's comparison.
+    pub before: Comparison,
+    /// The final model's comparison, when an effect was added.
+    pub after: Option<Comparison>,
+    /// The final case: the baseline with every kept effect (the baseline's when none).
+    pub updated: CaseEdit,
+    /// The final model's effects at their final values (after the re-fits).
+    pub effects: Vec<ModelEffect>,
+    /// The final model's effects fitted jointly, with the joint fit's intervals (profile
+    /// where the Wald one is cut at the range; [`confound`]); empty when none was added.
+    pub final_fit: Vec<model::RefitEffect>,
+    /// Rivals that explain part of what the final model's effects explain ([`confound`]).
+    pub confounding: Vec<confound::Confounding>,
+    /// Wall time of the final fit and the confounding tests \[s\].
+    pub final_seconds: f64,
+    /// Simulated samples per evaluation N.
+    pub samples: usize,
+    /// The simulations behind `before` and `after` (for plots).
+    pub simulations: (Simulation, Option<Simulation>),
+    /// Top-surface coordinate indices.
+    pub top: [[usize; 3]; 3],
+    /// Total simulations run, solves, and seconds.
+    pub work: (usize, usize, f64),
+}
+
+impl Diagnosis {
+    /// The effects of the final model in the order they entered it: each kept step's named
+    /// effect, less those a kept step removed, a swapped one's replacement in its place.
+    pub fn named_effects(&self) -> Vec<&str> {
+        final_effects(&self.steps)
+    }
+
+    /// The first added effect's name, or `none`.
+    pub fn named_effect(&self) -> &str {
+        self.named_effects().first().copied().unwrap_or("none")
+    }
+
+    /// The candidate of this name in the library.
+    pub fn candidate(&self, name: &str) -> Option<&dyn crate::candidates::Candidate> {
+        self.library
+            .iter()
+            .find(|c| c.name() == name)
+            .map(|c| c.as_ref())
+    }
+
+    /// The step that added the first effect (or step 1).
+    pub fn first_step(&self) -> &Step {
+        &self.steps[0]
+    }
+}
+
+/// The effects of the final model in the order they entered it ([`Diagnosis::named_effects`]).
+fn final_effects(steps: &[Step]) -> Vec<&str> {
+    let mut names: Vec<&str> = Vec::new();
+    for s in steps.iter().filter(|s| s.kept) {
+        names.extend(s.named_effect());
+        for r in &s.removed {
+            match &r.replaced_by {
+                Some(by) => {
+                    for n in names.iter_mut().filter(|n| **n == r.name) {
+                        *n = by.as_str();
+                    }
+                }
+                None => names.retain(|n| *n != r.name),
+            }
+        }
+    }
+    names
+}
+
+/// Most steps of the selection: one per candidate at most.
+pub const MAX_STEPS: usize = 6;
+
+/// The number of steps whose named effects are kept: ForwardStop (G'Sell, Wager,
+/// Chouldechova & Tibshirani 2016) at level α on the steps' adjusted p-values
+/// pₛ = min(1, Kₛ·p) (Bonferroni over the step's Kₛ candidates):
+/// k̂ = max{k : −(1/k)·Σ_{s ≤ k} ln(1 − pₛ) ≤ α}, 0 if none. It controls the false
+/// discovery rate over the steps at α when the p-values of the effects that are not there
+/// are uniform and come after those that are; the first step alone is the Bonferroni test
+/// (−ln(1 − p₁) ≤ α is p₁ ≤ 1 − e^(−α) ≈ α).
+pub fn forward_stop(adjusted: &[f64], alpha: f64) -> usize {
+    let mut sum = 0.0;
+    let mut kept = 0;
+    for (k, &p) in adjusted.iter().enumerate() {
+        sum += -(1.0 - p.min(1.0)).ln();
+        if sum / (k + 1) as f64 <= alpha {
+            kept = k + 1;
+        }
+    }
+    kept
+}
+/// Runs the stepwise selection (module doc).
+pub fn diagnose(
+    baseline: &Baseline,
+    measured: &Measured,
+    settings: &Settings,
+    progress: &Progress,
+) -> Result<Diagnosis, DiagnoseError> {
+    let n = measured.n();
+    let samples = settings.samples_for(n);
+    let model = baseline.model();
+    let top_nodes = model.top_surface().expect("checked when reading").nodes;
+    let top = top_indices(&measured.coords, top_nodes).expect("top nodes are measured");
+    let ctx = Context {
+        baseline,
+        measured,
+        settings,
+        samples,
+        noise: Noise {
+            sigma: settings.measurement_sigma,
+            seed: NOISE_SEED,
+        },
+        top,
+        progress,
+        simulations: std::cell::Cell::new(0),
+        memo: Default::default(),
+    };
+    progress.note(&format!(
+        "{n} specimens, {} coordinates; simulating the baseline case {:?} ({samples} samples)",
+        measured.d(),
+        baseline.case_name
+    ));
+    let (remaining, skipped) = asked_for(baseline, measured, settings)?;
+    let mut pool = Pool {
+        remaining,
+        added: Vec::new(),
+    };
+    let mut models: Vec<ComparedModel> = Vec::new();
+    let mut steps: Vec<Step> = Vec::new();
+    let mut edit = Some(baseline.derived_case());
+    while let Some(e) = edit.take() {
+        let previous = steps.last_mut().zip(models.last());
+        let Some(current) = step::compare(&ctx, e, previous)? else {
+            break;
+        };
+        models.push(current);
+        if steps.len() == MAX_STEPS || pool.remaining.is_empty() {
+            break;
+        }
+        let current = models.last().expect("just compared");
+        let (s, next) = step::run(&ctx, steps.len() + 1, current, &mut pool)?;
+        steps.push(s);
+        edit = next;
+    }
+    list_taken_over(&mut steps);
+    let adjusted: Vec<f64> = steps
+        .iter()
+        .filter(|s| s.kept)
+        .filter_map(|s| s.adjusted_p)
+        .collect();
+    let kept = forward_stop(&adjusted, settings.candidate_level());
+    for s in steps.iter_mut().filter(|s| s.kept).skip(kept) {
+        s.kept = false;
+        s.verdict = Verdict::CannotTell;
+        s.reason += &format!(
+            "; not kept: over the steps, the false discovery rate at α = {} keeps only the first {kept} named effects (ForwardStop on the steps' adjusted p-values {})",
+            settings.candidate_level(),
+            adjusted
+                .iter()
+                .map(|p| p_text(*p))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    let (verdict, reason) = overall(&steps, kept);
+    let last = steps
+        .iter()
+        .enumerate()
+        .filter(|(_, s)| s.kept)
+        .nth(kept.max(1) - 1)
+        .filter(|_| kept > 0)
+        .map(|(i, _)| i);
+    let effects = last.map_or_else(Vec::new, |i| steps[i].effects.clone());
+    progress.note(&format!("{}: {reason}", verdict.words()));
+    let library = library_for(baseline, measured.members.is_some()).0;
+    let clock = std::time::Instant::now();
+    let (final_fit, confounding) = match last {
+        Some(i) => {
+            let fit = confound::final_fit(&ctx, &steps[..=i], &steps[i], &library);
+            let found = confound::confounding(&ctx, &steps[..=i], &fit, &library);
+            (fit.effects, found)
+        }
+        None => (Vec::new(), Vec::new()),
+    };
+    for c in &confounding {
+        if let Some(s) = steps
+            .iter_mut()
+            .find(|s| s.kept && s.named_effect() == Some(c.effect.as_str()))
+            && !s.indistinguishable.contains(&c.rival)
+        {
+            s.indistinguishable.push(c.rival.clone());
+        }
+    }
+    let final_seconds = clock.elapsed().as_secs_f64();
+    let sims = ctx.simulations.get();
+    let mut models = models.into_iter();
+    let base = models.next().expect("the baseline is there");
+    let last = models.nth(kept.max(1) - 1).filter(|_| kept > 0);
+    Ok(Diagnosis {
+        verdict,
+        reason,
+        steps,
+        skipped,
+        library,
+        final_fit,
+        confounding,
+        final_seconds,
+        baseline_log_likelihood: base.log_likelihood,
+        before: base.comparison,
+        updated: last.as_ref().map_or(base.edit, |m| m.edit.clone()),
+        effects,
+        after: last.as_ref().map(|m| m.comparison.clone()),
+        simulations: (base.simulation, last.map(|m| m.simulation)),
+        samples,
+        top,
+        work: (sims, sims * samples, progress.seconds()),
+    })
+}
+
+/// The candidates to try: the library's for this baseline (backlash's spread only with the
+/// members measured), less those `--candidates` leaves out; and the (name, reason) of the
+/// others.
+fn asked_for(
+    baseline: &Baseline,
+    measured: &Measured,
+    settings: &Settings,
+) -> Result<Library, DiagnoseError> {
+    let (mut remaining, mut skipped) = library_for(baseline, measured.members.is_some());
+    if let Some(only) = &settings.candidates {
+        for name in only {
+            if !remaining.iter().any(|c| c.name() == name)
+                && !skipped.iter().any(|(n, _)| n == name)
+            {
+                return Err(DiagnoseError::Usage(format!(
+                    "--candidates: no candidate effect {name:?} (the library: {})",
+                    names()
+                )));
+            }
+        }
+        let (asked, left): (Vec<_>, Vec<_>) = remaining
+            .into_iter()
+            .partition(|c| only.iter().any(|n| n == c.name()));
+        skipped.extend(left.iter().map(|c| {
+            (
+                c.name().to_string(),
+                "not asked for (--candidates)".to_string(),
+            )
+        }));
+        remaining = asked;
+    }
+    if remaining.is_empty() {
+        return Err(DiagnoseError::Usage(
+            "no candidate effect applies to this case (see the skipped reasons with --candidates unset)".into(),
+        ));
+    }
+    Ok((remaining, skipped))
+}
+
+/// An effect removed because another took over what it explained is listed as
+/// indistinguishable from that other, at the step that named it; only removals of steps
+/// whose effect was added count, and only the steps up to them are searched.
+fn list_taken_over(steps: &mut [Step]) {
+    for i in 0..steps.len() {
+        if !steps[i].kept {
+            continue;
+        }
+        let taken_over: Vec<(String, String)> = steps[i]
+            .removed
+            .iter()
+            .filter_map(|r| r.explained_by.clone().map(|x| (x, r.name.clone())))
+            .collect();
+        for (by, name) in taken_over {
+            if let Some(s) = steps[..=i]
+                .iter_mut()
+                .find(|s| s.kept && s.named_effect() == Some(by.as_str()))
+                && !s.indistinguishable.contains(&name)
+            {
+                s.indistinguishable.push(name);
+            }
+        }
+    }
+}
+
+/// The overall verdict and reason from the steps, `kept` of whose named effects are kept.
+fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
+    if kept == 0 {
+        let first = &steps[0];
+        return (first.verdict, first.reason.clone());
+    }
+    let added: Vec<String> = steps
+        .iter()
+        .filter(|s| s.kept)
+        .map(|s| {
+            format!(
+                "step {}: {} ({})",
+                s.number,
+                s.named_effect().unwrap_or("none"),
+                s.reason
+            )
+        })
+        .collect();
+    let last = steps.last().expect("at least one step");
+    let end = if last.kept {
+        "no candidate is left to try".to_string()
+    } else {
+        format!("step {}: {}", last.number, last.reason)
+    };
+    let names = final_effects(steps);
+    let model = if names.len() == kept {
+        String::new()
+    } else {
+        format!(
+            " (the final model has {}: the others were removed or replaced on the way)",
+            names.join(" and ")
+        )
+    };
+    (
+        Verdict::Named,
+        format!(
+            "{kept} effect{} added in turn{model}. {}. Finally, {end}",
+            if kept == 1 { "" } else { "s" },
+            added.join(". ")
+        ),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::comparison::statistics::Tolerance;
+    use crate::likelihood::score::CandidateScore;
+
+    fn score(name: &str, k: usize, delta_bic: f64, significant: bool) -> CandidateScore {
+        CandidateScore {
+            name: name.into(),
+            mechanism: String::new(),
+            k,
+            parameters: Vec::new(),
+            log_likelihood: 0.0,
+            lr_statistic: 0.0,
+            adjustment: 1.0,
+            p_value: if significant { 1e-6 } else { 0.5 },
+            significant,
+            delta_bic,
+            evaluations: 0,
+            profile_evaluations: 0,
+            seconds: 0.0,
+            vuong_z: None,
+            error: None,
+        }
+    }
+
+    fn comparison() -> Comparison {
+        Comparison {
+            specimens: 200,
+            samples: 4000,
+            statistics: Vec::new(),
+            energy: 0.0,
+            energy_p: 1.0,
+            energy_noise: 0.0,
+            tolerance: Tolerance {
+                within: true,
+                outside: Vec::new(),
+                bands: String::new(),
+            },
+        }
+    }
+
+    /// The final model's effects from the steps: each kept step's named effect in turn, a
+    /// removed one taken out, a swapped one's replacement in its place, and nothing of a
+    /// step that is not kept (its removals included).
+    #[test]
+    fn final_effects_follow_removals_and_swaps() {
+        use crate::selection::eliminate::Removal;
+        let removal = |name: &str, by: Option<&str>| Removal {
+            name: name.into(),
+            replaced_by: by.map(String::from),
+            added_in_step: 1,
+            lr_statistic: 0.0,
+            p_value: None,
+            delta_bic: 0.0,
+            explained_by: None,
+            separate_by: String::new(),
+        };
+        let step = |number: usize, named: &str, kept: bool, removed: Vec<Removal>| Step {
+            number,
+            verdict: Verdict::Named,
+            reason: String::new(),
+            named: Some(0),
+            kept,
+            indistinguishable: Vec::new(),
+            candidates: vec![score(named, 1, -10.0, true)],
+            log_likelihood_before: 0.0,
+            adjusted_p: Some(0.0),
+            before: comparison(),
+            after: None,
+            refitted: Vec::new(),
+            removed,
+            effects: Vec::new(),
+            joint: None,
+            seconds: 0.0,
+        };
+        let steps = vec![
+            step(1, "length_bias", true, Vec::new()),
+            step(
+                2,
+                "length_sigma",
+                true,
+                vec![removal("length_bias", Some("diagonal_pretension"))],
+            ),
+            step(
+                3,
+                "thermal_gradient",
+                true,
+                vec![removal("length_sigma", None)],
+            ),
+            step(4, "gravity", false, vec![removal("thermal_gradient", None)]),
+        ];
+        assert_eq!(
+            final_effects(&steps),
+            ["diagonal_pretension", "thermal_gradient"]
+        );
+        assert_eq!(
+            final_effects(&steps[..2]),
+            ["diagonal_pretension", "length_sigma"]
+        );
+        assert!(final_effects(&steps[3..]).is_empty());
+    }
+
+    /// ForwardStop by hand: −ln(1 − p) for p = 0.01, 0.04, 0.2 is 0.01005, 0.04082, 0.22314;
+    /// running means 0.01005, 0.02544, 0.09134: at α = 0.05 the first two are kept; a first
+    /// step at p = 0.06 keeps none even though a later one is tiny (mean 0.0309 ≤ 0.05 at
+    /// k = 2 keeps both: ForwardStop is about the rate, not each step); none for no steps.
+    #[test]
+    fn forward_stop_keeps_the_longest_prefix_within_alpha() {
+        assert_eq!(forward_stop(&[0.01, 0.04, 0.2], 0.05), 2);
+        assert_eq!(forward_stop(&[0.06], 0.05), 0);
+        assert_eq!(forward_stop(&[0.06, 1e-9], 0.05), 2);
+        assert_eq!(forward_stop(&[1.0, 0.0], 0.05), 0);
+        assert_eq!(forward_stop(&[], 0.05), 0);
+    }
+}

@@ -1,0 +1,487 @@
+//! After the selection: the final model's effects with the intervals of their joint fit, and
+//! the rivals that explain part of the same signal.
+//!
+//! ## The final fit
+//!
+//! The numbers read last are those of the final model's effects fitted jointly (the last
+//! kept step's re-fit; for a model of one effect, its own step's fit with its profile
+//! intervals). The joint fit's intervals are the sandwich Wald ones; where a Wald interval
+//! is cut at the plausible range (a quadratic ℓ would reach beyond it, so the interval
+//! says little of where ℓ itself falls), the profile-likelihood interval of that parameter
+//! in the joint fit replaces it ([`crate::likelihood::profile`]). A parameter whose interval
+//! covers most of its plausible range is *not determined* by the data
+//! ([`crate::likelihood::score::UNDETERMINED`]).
+//!
+//! ## Confounding
+//!
+//! A named effect's extra parameters can take up a rival's signal: a temperature field's
+//! uniform offset and vertical gradient lengthen the columns much as a longeron length bias
+//! does, and a temperature field named alone then reports a wrong field while nothing says
+//! a length bias explains part of the same signal. So each rival R (a candidate significant
+//! at a kept step, not in the final model nor removed from it; at most [`MAX_RIVALS`], the
+//! strongest first) is added to the final model, all effects fitted jointly from their
+//! final values and R's own fit at the step where it was strongest (R's explanation of the
+//! signal: where the two share it, the joint fit moves the model's parameters off the part
+//! R explains; a fit that ends more than [`NESTED_SLACK`] below the model's ℓ̂, which a
+//! maximum cannot since the model is R at its null, is started again from R's null, and R
+//! is not judged where that one too ends below), and
+//!
+//! - R's contribution is tested as an effect given the others: Λ_R = 2(ℓ̂_{M+R} − ℓ̂_M)/(c·λ_R),
+//!   p = P(χ²_{k_R} ≥ Λ_R), ΔBIC_R = λ_R·(k_R ln n − Λ_R) (as backward elimination does);
+//! - each parameter θ of the model's effects is compared with and without R: θ is
+//!   *confounded with R* when its value with R lies outside its final 95 % interval (R
+//!   takes over part of what it explained), or when its Wald interval widens by a factor of
+//!   at least [`WIDENED`] on the fit's own scale (R could take over part of it: the data
+//!   cannot say how the signal divides between the two; judged only where both Wald
+//!   intervals were found).
+//!
+//! An effect with a confounded parameter lists R as indistinguishable from it for that
+//! part, with the parameters, R's test and the measurement that separates them
+//! ([`crate::candidates::separating_measurement`]). A rival with no confounded parameter
+//! is not listed, whatever its test: either it explains nothing the model does not
+//! (a rival the model already excludes), or what it adds is separate from the model's
+//! effects, and the selection's own steps judge it.
+
+use crate::candidates::candidate::{Candidate, separating_measurement};
+use crate::candidates::parameter::Parameter;
+use crate::errors::DiagnoseError;
+use crate::likelihood::fit::{Interval, adjustments};
+use crate::likelihood::joint::{Combined, JointFit};
+use crate::likelihood::profile::{Problem, Profile, profile_some};
+use crate::likelihood::score::{FittedParameter, p_text, projection};
+use crate::selection::model::{Context, RefitEffect};
+use crate::selection::step::Step;
+use crate::selection::update::fit_jointly;
+use serde::Serialize;
+use statrs::distribution::{ChiSquared, ContinuousCDF};
+
+/// Most rivals tried against the final model.
+pub const MAX_RIVALS: usize = 3;
+
+/// The factor by which a parameter's Wald interval must widen, with a rival added, for the
+/// parameter to be confounded with it (a variance inflation of 4).
+pub const WIDENED: f64 = 2.0;
+
+/// How far below the final model's ℓ̂ a joint fit with a rival added may end and still count
+/// as a maximum (the model is the rival's null, so the maximum is at least ℓ̂_M; a fit that
+/// ends lower stopped on the way and is started again from the rival's null).
+pub const NESTED_SLACK: f64 = 1.0;
+
+/// The final model's effects fitted jointly.
+pub struct FinalFit {
+    /// Each effect with its parameters and their intervals (module doc).
+    pub effects: Vec<RefitEffect>,
+    /// ℓ̂ of the fit; `None` where the effects were not fitted jointly (the joint re-fit
+    /// failed), and rivals are then not tried.
+    pub log_likelihood: Option<f64>,
+}
+
+/// A parameter confounded with a rival.
+#[derive(Debug, Clone, Serialize)]
+pub struct ConfoundedParameter {
+    /// The parameter.
+    pub name: String,
+    /// Its unit.
+    pub unit: &'static str,
+    /// Its final value.
+    pub value: f64,
+    /// Its value with the rival added.
+    pub with_rival: f64,
+    /// Its final 95 % interval.
+    pub interval: Interval,
+    /// Whether the value with the rival lies outside that interval.
+    pub moved: bool,
+    /// The width of its Wald interval with the rival over the width without (on the fit's
+    /// scale; 1 where either was not found).
+    pub widening: f64,
+}
+
+/// A rival that explains part of what an effect of the final model explains.
+#[derive(Debug, Clone, Serialize)]
+pub struct Confounding {
+    /// The model's effect.
+    pub effect: String,
+    /// The rival candidate.
+    pub rival: String,
+    /// The effect's parameters confounded with it.
+    pub parameters: Vec<ConfoundedParameter>,
+    /// Λ_R of the rival given the model's effects, fitted jointly.
+    pub lr_statistic: f64,
+    /// P(χ²_{k_R} ≥ Λ_R).
+    pub p_value: f64,
+    /// ΔBIC_R (negative: the model with the rival is better).
+    pub delta_bic: f64,
+    /// The measurement that would separate the two.
+    pub separate_by: String,
+}
+
+/// The final model's effects fitted jointly: `last` the final model's step (the last kept
+/// one), `steps` every step up to it; `library` the candidates.
+pub(crate) fn final_fit(
+    ctx: &Context,
+    steps: &[Step],
+    last: &Step,
+    library: &[Box<dyn Candidate>],
+) -> FinalFit {
+    if let (Some(joint), false) = (&last.joint, last.refitted.is_empty()) {
+        let mut effects = last.refitted.clone();
+        let parts: Vec<&dyn Candidate> = last
+            .refitted
+            .iter()
+            .map(|e| effect(library, &e.name))
+            .collect();
+        profile_cut(ctx, &parts, joint, &mut effects);
+        return FinalFit {
+            effects,
+            log_likelihood: Some(joint.log_likelihood),
+        };
+    }
+    // One effect, fitted at its own step; or the joint re-fit failed, and each effect's
+    // own step's fit is all there is.
+    let effects: Vec<RefitEffect> = last
+        .effects
+        .iter()
+        .filter_map(|e| {
+            let score = steps
+                .iter()
+                .filter(|s| s.kept)
+                .find_map(|s| s.named_score().filter(|c| c.name == e.name))?;
+            Some(RefitEffect {
+                name: e.name.clone(),
+                parameters: score.parameters.clone(),
+            })
+        })
+        .collect();
+    let single = (last.effects.len() == 1 && effects.len() == 1)
+        .then(|| {
+            steps
+                .iter()
+                .find_map(|s| s.named_score().filter(|c| c.name == effects[0].name))
+        })
+        .flatten();
+    FinalFit {
+        effects,
+        log_likelihood: single.map(|c| c.log_likelihood),
+    }
+}
+
+/// The library's candidate of this name: the model's effects and their rivals are all there.
+fn effect<'a>(library: &'a [Box<dyn Candidate>], name: &str) -> &'a dyn Candidate {
+    library
+        .iter()
+        .find(|c| c.name() == name)
+        .map(|c| c.as_ref())
+        .expect("the model's effects and their rivals are in the library")
+}
+
+/// Profile-likelihood intervals, in the joint fit, of the parameters whose Wald interval is
+/// cut at the plausible range; where a profile fails or finds a higher point, the Wald
+/// interval stays (with a note).
+fn profile_cut(
+    ctx: &Context,
+    parts: &[&dyn Candidate],
+    joint: &JointFit,
+    effects: &mut [RefitEffect],
+) {
+    let cut: Vec<usize> = effects
+        .iter()
+        .flat_map(|e| &e.parameters)
+        .enumerate()
+        .filter(|(_, p)| p.wald_interval.at_range_end())
+        .map(|(j, _)| j)
+        .collect();
+    if cut.is_empty() {
+        return;
+    }
+    let combined = Combined::new(parts.to_vec());
+    let params = combined.parameters().to_vec();
+    ctx.progress.note(&format!(
+        "final fit: profile intervals of {} (Wald cut at the range)…",
+        cut.iter()
+            .map(|&j| params[j].name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    let ev = ctx.evaluator(&ctx.baseline.derived_case());
+    let project = projection(&combined);
+    let mut objective = |t: &[f64]| {
+        let v: Vec<f64> = params.iter().zip(t).map(|(p, &x)| p.value(x)).collect();
+        ev.terms_at(&combined, &v)
+    };
+    let problem = Problem {
+        parameters: &params,
+        project: &project,
+        inflation: ctx.inflation(),
+    };
+    let outcome = profile_some(&joint.fit, &problem, &mut objective, false, &cut);
+    ctx.count(&ev);
+    match outcome {
+        Ok(Profile::Intervals(iv)) => {
+            let mut flat: Vec<&mut FittedParameter> =
+                effects.iter_mut().flat_map(|e| &mut e.parameters).collect();
+            for (&j, interval) in cut.iter().zip(iv.marginal) {
+                flat[j].set_interval(&params[j], interval);
+            }
+        }
+        Ok(Profile::Higher(..)) => ctx
+            .progress
+            .note("  the profile found a higher point than the joint fit; Wald intervals kept"),
+        Err(e) => ctx
+            .progress
+            .note(&format!("  profile failed ({e}); Wald intervals kept")),
+    }
+}
+
+/// The rivals to try against the final model (module doc): candidates significant at a
+/// kept step among `steps`, not in the final model nor removed from it, strongest (lowest
+/// ΔBIC at their step) first, at most [`MAX_RIVALS`]; each with its fitted values at the
+/// step where it was strongest.
+fn rivals(steps: &[Step], model: &[RefitEffect]) -> Vec<(String, Vec<f64>)> {
+    let gone: Vec<&str> = steps
+        .iter()
+        .filter(|s| s.kept)
+        .flat_map(|s| s.removed.iter().map(|r| r.name.as_str()))
+        .collect();
+    let mut found: Vec<(String, f64, Vec<f64>)> = Vec::new();
+    for c in steps
+        .iter()
+        .filter(|s| s.kept)
+        .flat_map(|s| &s.candidates)
+        .filter(|c| c.significant && c.error.is_none())
+    {
+        if model.iter().any(|e| e.name == c.name) || gone.contains(&c.name.as_str()) {
+            continue;
+        }
+        let values = c.parameters.iter().map(|p| p.value).collect();
+        match found.iter_mut().find(|(n, ..)| *n == c.name) {
+            Some(f) if c.delta_bic < f.1 => *f = (c.name.clone(), c.delta_bic, values),
+            Some(_) => {}
+            None => found.push((c.name.clone(), c.delta_bic, values)),
+        }
+    }
+    found.sort_by(|a, b| a.1.total_cmp(&b.1));
+    found
+        .into_iter()
+        .take(MAX_RIVALS)
+        .map(|(name, _, values)| (name, values))
+        .collect()
+}
+
+/// The rivals confounded with the final model's effects (module doc); `steps` up to the
+/// final model's, `library` the candidates.
+pub(crate) fn confounding(
+    ctx: &Context,
+    steps: &[Step],
+    fit: &FinalFit,
+    library: &[Box<dyn Candidate>],
+) -> Vec<Confounding> {
+    let Some(l_model) = fit.log_likelihood else {
+        return Vec::new();
+    };
+    let mut out = Vec::new();
+    for (name, start) in rivals(steps, &fit.effects) {
+        let rival = effect(library, &name);
+        ctx.progress.note(&format!(
+            "confounding: {name} added to the final model, all fitted jointly…"
+        ));
+        match with_rival(ctx, fit, l_model, (rival, &start), library) {
+            Ok(found) => {
+                for c in &found {
+                    ctx.progress.note(&format!(
+                        "  {} confounded with {name} ({}; {name} given the model: Λ {:.1}, p {}, ΔBIC {:.1})",
+                        c.effect,
+                        c.parameters
+                            .iter()
+                            .map(|p| p.name.as_str())
+                            .collect::<Vec<_>>()
+                            .join(", "),
+                        c.lr_statistic,
+                        p_text(c.p_value),
+                        c.delta_bic
+                    ));
+                }
+                out.extend(found);
+            }
+            Err(e) => ctx.progress.note(&format!("  failed ({e})")),
+        }
+    }
+    out
+}
+
+/// The model's effects fitted jointly with `rival` (from the final values and the rival's
+/// own fit, `start`), and what it confounds.
+fn with_rival<'a>(
+    ctx: &Context,
+    fit: &FinalFit,
+    l_model: f64,
+    (rival, start): (&'a dyn Candidate, &[f64]),
+    library: &'a [Box<dyn Candidate>],
+) -> Result<Vec<Confounding>, DiagnoseError> {
+    let values: Vec<Vec<f64>> = fit
+        .effects
+        .iter()
+        .map(|e| e.parameters.iter().map(|p| p.value).collect())
+        .collect();
+    let mut members: Vec<(&dyn Candidate, &[f64])> = fit
+        .effects
+        .iter()
+        .zip(&values)
+        .map(|(e, v)| (effect(library, &e.name), v.as_slice()))
+        .collect();
+    members.push((rival, start));
+    let nulls: Vec<f64> = rival.parameters().iter().map(|q| q.null).collect();
+    // The model with the rival at its null is the model itself: a joint fit that ends below
+    // the model's ℓ̂ stopped short of the maximum, and its values say nothing.
+    let as_good = |j: &JointFit| j.log_likelihood >= l_model - NESTED_SLACK;
+    let joint = match fit_jointly(ctx, &members, None) {
+        Ok(j) if as_good(&j) => j,
+        first => {
+            ctx.progress.note(&format!(
+                "  the fit from {}'s own values ended below the model ({}); again from its null",
+                rival.name(),
+                first.map_or_else(|e| e.to_string(), |j| format!("ℓ̂ {:.1}", j.log_likelihood))
+            ));
+            *members.last_mut().expect("the rival is there") = (rival, &nulls);
+            let j = fit_jointly(ctx, &members, None)?;
+            if !as_good(&j) {
+                ctx.progress.note(&format!(
+                    "  ended below the model again (ℓ̂ {:.1}): {} not judged",
+                    j.log_likelihood,
+                    rival.name()
+                ));
+                return Ok(Vec::new());
+            }
+            j
+        }
+    };
+    let (lr, p, delta_bic) = contribution(ctx, &joint, l_model, rival.parameters().len());
+    ctx.progress.note(&format!(
+        "  ℓ̂ {:.1} (the model's {l_model:.1}); {}",
+        joint.log_likelihood,
+        fit.effects
+            .iter()
+            .zip(&joint.parameters)
+            .flat_map(|(now, with)| now.parameters.iter().zip(with))
+            .map(|(a, b)| format!("{} {:.4e} → {:.4e}", a.name, a.value, b.value))
+            .chain(
+                joint
+                    .parameters
+                    .last()
+                    .into_iter()
+                    .flatten()
+                    .map(|r| format!("{} {:.4e}", r.name, r.value))
+            )
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    let mut out = Vec::new();
+    for (e, (now, with)) in fit.effects.iter().zip(&joint.parameters).enumerate() {
+        let c = members[e].0;
+        let parameters: Vec<ConfoundedParameter> = now
+            .parameters
+            .iter()
+            .zip(with)
+            .zip(c.parameters())
+            .filter_map(|((a, b), q)| confounded(q, a, b))
+            .collect();
+        if parameters.is_empty() {
+            continue;
+        }
+        out.push(Confounding {
+            effect: now.name.clone(),
+            rival: rival.name().into(),
+            parameters,
+            lr_statistic: lr,
+            p_value: p,
+            delta_bic,
+            separate_by: separating_measurement(c, rival).into(),
+        });
+    }
+    Ok(out)
+}
+
+/// The rival's test given the model's effects (module doc): Λ_R, p, ΔBIC_R; the rival's
+/// parameters are the last `k` of the joint fit.
+fn contribution(ctx: &Context, joint: &JointFit, l_model: f64, k: usize) -> (f64, f64, f64) {
+    let n = ctx.measured.n() as f64;
+    let total = joint.fit.internal.len();
+    let lambda = adjustments(&joint.fit)
+        .map_or(1.0, |(_, per)| {
+            per[total - k..].iter().sum::<f64>() / k as f64
+        })
+        .max(1.0);
+    let lr = (2.0 * (joint.log_likelihood - l_model) / (ctx.inflation() * lambda)).max(0.0);
+    let p = 1.0 - ChiSquared::new(k as f64).expect("k ≥ 1").cdf(lr);
+    (lr, p, lambda * (k as f64 * n.ln() - lr))
+}
+
+/// Whether parameter `q`, fitted as `now` in the final model and as `with` with a rival
+/// added, is confounded with the rival (module doc).
+fn confounded(
+    q: &Parameter,
+    now: &FittedParameter,
+    with: &FittedParameter,
+) -> Option<ConfoundedParameter> {
+    let i = &now.interval;
+    let moved = i.lower.is_some_and(|l| with.value < l) || i.upper.is_some_and(|u| with.value > u);
+    // On the fit's scale; none where an end is missing (the curvature not positive
+    // definite: a rival at the edge of its range, whose fit says nothing of the others).
+    let width = |w: &Interval| Some(q.internal(w.upper?) - q.internal(w.lower?));
+    let widening = match (width(&now.wald_interval), width(&with.wald_interval)) {
+        (Some(before), Some(after)) if before > 0.0 => after / before,
+        _ => 1.0,
+    };
+    (moved || widening >= WIDENED).then(|| ConfoundedParameter {
+        name: now.name.clone(),
+        unit: now.unit,
+        value: now.value,
+        with_rival: with.value,
+        interval: now.interval.clone(),
+        moved,
+        widening,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn fitted(value: f64, interval: (f64, f64), wald: (f64, f64)) -> FittedParameter {
+        let iv = |(a, b): (f64, f64)| Interval {
+            lower: Some(a),
+            upper: Some(b),
+            lower_at_range_end: false,
+            upper_at_range_end: false,
+            method: "wald",
+            threshold: None,
+        };
+        FittedParameter {
+            name: "offset".into(),
+            unit: "K",
+            value,
+            interval: iv(interval),
+            wald_interval: iv(wald),
+            joint_interval: None,
+            range: [-20.0, 20.0],
+            null: 0.0,
+            determined: true,
+        }
+    }
+
+    /// A parameter is confounded with a rival when the rival moves it out of its interval
+    /// (−0.28 K in [−0.4, −0.16] moved to 0.01 K), or widens its Wald interval by 2 or more
+    /// (0.24 K wide to 0.5 K: 2.08); a move within the interval that widens it by 1.5 is not.
+    #[test]
+    fn moved_or_widened_is_confounded() {
+        let q = Parameter::linear("offset", "K", -20.0, 20.0, 0.0);
+        let now = fitted(-0.28, (-0.4, -0.16), (-0.4, -0.16));
+        let moved = confounded(&q, &now, &fitted(0.01, (-0.1, 0.12), (-0.1, 0.12))).unwrap();
+        assert!(moved.moved && moved.with_rival == 0.01, "{moved:?}");
+        let wide = confounded(&q, &now, &fitted(-0.3, (-0.55, -0.05), (-0.55, -0.05))).unwrap();
+        assert!(
+            !wide.moved && (wide.widening - 0.5 / 0.24).abs() < 1e-9,
+            "{wide:?}"
+        );
+        assert!(confounded(&q, &now, &fitted(-0.25, (-0.43, -0.07), (-0.43, -0.07))).is_none());
+    }
+}
