@@ -10,8 +10,9 @@
 //! The backlash check uses section 4.2.3's job (`jobs/paper-4.2.3.json`) instead.
 //!
 //! Two tiers here. The default run's checks are small (40–60 specimens, N = 300 simulated
-//! samples, the true effect tried against one or two others); the `#[ignore]`d ones (run in
-//! release by scripts/test.sh) try every candidate on 80–200 specimens with N = 1200, and
+//! samples, the true effect tried against one or two others; the small backlash and
+//! two-effect checks, some 20 s each in the debug build, are `#[ignore]`d with the slow tier);
+//! the `#[ignore]`d ones (run in release by scripts/test.sh) try every candidate on 80–200 specimens with N = 1200, and
 //! the null-data false-positive rate over 20 seeds at 100 specimens (at 30:
 //! `ONLY=null-fpr scripts/diagnose-check.sh`), and (in `hidden_effects/stepwise.rs`) two
 //! pairs of effects in which the stepwise selection must swap out or remove an effect it
@@ -533,10 +534,11 @@ fn conditioning_on_members_narrows_the_clearance() {
     );
 }
 
-/// The fast version of the backlash check, in the default run: the paper's clearances
+/// The fast version of the backlash check (in release, with the slow tier): the paper's clearances
 /// (U[0.004, 0.017] mm per joint, made by the job's own backlash case) on 80 specimens with
 /// their members measured are named backlash, and the gap is at least halved.
 #[test]
+#[ignore = "about 20 s in the debug build since backlash and the confounding re-fits run at the cables' limit: scripts/test.sh runs it in release"]
 fn hidden_backlash_is_named_fast() {
     let dir = tempfile::tempdir().unwrap();
     let paper = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../jobs/paper-4.2.3.json");
@@ -568,12 +570,13 @@ fn hidden_backlash_is_named_fast() {
     check_halved(&v);
 }
 
-/// The fast forward selection (default run): self-weight (a mean shift) and a longeron
+/// The fast forward selection (in release, with the slow tier): self-weight (a mean shift) and a longeron
 /// scatter twice the stated (a change of scatter) hidden at once in 60 specimens, tried
 /// against gravity, length_sigma and diagonal_pretension: both are named, one per step, and the
 /// third step names nothing; each step's discrepancy shrinks, and `updated-job.json` holds
 /// both effects.
 #[test]
+#[ignore = "about 20 s in the debug build since backlash and the confounding re-fits run at the cables' limit: scripts/test.sh runs it in release"]
 fn two_hidden_effects_are_both_named_fast() {
     let dir = tempfile::tempdir().unwrap();
     let m = make(
