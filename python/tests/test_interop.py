@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -62,6 +63,10 @@ def test_ctrl_c_stops_a_run() -> None:
     job = truss_mc.Job.from_json(BIG_JOB)
     # A real SIGINT, as a terminal's Ctrl-C sends, from a process of its own: a Python timer
     # thread would need the interpreter lock to deliver it.
+    # Python raises KeyboardInterrupt only where SIGINT was not ignored when it started (a
+    # shell's background job, `cmd &`, starts with it ignored): install the handler an
+    # interactive session has.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     started = time.monotonic()
     killer = subprocess.Popen(["sh", "-c", f"sleep 0.3; kill -INT {os.getpid()}"])
     try:
@@ -69,6 +74,7 @@ def test_ctrl_c_stops_a_run() -> None:
             job.run(threads=2)
     finally:
         killer.wait()
+        signal.signal(signal.SIGINT, previous)
     # The whole run takes about a minute; the interrupt is seen within a tick.
     assert time.monotonic() - started < 10
 
