@@ -122,7 +122,7 @@ impl Solver {
                 break;
             }
             p.iterations += 1;
-            let choice = self.choose_step(&mut p)?;
+            let choice = self.choose_step(&mut p, kernels).await?;
             let residual_before = p.eval.residual;
             let alpha = match self
                 .line_search(
@@ -290,9 +290,12 @@ impl Solver {
     /// slack set's Woodbury inverse while those contract, else a model step with the true
     /// tangent (reusing its factorisation while the slack set is unchanged and steps
     /// contract).
-    fn choose_step(&mut self, p: &mut Progress) -> Result<StepChoice, SolveError> {
+    async fn choose_step(
+        &mut self,
+        p: &mut Progress,
+        kernels: Kernels<'_>,
+    ) -> Result<StepChoice, SolveError> {
         let structure = Arc::clone(&self.structure);
-        let n = structure.free;
         self.step.step_slack.copy_from_slice(&self.work.slack);
         let mut choice = StepChoice {
             fresh: false,
@@ -331,9 +334,19 @@ impl Solver {
                     && self.work.slack == self.factor.factor_slack;
                 if reuse {
                     self.negate_residual_into_step();
-                    self.factor.k.solve_in_place(&mut self.work.d[..n]);
+                    kernels
+                        .solve(
+                            &structure,
+                            self.sample_key,
+                            &mut self.factor.k,
+                            &mut self.work.d,
+                        )
+                        .await;
                 } else {
-                    match self.model_step(p.iterations, &mut p.factorisations)? {
+                    match self
+                        .model_step(p.iterations, &mut p.factorisations, kernels)
+                        .await?
+                    {
                         Step::Newton { shift } => {
                             choice.shift = shift;
                             choice.fresh = true;

@@ -42,6 +42,9 @@ pub fn run_lanes<'a, W: LaneWork<'a>>(work: &mut W, kernels: &mut BatchKernels) 
                 let Some(solve) = lane else {
                     break;
                 };
+                if slots.lane(l).waiting() {
+                    break;
+                }
                 match solve.as_mut().poll(&mut context) {
                     Poll::Ready(done) => {
                         *lane = None;

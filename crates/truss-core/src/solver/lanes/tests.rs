@@ -2,6 +2,7 @@
 //! whole solves in lanes beside other samples (of the same structure and of another), on
 //! the baseline x86-64 kernels and on the best this processor has.
 
+use super::band::{BandLanes, FactorLane, SolveLane};
 use super::evaluate::{EvalBuffers, EvalLanes};
 use super::*;
 use crate::element::AxialState;
@@ -201,7 +202,12 @@ fn outcome(solver: &Solver, result: Result<SolveReport, SolveError>) -> String {
 
 /// Solves every sample of `samples` (a model's index and length errors) in lanes, with a
 /// pool of solvers per model reused from sample to sample; returns each outcome in order.
-fn in_lanes(models: &[Model], samples: &[(usize, Vec<f64>)], arch: pulp::Arch) -> Vec<String> {
+fn in_lanes(
+    models: &[Model],
+    samples: &[(usize, Vec<f64>)],
+    arch: pulp::Arch,
+    batched_dofs: usize,
+) -> Vec<String> {
     struct Work<'m> {
         structures: Vec<Arc<crate::Structure>>,
         samples: &'m [(usize, Vec<f64>)],
@@ -248,6 +254,7 @@ fn in_lanes(models: &[Model], samples: &[(usize, Vec<f64>)], arch: pulp::Arch) -
         outcomes: vec![None; samples.len()],
     };
     let mut kernels = BatchKernels::with_arch(arch);
+    kernels.batched_dofs = batched_dofs;
     run_lanes(&mut work, &mut kernels);
     work.outcomes.into_iter().map(Option::unwrap).collect()
 }
@@ -271,10 +278,150 @@ fn solves_in_lanes_are_the_one_sample_solves_bit_for_bit() {
             outcome(&solver, result)
         })
         .collect();
-    for arch in arches() {
-        let batched = in_lanes(&models, &samples, arch);
+    // Batched on both instruction sets, and one lane at a time (a structure too large to
+    // batch).
+    for (arch, batched_dofs) in [
+        (pulp::Arch::Scalar, BATCHED_DOFS),
+        (pulp::Arch::new(), BATCHED_DOFS),
+        (pulp::Arch::new(), 0),
+    ] {
+        let batched = in_lanes(&models, &samples, arch, batched_dofs);
         for (i, (a, b)) in alone.iter().zip(&batched).enumerate() {
-            assert_eq!(a, b, "sample {i}, {arch:?}");
+            assert_eq!(a, b, "sample {i}, {arch:?}, batched up to {batched_dofs}");
         }
+    }
+}
+
+/// A symmetric banded matrix of `nb` block rows and half-bandwidth `q` with entries in
+/// (−0.5, 0.5) and `diagonal` added on the diagonal: positive definite when `diagonal` is
+/// large, indefinite when it is small.
+fn band(nb: usize, q: usize, diagonal: f64, stream: &mut Stream) -> crate::block::BlockBandMatrix {
+    let mut m = crate::block::BlockBandMatrix::new(nb, q);
+    for i in 0..nb {
+        for j in i.saturating_sub(q)..=i {
+            let b = m.block_mut(i, j);
+            for (r, row) in b.iter_mut().enumerate() {
+                for (c, x) in row.iter_mut().enumerate() {
+                    *x = stream.uniform() - 0.5;
+                    if i == j && r == c {
+                        *x += diagonal;
+                    }
+                }
+            }
+            if i == j {
+                // Symmetric: the upper triangle mirrors the lower.
+                *b = std::array::from_fn(|r| std::array::from_fn(|c| b[r.max(c)][r.min(c)]));
+            }
+        }
+    }
+    m
+}
+
+fn factor_bits(m: &crate::block::BlockBandMatrix) -> (Vec<u64>, Vec<u64>) {
+    let (blocks, inv) = m.factor_parts();
+    (
+        blocks
+            .iter()
+            .flatten()
+            .flatten()
+            .map(|x| x.to_bits())
+            .collect(),
+        inv.iter().flatten().map(|x| x.to_bits()).collect(),
+    )
+}
+
+/// The batched factorisation and solves against the one-sample ones, bit for bit: positive
+/// definite and indefinite matrices side by side (an indefinite lane is factorised again
+/// by the one-sample code, its failed pivot recorded), solves with a factor the lanes hold,
+/// held across another lane's factorisation, and with one they must gather (another lane's
+/// matrix).
+#[test]
+fn the_band_in_lanes_is_the_one_sample_band_bit_for_bit() {
+    let (nb, q) = (7, 3);
+    for arch in arches() {
+        let mut stream = Stream(99);
+        let diagonals = [20.0, 0.1, 15.0, 25.0];
+        let originals: Vec<_> = diagonals
+            .iter()
+            .map(|&d| band(nb, q, d, &mut stream))
+            .collect();
+        let mut want = originals.clone();
+        let mut want_failures = vec![Vec::new(); LANES];
+        for (m, f) in want.iter_mut().zip(&mut want_failures) {
+            m.factor_collecting(f, 1);
+        }
+        assert!(want[1].factor_parts().0.len() == nb * (q + 1) && !want_failures[1].is_empty());
+        let mut lanes = BandLanes::<LANES>::new(nb, q, arch);
+        let mut got = originals.clone();
+        let mut failures = vec![vec![]; LANES];
+        {
+            let mut io: [Option<FactorLane<'_>>; LANES] = std::array::from_fn(|_| None);
+            for ((x, m), f) in io.iter_mut().zip(got.iter_mut()).zip(failures.iter_mut()) {
+                *x = Some((m, f, 1));
+            }
+            lanes.factor(&mut io);
+        }
+        for l in 0..LANES {
+            assert_eq!(
+                got[l].is_factored(),
+                want[l].is_factored(),
+                "{arch:?} lane {l}"
+            );
+            assert_eq!(failures[l], want_failures[l], "{arch:?} lane {l}");
+            assert_eq!(
+                factor_bits(&got[l]),
+                factor_bits(&want[l]),
+                "{arch:?} lane {l}"
+            );
+        }
+        let rhs: Vec<Vec<f64>> = (0..LANES)
+            .map(|_| (0..3 * nb).map(|_| stream.uniform() - 0.5).collect())
+            .collect();
+        let solved = |m: &crate::block::BlockBandMatrix, b: &[f64]| {
+            let mut x = b.to_vec();
+            m.solve_in_place(&mut x);
+            bits(&x)
+        };
+        // Lanes 0, 2, 3 hold their factors; lane 1 failed and holds none.
+        let mut xs = rhs.clone();
+        {
+            let mut io: [Option<SolveLane<'_>>; LANES] = std::array::from_fn(|_| None);
+            for (l, (x, b)) in io.iter_mut().zip(xs.iter_mut()).enumerate() {
+                if l != 1 {
+                    *x = Some((&got[l], &mut b[..]));
+                }
+            }
+            lanes.solve(&mut io);
+        }
+        for l in [0, 2, 3] {
+            assert_eq!(bits(&xs[l]), solved(&want[l], &rhs[l]), "{arch:?} lane {l}");
+        }
+        // A factorisation in lane 1 alone leaves the other lanes' factors: lane 0 solves
+        // with the one it holds; lane 3 gathers another lane's matrix.
+        let mut other = originals[3].clone();
+        let mut f = Vec::new();
+        {
+            let mut io: [Option<FactorLane<'_>>; LANES] = std::array::from_fn(|_| None);
+            io[1] = Some((&mut other, &mut f, 1));
+            lanes.factor(&mut io);
+        }
+        let mut xs = rhs.clone();
+        {
+            let mut io: [Option<SolveLane<'_>>; LANES] = std::array::from_fn(|_| None);
+            let (first, rest) = xs.split_at_mut(1);
+            io[0] = Some((&got[0], &mut first[0][..]));
+            io[3] = Some((&got[2], &mut rest[2][..]));
+            lanes.solve(&mut io);
+        }
+        assert_eq!(
+            bits(&xs[0]),
+            solved(&want[0], &rhs[0]),
+            "{arch:?} held across a factorisation"
+        );
+        assert_eq!(
+            bits(&xs[3]),
+            solved(&want[2], &rhs[3]),
+            "{arch:?} another lane's factor"
+        );
     }
 }
