@@ -14,6 +14,8 @@
 #
 # Usage: scripts/bench-instructions.sh [CASE ...]    (default: rigid backlash tall)
 #        MC_SHARD=path/to/mc-shard scripts/bench-instructions.sh   (another build, to compare)
+#        TRUSS_LANES=off scripts/bench-instructions.sh   (one sample at a time instead of four
+#        side by side in lanes: the same bytes; see the README's Speed section)
 # Needs valgrind (Debian package valgrind).
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

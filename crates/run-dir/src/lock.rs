@@ -31,7 +31,8 @@ pub fn try_lock(file: &File) -> std::io::Result<Lock> {
     }
 }
 
-/// The pid of the process holding a `flock` lock on `file`, from `/proc/locks`.
+/// The pid of the process holding a `flock` lock on `file`, from `/proc/locks` (read up to
+/// three times, see below).
 pub fn holder(file: &File) -> Option<u32> {
     use std::os::unix::fs::MetadataExt;
     let meta = file.metadata().ok()?;
@@ -42,8 +43,10 @@ pub fn holder(file: &File) -> Option<u32> {
         rustix::fs::minor(dev),
         meta.ino()
     );
-    let table = std::fs::read_to_string("/proc/locks").ok()?;
-    holder_in(&table, &key)
+    // The kernel writes /proc/locks a page at a time: a lock taken or released by another
+    // thread between two reads can shift the lines so that one is skipped. Read it again
+    // before saying the holder is not visible.
+    (0..3).find_map(|_| holder_in(&std::fs::read_to_string("/proc/locks").ok()?, &key))
 }
 
 /// The pid of the `FLOCK` lock on `key` (`MAJOR:MINOR:INODE`, as `/proc/locks` writes it) in

@@ -13,7 +13,8 @@
 //! whose bracing is all slack), the samples, their mean iterations and median time. Run with
 //! `cargo bench -p truss-core`; `-- --quick` for fewer samples, `-- --only 5` (or `5b`, `30`,
 //! `300`) for one model alone (for a profiler), `-- --paths` for the probe of whether the
-//! converged state depends on the solver's path (see `path_independence`).
+//! converged state depends on the solver's path (see `path_independence`). Per model also
+//! the batched path: every sample one at a time against in lanes (see `in_lanes`).
 //! The machine is shared: run it several times and quote medians.
 
 use std::hint::black_box;
@@ -85,6 +86,7 @@ fn bench(stages: usize, samples: usize, backlash: bool, histogram: bool) -> f64 
                 .collect()
         })
         .collect();
+    in_lanes(&solver, &errors);
     // Warm up.
     for e in errors.iter().take(samples.min(200)) {
         solver.solve(e).unwrap();
@@ -372,6 +374,84 @@ fn path_independence(samples: usize) {
             );
         }
     }
+}
+
+/// The samples solved one at a time and in lanes (four side by side, their kernels
+/// batched: `truss_core::solver::lanes`), all of them, three times each; prints the median
+/// time per sample of each and their ratio, and checks that both give the same bits.
+fn in_lanes(solver: &Solver, errors: &[Vec<f64>]) {
+    use truss_core::solver::lanes::{BatchKernels, Kernels, LaneSolve, LaneWork, run_lanes};
+    struct Work<'e> {
+        structure: std::sync::Arc<truss_core::Structure>,
+        errors: &'e [Vec<f64>],
+        next: usize,
+        pool: Vec<Solver>,
+        out: Vec<u64>,
+    }
+    impl<'e> LaneWork<'e> for Work<'e> {
+        type Done = (usize, Solver, u64);
+        fn next<'s>(&mut self, kernels: Kernels<'s>) -> Option<LaneSolve<'s, Self::Done>>
+        where
+            'e: 's,
+        {
+            let i = self.next;
+            let e = self.errors.get(i)?;
+            self.next += 1;
+            let mut solver = self.pool.pop().unwrap_or_else(|| {
+                Solver::with_structure(self.structure.clone(), SolveOptions::default())
+            });
+            Some(Box::pin(async move {
+                let p = truss_core::solver::Perturbation {
+                    length_errors: e,
+                    ..Default::default()
+                };
+                solver.solve_perturbed_in(p, kernels).await.unwrap();
+                let bits = solver.displacement(0)[0].to_bits();
+                (i, solver, bits)
+            }))
+        }
+        fn done(&mut self, (i, solver, bits): Self::Done) {
+            self.out[i] = bits;
+            self.pool.push(solver);
+        }
+    }
+    let structure = solver.structure().clone();
+    let mut alone = Solver::with_structure(structure.clone(), SolveOptions::default());
+    let (mut one, mut batched) = (vec![], vec![]);
+    let mut want = vec![];
+    let mut kernels = BatchKernels::default();
+    for _ in 0..3 {
+        let t = Instant::now();
+        want = errors
+            .iter()
+            .map(|e| {
+                alone.solve(black_box(e)).unwrap();
+                alone.displacement(0)[0].to_bits()
+            })
+            .collect();
+        one.push(t.elapsed().as_secs_f64() * 1e6 / errors.len() as f64);
+        let mut work = Work {
+            structure: structure.clone(),
+            errors,
+            next: 0,
+            pool: vec![],
+            out: vec![0; errors.len()],
+        };
+        let t = Instant::now();
+        run_lanes(&mut work, &mut kernels);
+        batched.push(t.elapsed().as_secs_f64() * 1e6 / errors.len() as f64);
+        assert_eq!(work.out, want, "lanes and one at a time differ");
+    }
+    one.sort_by(f64::total_cmp);
+    batched.sort_by(f64::total_cmp);
+    println!(
+        "  one at a time {:.2} µs/sample, in {} lanes ({}) {:.2} µs/sample: {:.2}x (median of 3)",
+        one[1],
+        truss_core::solver::lanes::LANES,
+        truss_core::solver::lanes::kernel_set(),
+        batched[1],
+        one[1] / batched[1]
+    );
 }
 
 fn main() {

@@ -36,7 +36,7 @@ pub struct PivotFailure {
 pub const PIVOT_TOLERANCE: f64 = 1e-12;
 
 /// A symmetric block-banded matrix, stored as its lower block band, factorisable in place.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct BlockBandMatrix {
     nb: usize,
     q: usize,
@@ -44,6 +44,33 @@ pub struct BlockBandMatrix {
     diag: Vec<[f64; 3]>,
     inv_diag: Vec<[f64; 3]>,
     factored: bool,
+    /// Which matrix this is, and how many times its numbers changed: a batched solve's
+    /// copy of the factor is reused while both match (see `solver::lanes`).
+    id: u64,
+    version: u64,
+}
+
+/// The next matrix's number (see `BlockBandMatrix::id`).
+static MATRICES: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+fn next_id() -> u64 {
+    MATRICES.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+impl Clone for BlockBandMatrix {
+    /// A copy with the same numbers, and a number of its own.
+    fn clone(&self) -> Self {
+        Self {
+            nb: self.nb,
+            q: self.q,
+            a: self.a.clone(),
+            diag: self.diag.clone(),
+            inv_diag: self.inv_diag.clone(),
+            factored: self.factored,
+            id: next_id(),
+            version: 0,
+        }
+    }
 }
 
 const ZERO: Block = [[0.0; 3]; 3];
@@ -58,7 +85,38 @@ impl BlockBandMatrix {
             diag: vec![[0.0; 3]; nb],
             inv_diag: vec![[0.0; 3]; nb],
             factored: false,
+            id: next_id(),
+            version: 0,
         }
+    }
+
+    /// The numbers changed: not factorised, and a new version.
+    #[inline]
+    fn touched(&mut self) {
+        self.factored = false;
+        self.version += 1;
+    }
+
+    /// This matrix's number and version: the same pair, the same numbers.
+    pub(crate) fn identity(&self) -> (u64, u64) {
+        (self.id, self.version)
+    }
+
+    /// The blocks (the factor once factorised), and the factor's inverse pivots.
+    pub(crate) fn factor_parts(&self) -> (&[Block], &[[f64; 3]]) {
+        (&self.a, &self.inv_diag)
+    }
+
+    /// Installs a factor computed elsewhere (the batched factorisation, bit for bit
+    /// [`BlockBandMatrix::factor`]'s): `fill` writes the blocks, each row's original diagonal
+    /// and the inverse pivots; the matrix is then factorised.
+    pub(crate) fn install_factor(
+        &mut self,
+        fill: impl FnOnce(&mut [Block], &mut [[f64; 3]], &mut [[f64; 3]]),
+    ) {
+        fill(&mut self.a, &mut self.diag, &mut self.inv_diag);
+        self.touched();
+        self.factored = true;
     }
 
     /// Number of block rows.
@@ -89,13 +147,13 @@ impl BlockBandMatrix {
     /// Sets every entry to zero, ready for assembly.
     pub fn clear(&mut self) {
         self.a.as_flattened_mut().as_flattened_mut().fill(0.0);
-        self.factored = false;
+        self.touched();
     }
 
     /// The blocks, for assembly by precomputed slots (see [`BlockBandMatrix::slot`]).
     #[inline]
     pub fn storage_mut(&mut self) -> &mut [Block] {
-        self.factored = false;
+        self.touched();
         &mut self.a
     }
 
@@ -108,13 +166,13 @@ impl BlockBandMatrix {
                 row[k] *= factor;
             }
         }
-        self.factored = false;
+        self.touched();
     }
 
     /// Block `(i, j)`, `j ≤ i`, for assembly.
     #[inline]
     pub fn block_mut(&mut self, i: usize, j: usize) -> &mut Block {
-        self.factored = false;
+        self.touched();
         let s = self.slot(i, j);
         &mut self.a[s]
     }
@@ -161,7 +219,7 @@ impl BlockBandMatrix {
     /// after failures, [`BlockBandMatrix::failed_pivot_direction`] works for each of them.
     pub fn factor_collecting(&mut self, failures: &mut Vec<PivotFailure>, max: usize) {
         failures.clear();
-        self.factored = false;
+        self.touched();
         let q = self.q;
         let w = q + 1;
         for (d, row) in self.diag.iter_mut().zip(self.a.chunks_exact(w)) {

@@ -32,6 +32,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{RecvTimeoutError, sync_channel};
 use std::time::{Duration, Instant};
 use truss_core::SolveOptions;
+use truss_core::solver::lanes::{BatchKernels, Kernels, LaneSolve, LaneWork, run_lanes};
 
 /// Positions a worker takes at a time. Each chunk wakes the calling thread once (the
 /// runner: one write): at 16 (about 0.2 ms of 5-stage samples) those wakeups, on a machine
@@ -101,18 +102,29 @@ pub struct Engine<'a> {
     threads: usize,
     options: SolveOptions,
     halt: Option<&'a (dyn Fn() -> bool + Sync)>,
+    lanes: bool,
 }
 
 impl<'a> Engine<'a> {
     /// An engine for `job` on `threads` threads (at least 1), with the default solver
-    /// options.
+    /// options, solving in lanes unless the environment says `TRUSS_LANES=off` (for
+    /// benchmarks and for debugging: the results are the same bits).
     pub fn new(job: &'a Job, threads: usize) -> Self {
         Self {
             job,
             threads: threads.max(1),
             options: SolveOptions::default(),
             halt: None,
+            lanes: std::env::var_os("TRUSS_LANES").is_none_or(|v| v != "off"),
         }
+    }
+
+    /// Whether each worker solves [`LANES`](truss_core::solver::lanes::LANES) samples side by side, their kernels batched
+    /// (the default; see [`truss_core::solver::lanes`]), or one sample at a time. The
+    /// results are the same bits either way.
+    pub fn in_lanes(mut self, lanes: bool) -> Self {
+        self.lanes = lanes;
+        self
     }
 
     /// With these solver options (for example, recording iterations).
@@ -163,7 +175,8 @@ impl<'a> Engine<'a> {
                 let tx = tx.clone();
                 let (next, each, halted, indices) = (&next, &each, &halted, &indices);
                 scope.spawn(move || {
-                    let mut solver = SampleSolver::with_options(self.job, self.options.clone());
+                    let mut pool = vec![SampleSolver::with_options(self.job, self.options.clone())];
+                    let mut kernels = BatchKernels::default();
                     loop {
                         let start = next.fetch_add(CHUNK, Ordering::Relaxed);
                         if start >= total || halted() {
@@ -172,13 +185,32 @@ impl<'a> Engine<'a> {
                         let end = (start + CHUNK).min(total);
                         let mut chunk = C::default();
                         let mut done = 0;
-                        for p in start..end {
-                            if halted() {
-                                break;
+                        if self.lanes {
+                            let mut work = InOrder {
+                                job: self.job,
+                                options: &self.options,
+                                indices,
+                                next: start,
+                                end,
+                                delivered: start,
+                                pool: &mut pool,
+                                parked: BTreeMap::new(),
+                                chunk: &mut chunk,
+                                each,
+                                halted,
+                            };
+                            run_lanes(&mut work, &mut kernels);
+                            done = work.delivered - start;
+                        } else {
+                            let solver = &mut pool[0];
+                            for p in start..end {
+                                if halted() {
+                                    break;
+                                }
+                                let result = solver.solve(indices.at(p));
+                                each(&mut chunk, solver, result);
+                                done += 1;
                             }
-                            let result = solver.solve(indices.at(p));
-                            each(&mut chunk, &solver, result);
-                            done += 1;
                         }
                         // A halted worker still sends what it finished.
                         if done > 0 && tx.send((start, done, chunk)).is_err() {
@@ -257,6 +289,62 @@ impl<'a> Engine<'a> {
     }
 }
 
+/// A chunk's samples solved in lanes, handed to `each` in position order: a sample that
+/// ends before one issued earlier waits, with its solver, until that one has ended. Each
+/// lane takes a solver from the pool (a new one when all are waiting).
+struct InOrder<'e, 'a, C, F, H> {
+    job: &'a Job,
+    options: &'e SolveOptions,
+    indices: &'e Indices<'e>,
+    /// The next position to issue.
+    next: u64,
+    end: u64,
+    /// The next position to hand to `each`.
+    delivered: u64,
+    pool: &'e mut Vec<SampleSolver<'a>>,
+    parked: BTreeMap<u64, (SampleSolver<'a>, SampleResult)>,
+    chunk: &'e mut C,
+    each: &'e F,
+    halted: &'e H,
+}
+
+impl<'a, C, F, H> LaneWork<'a> for InOrder<'_, 'a, C, F, H>
+where
+    F: Fn(&mut C, &SampleSolver<'a>, SampleResult),
+    H: Fn() -> bool,
+{
+    type Done = (u64, SampleSolver<'a>, SampleResult);
+
+    fn next<'s>(&mut self, kernels: Kernels<'s>) -> Option<LaneSolve<'s, Self::Done>>
+    where
+        'a: 's,
+    {
+        if self.next >= self.end || (self.halted)() {
+            return None;
+        }
+        let p = self.next;
+        self.next += 1;
+        let index = self.indices.at(p);
+        let mut solver = self
+            .pool
+            .pop()
+            .unwrap_or_else(|| SampleSolver::with_options(self.job, self.options.clone()));
+        Some(Box::pin(async move {
+            let result = solver.solve_in(index, kernels).await;
+            (p, solver, result)
+        }))
+    }
+
+    fn done(&mut self, (p, solver, result): Self::Done) {
+        self.parked.insert(p, (solver, result));
+        while let Some((solver, result)) = self.parked.remove(&self.delivered) {
+            (self.each)(self.chunk, &solver, result);
+            self.pool.push(solver);
+            self.delivered += 1;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,8 +395,10 @@ mod tests {
         results.iter().map(|r| format!("{r:?}")).collect()
     }
 
-    /// The same bits for 1, 2 and 3 threads, and for the range split in two at every
-    /// offset (chunk edges and case edges among them), each part on its own thread count.
+    /// The same bits as one sample at a time for 1, 2 and 3 threads, in lanes or not, and
+    /// for the range split in two at every offset (so at every offset modulo the lane
+    /// count, chunk edges and case edges among them), each part in lanes on its own thread
+    /// count.
     #[test]
     fn the_same_bits_for_any_thread_count_and_any_split() {
         let job = job(90);
@@ -316,13 +406,19 @@ mod tests {
         let mut alone = SampleSolver::new(&job);
         let reference = bits(&(0..n).map(|i| alone.solve(i)).collect::<Vec<_>>());
         for threads in [1, 2, 3] {
-            let whole = Engine::new(&job, threads).results(0..n);
-            assert_eq!(bits(&whole), reference, "{threads} threads");
+            for lanes in [true, false] {
+                let whole = Engine::new(&job, threads).in_lanes(lanes).results(0..n);
+                assert_eq!(bits(&whole), reference, "{threads} threads, lanes {lanes}");
+            }
         }
         for cut in 0..=n {
             let threads = 1 + (cut % 3) as usize;
-            let mut parts = Engine::new(&job, threads).results(0..cut);
-            parts.extend(Engine::new(&job, 4 - threads).results(cut..n));
+            let mut parts = Engine::new(&job, threads).in_lanes(true).results(0..cut);
+            parts.extend(
+                Engine::new(&job, 4 - threads)
+                    .in_lanes(true)
+                    .results(cut..n),
+            );
             assert_eq!(
                 bits(&parts),
                 reference,
@@ -349,16 +445,18 @@ mod tests {
 
     /// A halt stops the workers; what they finished is handed over up to the first gap, in
     /// order, and counted. On one thread that is exactly the samples solved before the halt
-    /// (the partial chunk included); on several, a worker the scheduler held back may leave
-    /// the gap anywhere, even at the start.
+    /// (the partial chunk included), plus, in lanes, the ones issued before the halt (they
+    /// finish); on several, a worker the scheduler held back may leave the gap
+    /// anywhere, even at the start.
     #[test]
     fn a_halt_hands_over_what_was_finished() {
         let job = job(300);
-        for threads in [1, 3] {
+        for (threads, lanes) in [(1, false), (1, true), (3, false), (3, true)] {
             let solved = AtomicUsize::new(0);
             let halt = || solved.load(Ordering::Relaxed) >= 100;
             let mut got = Vec::new();
             let handed = Engine::new(&job, threads)
+                .in_lanes(lanes)
                 .halting_when(&halt)
                 .run(
                     0..350,
@@ -374,8 +472,12 @@ mod tests {
                 .unwrap();
             assert_eq!(handed, got.len() as u64, "{threads} threads");
             assert_eq!(got, (0..handed).collect::<Vec<_>>(), "{threads} threads");
-            if threads == 1 {
+            if threads == 1 && !lanes {
                 assert_eq!(handed, 100);
+            } else if threads == 1 {
+                // The lanes' samples issued before the halt finish: those in flight, and
+                // those that ended before an earlier one (at most the rest of the chunk).
+                assert!((100..=100 + CHUNK).contains(&handed), "{handed}");
             } else {
                 assert!(handed < 350, "{handed}");
             }

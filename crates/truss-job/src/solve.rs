@@ -7,6 +7,7 @@ use crate::job::Job;
 use crate::sampler::{draw_sample, stream_key};
 use truss_core::measure::Distortion;
 use truss_core::solver::Perturbation;
+use truss_core::solver::lanes::{Kernels, finish};
 use truss_core::{SolveError, SolveOptions, Solver};
 
 /// A converged sample's measurements.
@@ -92,6 +93,16 @@ impl<'j> SampleSolver<'j> {
     /// # Panics
     /// If `index` is beyond the job (a bug in the caller).
     pub fn solve(&mut self, index: u64) -> SampleResult {
+        finish(self.solve_in(index, Kernels::OneSample))
+    }
+
+    /// [`SampleSolver::solve`], the solver's kernels run by `kernels`: at once, or in a
+    /// lane of a batch of samples (see [`truss_core::solver::lanes`]); the same bits either
+    /// way.
+    ///
+    /// # Panics
+    /// If `index` is beyond the job (a bug in the caller).
+    pub async fn solve_in(&mut self, index: u64, kernels: Kernels<'_>) -> SampleResult {
         let (c, k) = self.job.case_of(index).expect("index within the job");
         let case = &self.job.cases[c];
         draw_sample(
@@ -107,11 +118,16 @@ impl<'j> SampleSolver<'j> {
         let options = &self.options;
         let solver = self.solvers[c]
             .get_or_insert_with(|| Solver::with_structure(case.structure.clone(), options.clone()));
-        let result = solver.solve_perturbed(Perturbation {
-            length_errors: &self.errors,
-            extra_loads: &case.applied.loads,
-            clearances: &self.clearances,
-        });
+        let result = solver
+            .solve_perturbed_in(
+                Perturbation {
+                    length_errors: &self.errors,
+                    extra_loads: &case.applied.loads,
+                    clearances: &self.clearances,
+                },
+                kernels,
+            )
+            .await;
         let has_joints = !case.model.joints().is_empty();
         let (iterations, outcome) = match result {
             Ok(report) => (

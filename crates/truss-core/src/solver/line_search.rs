@@ -2,7 +2,8 @@
 //! sufficient-decrease test, seeded by an exact minimiser of the piecewise quadratic model
 //! along the line.
 
-use super::evaluate::{dot_n, evaluate_with, max_abs};
+use super::evaluate::{dot_n, max_abs};
+use super::lanes::{Evaluate, Kernels};
 use super::{Evaluation, Solver};
 use crate::SolveError;
 
@@ -56,12 +57,13 @@ impl Solver {
     /// the sample's largest initial stretch, and a fifth of the shortest member. Returns an
     /// error, for the caller to damp its steps, when the direction does not descend
     /// (`φ'(0) ≥ 0`) or no acceptable α is found.
-    pub(super) fn line_search(
+    pub(super) async fn line_search(
         &mut self,
         iteration: u32,
         current: Evaluation,
         expand: bool,
         chord: bool,
+        kernels: Kernels<'_>,
     ) -> Result<(f64, Evaluation, f64), SolveError> {
         let n = self.structure.free;
         let phi0 = dot_n(&self.work.r[..n], &self.work.d[..n]);
@@ -110,7 +112,7 @@ impl Solver {
             } else {
                 0.5 * (a + b)
             };
-            let eval = self.try_step(alpha);
+            let eval = self.try_step(alpha, kernels).await;
             let phi = dot_n(&self.work.trial_r[..n], &self.work.d[..n]);
             let energy = eval.strain - dot_n(&self.sample.loads[..n], &self.work.trial_u[..n]);
             let decrease = energy <= energy0 + C1 * alpha * phi0.min(0.0) + noise;
@@ -245,7 +247,7 @@ impl Solver {
     }
 
     /// Evaluates the trial point `u + α·d` into the trial buffers.
-    pub(super) fn try_step(&mut self, alpha: f64) -> Evaluation {
+    pub(super) async fn try_step(&mut self, alpha: f64, kernels: Kernels<'_>) -> Evaluation {
         self.evaluations += 1;
         for ((t, u), d) in self
             .work
@@ -256,15 +258,18 @@ impl Solver {
         {
             *t = u + alpha * d;
         }
-        evaluate_with(
-            &self.structure,
-            &self.sample.members,
-            self.sample.tension.iter().copied(),
-            &self.sample.loads,
-            &self.work.trial_u,
-            &mut self.work.trial_r,
-            &mut self.work.trial_states,
-        )
+        kernels
+            .evaluate(Evaluate {
+                structure: &self.structure,
+                key: self.sample_key,
+                members: &mut self.sample.members,
+                tension: &mut self.sample.tension,
+                loads: &mut self.sample.loads,
+                u: &mut self.work.trial_u,
+                r: &mut self.work.trial_r,
+                states: &mut self.work.trial_states,
+            })
+            .await
     }
 
     /// Makes the trial point current.

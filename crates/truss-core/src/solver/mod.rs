@@ -82,10 +82,13 @@ use crate::measure::{Distortion, distortion};
 use crate::structure::Structure;
 use crate::{ModelError, SolveError};
 use evaluate::{Evaluation, dot_n};
+use lanes::{Kernels, finish};
 use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 mod evaluate;
 mod floating;
+pub mod lanes;
 mod line_search;
 mod newton;
 mod step;
@@ -243,7 +246,13 @@ pub struct Solver {
     /// (NaN when the last step was not a chord step, or switched a one-sided member):
     /// the next chord step's first trial (see `line_search`).
     chord_secant: f64,
+    /// Which sample the solver holds, for the batched kernels' buffers: a number unique to
+    /// this solver in the process, and its count of samples set.
+    sample_key: (usize, u64),
 }
+
+/// The next solver's number (see `Solver::sample_key`).
+static SOLVERS: AtomicU64 = AtomicU64::new(0);
 
 /// What a sample sets: members, loads and clearances, and its scales.
 #[derive(Debug, Clone)]
@@ -369,6 +378,7 @@ impl Solver {
             last: None,
             evaluations: 0,
             chord_secant: f64::NAN,
+            sample_key: (SOLVERS.fetch_add(1, Ordering::Relaxed) as usize, 0),
             structure,
         }
     }
@@ -394,11 +404,22 @@ impl Solver {
     /// Solves one sample. On success the solver holds its equilibrium (see
     /// [`Solver::displacement`], [`Solver::distortion`], [`Solver::equilibrium`]).
     pub fn solve_perturbed(&mut self, p: Perturbation<'_>) -> Result<SolveReport, SolveError> {
+        finish(self.solve_perturbed_in(p, Kernels::OneSample))
+    }
+
+    /// [`Solver::solve_perturbed`], its kernels run by `kernels`: at once, or in a lane of
+    /// a batch (see [`lanes`]). The same operations either way, so the same bits.
+    pub async fn solve_perturbed_in(
+        &mut self,
+        p: Perturbation<'_>,
+        kernels: Kernels<'_>,
+    ) -> Result<SolveReport, SolveError> {
         self.last = None;
         self.log.clear();
         self.evaluations = 0;
+        self.sample_key.1 += 1;
         self.set_sample(p)?;
-        let report = self.newton()?;
+        let report = self.newton(kernels).await?;
         self.last = Some(report);
         Ok(report)
     }

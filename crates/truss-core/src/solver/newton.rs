@@ -1,7 +1,8 @@
 //! The iteration of the module doc: the linearised problem, then chord steps or model
 //! steps, each followed by a line search, until converged.
 
-use super::evaluate::{evaluate_with, max_abs};
+use super::evaluate::max_abs;
+use super::lanes::{Evaluate, Kernels};
 use super::step::Step;
 use super::{Evaluation, IterationRecord, Mode, SolveReport, Solver};
 use crate::SolveError;
@@ -114,21 +115,25 @@ impl Solver {
     /// Steps 1–5 of the module doc: the linearised start, then steps (chosen by
     /// [`Solver::choose_step`], taken by the line search) until the force test
     /// ([`Solver::force_converged`]) or the step test ([`Solver::step_converged`]) holds.
-    pub(super) fn newton(&mut self) -> Result<SolveReport, SolveError> {
-        let mut p = self.start();
+    pub(super) async fn newton(&mut self, kernels: Kernels<'_>) -> Result<SolveReport, SolveError> {
+        let mut p = self.start(kernels).await;
         loop {
             if let Next::Done = self.force_converged(&mut p)? {
                 break;
             }
             p.iterations += 1;
-            let choice = self.choose_step(&mut p)?;
+            let choice = self.choose_step(&mut p, kernels).await?;
             let residual_before = p.eval.residual;
-            let alpha = match self.line_search(
-                p.iterations,
-                p.eval,
-                choice.curved,
-                !choice.fresh && !choice.curved,
-            ) {
+            let alpha = match self
+                .line_search(
+                    p.iterations,
+                    p.eval,
+                    choice.curved,
+                    !choice.fresh && !choice.curved,
+                    kernels,
+                )
+                .await
+            {
                 Ok((alpha, eval, d_max)) => {
                     p.eval = eval;
                     p.step = alpha * d_max;
@@ -175,7 +180,7 @@ impl Solver {
     }
 
     /// Step 1: the linearised problem (or zero, if it fails), evaluated.
-    pub(super) fn start(&mut self) -> Progress {
+    pub(super) async fn start(&mut self, kernels: Kernels<'_>) -> Progress {
         let structure = Arc::clone(&self.structure);
         let mut factorisations = 0;
         let mut iterations = 0;
@@ -191,15 +196,18 @@ impl Solver {
                 Mode::Tangent
             }
         };
-        let eval = evaluate_with(
-            &structure,
-            &self.sample.members,
-            self.sample.tension.iter().copied(),
-            &self.sample.loads,
-            &self.work.u,
-            &mut self.work.r,
-            &mut self.work.states,
-        );
+        let eval = kernels
+            .evaluate(Evaluate {
+                structure: &structure,
+                key: self.sample_key,
+                members: &mut self.sample.members,
+                tension: &mut self.sample.tension,
+                loads: &mut self.sample.loads,
+                u: &mut self.work.u,
+                r: &mut self.work.r,
+                states: &mut self.work.states,
+            })
+            .await;
         self.update_slack();
         Progress {
             iterations,
@@ -282,9 +290,12 @@ impl Solver {
     /// slack set's Woodbury inverse while those contract, else a model step with the true
     /// tangent (reusing its factorisation while the slack set is unchanged and steps
     /// contract).
-    fn choose_step(&mut self, p: &mut Progress) -> Result<StepChoice, SolveError> {
+    async fn choose_step(
+        &mut self,
+        p: &mut Progress,
+        kernels: Kernels<'_>,
+    ) -> Result<StepChoice, SolveError> {
         let structure = Arc::clone(&self.structure);
-        let n = structure.free;
         self.step.step_slack.copy_from_slice(&self.work.slack);
         let mut choice = StepChoice {
             fresh: false,
@@ -323,9 +334,19 @@ impl Solver {
                     && self.work.slack == self.factor.factor_slack;
                 if reuse {
                     self.negate_residual_into_step();
-                    self.factor.k.solve_in_place(&mut self.work.d[..n]);
+                    kernels
+                        .solve(
+                            &structure,
+                            self.sample_key,
+                            &mut self.factor.k,
+                            &mut self.work.d,
+                        )
+                        .await;
                 } else {
-                    match self.model_step(p.iterations, &mut p.factorisations)? {
+                    match self
+                        .model_step(p.iterations, &mut p.factorisations, kernels)
+                        .await?
+                    {
                         Step::Newton { shift } => {
                             choice.shift = shift;
                             choice.fresh = true;

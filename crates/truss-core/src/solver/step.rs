@@ -25,6 +25,7 @@
 
 use super::Solver;
 use super::evaluate::{dot_n, max_abs};
+use super::lanes::Kernels;
 use crate::SolveError;
 
 /// Most slack sets tried for one model step; the last step is used if none settles.
@@ -92,10 +93,11 @@ impl Solver {
     /// curvature that the failed pivot gives is where the first slack cable engages: that
     /// cable is made taut (and kept so for this step) and `K(S)` factorised again. Only when
     /// no cable bounds the direction does the step become a search along it.
-    pub(super) fn model_step(
+    pub(super) async fn model_step(
         &mut self,
         iteration: u32,
         factorisations: &mut u32,
+        kernels: Kernels<'_>,
     ) -> Result<Step, SolveError> {
         let n = self.structure.free;
         self.factor.factor_slack.copy_from_slice(&self.work.slack);
@@ -108,7 +110,15 @@ impl Solver {
                 self.factor.k.scale_diagonal(1.0 + self.step.damping);
             }
             *factorisations += 1;
-            self.factor.k.factor_collecting(&mut self.work.failures, 1);
+            kernels
+                .factor(
+                    &self.structure,
+                    self.sample_key,
+                    &mut self.factor.k,
+                    &mut self.work.failures,
+                    1,
+                )
+                .await;
             let mut shift = self.step.damping;
             // Plain steps (the current slack set, no switching): while damped, and after a
             // switching step that did not come true.
@@ -151,7 +161,14 @@ impl Solver {
                 }
             }
             self.work.d[n] = 0.0;
-            self.factor.k.solve_in_place(&mut self.work.d[..n]);
+            kernels
+                .solve(
+                    &self.structure,
+                    self.sample_key,
+                    &mut self.factor.k,
+                    &mut self.work.d,
+                )
+                .await;
             if damped {
                 // Plain steps keep the current slack set: with no switched cables the
                 // direction −(K + μ·diag K)⁻¹·r descends, whatever the model says, and

@@ -271,7 +271,7 @@ fn linearised_start(solver: &mut Solver, errors: &[f64]) -> Vec<f64> {
             ..Perturbation::default()
         })
         .unwrap();
-    let _ = solver.start();
+    let _ = lanes::finish(solver.start(lanes::Kernels::OneSample));
     solver.work.u.clone()
 }
 
