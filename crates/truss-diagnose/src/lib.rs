@@ -7,7 +7,8 @@
 //!
 //! ```text
 //! truss diagnose --job BASELINE.json --case NAME --measured M.csv [--measured-members MM.csv]
-//!                [--measurement-sigma MM] [--samples N] [--candidates A,B] --out DIR
+//!                [--measurement-sigma MM] [--samples N] [--candidates A,B] [--threads T]
+//!                --out DIR
 //! truss synth-measured --job J --case NAME --specimens N --seed S --effect 'NAME:P=V,…[;…]'
 //!                [--measurement-sigma MM] [--all-nodes] [--members-out MM.csv] > M.csv
 //! ```
@@ -203,6 +204,14 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     {
         return Err(DiagnoseError::Usage(format!(
             "--samples {n}: must be from 100 to {MAX_SAMPLES}"
+        )));
+    }
+    if let Some(t) = s.threads
+        && !truss_threads::accepted(t)
+    {
+        return Err(DiagnoseError::Usage(format!(
+            "--threads {t}: must be from 1 to {}",
+            truss_threads::MAX_THREADS
         )));
     }
     // Before any work: no output may go through a link.

@@ -3,7 +3,7 @@
 //! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
 //! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 6)
+//! ## diagnosis.json (format `truss-diagnose`, version 7)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -76,8 +76,14 @@
 //!              model; after = before when no effect is added)
 //! method      {likelihood, fit, intervals, selection, verdicts, steps, statistics, discrepancy}
 //!             (in words)
-//! timing      {simulations, solves, seconds, final_fit_seconds}
+//! timing      {simulations, solves, seconds, final_fit_seconds, threads (of the
+//!              simulations), stages [{stage, seconds, simulations}] (each stage in order:
+//!              the baseline's simulation and comparison; per step, fitting the
+//!              candidates, deciding with the profiles, updating the model, comparing the
+//!              updated model; the final fit; the confounding tests)}
 //! ```
+//!
+//! Version 7 (from 6): `timing.threads` and `timing.stages`.
 //!
 //! Version 6 (from 5): `final_fit`, `confounding`, each parameter's `determined`,
 //! `timing.final_fit_seconds`; a confounded rival is also in its effect's step's
@@ -129,7 +135,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 6;
+pub const FORMAT_VERSION: u32 = 7;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -157,11 +163,13 @@ struct Baseline0 {
 }
 
 #[derive(Serialize)]
-struct Timing {
+struct Timing<'a> {
     simulations: usize,
     solves: usize,
     seconds: f64,
     final_fit_seconds: f64,
+    threads: usize,
+    stages: &'a [crate::selection::model::StageTime],
 }
 
 #[derive(Serialize)]
@@ -190,7 +198,7 @@ struct Report<'a> {
     discrepancy_before: f64,
     discrepancy_after: f64,
     method: Method,
-    timing: Timing,
+    timing: Timing<'a>,
 }
 
 #[derive(Serialize)]
@@ -312,6 +320,8 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
             solves: d.work.1,
             seconds: d.work.2,
             final_fit_seconds: d.final_seconds,
+            threads: d.threads,
+            stages: &d.stages,
         },
     };
     let mut s = serde_json::to_string_pretty(&report).expect("the report serialises");

@@ -780,7 +780,7 @@ fn one_bad_row_is_an_outlier_not_an_effect() {
 }
 
 /// The refusals, each naming what is wrong: `--samples` above the documented 10 000,
-/// and `synth-measured` parameters outside their range or not finite (`clearance=-0.01`
+/// `--threads 0`, and `synth-measured` parameters outside their range or not finite (`clearance=-0.01`
 /// was silently taken as 0, `gradient_x=nan` gave an internal error).
 #[test]
 fn out_of_range_settings_and_effects_are_refused() {
@@ -789,7 +789,7 @@ fn out_of_range_settings_and_effects_are_refused() {
     let e = run(&DiagnoseOptions {
         job: job(),
         case: "as-built".into(),
-        measured: m,
+        measured: m.clone(),
         measured_members: None,
         out: dir.path().join("out"),
         settings: Settings {
@@ -805,6 +805,22 @@ fn out_of_range_settings_and_effects_are_refused() {
         e.contains("--samples 100000000: must be from 100 to 10000"),
         "{e}"
     );
+    let e = run(&DiagnoseOptions {
+        job: job(),
+        case: "as-built".into(),
+        measured: m,
+        measured_members: None,
+        out: dir.path().join("out"),
+        settings: Settings {
+            threads: Some(0),
+            quiet: true,
+            ..Settings::default()
+        },
+        plots: false,
+    })
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("--threads 0: must be from 1 to 1024"), "{e}");
     let synth_err = |effect: &str| {
         let mut out = Vec::new();
         synth(
