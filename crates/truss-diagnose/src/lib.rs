@@ -82,7 +82,8 @@
 //!    parameter whose interval covers most of its plausible range is reported "not
 //!    determined by these data", with no physical reading. Each significant rival is added
 //!    to the final model and all re-fitted: one that moves an effect's parameters out of
-//!    their intervals, or widens them two-fold, is listed as confounded with it (a
+//!    their intervals, or is itself significant given the model and widens them
+//!    two-fold, is listed as confounded with it (a
 //!    temperature field's offset and vertical gradient against a longeron length bias),
 //!    with the measurement that would separate them.
 //!

@@ -41,7 +41,9 @@
 //!              moved, widening}, lr_statistic, p_value, delta_bic, separate_by}]   rivals
 //!              that, added to the final model and fitted jointly, move an effect's
 //!              parameters out of their intervals (moved) or widen their Wald intervals
-//!              two-fold or more (widening): the data cannot tell how that part of the
+//!              two-fold or more (widening; listed for a widening alone only where the
+//!              rival is significant given the model, p < α/2): the data cannot tell how
+//!              that part of the
 //!              signal divides between the two; the rival is also listed in the
 //!              `indistinguishable` of the step that named the effect
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
@@ -83,7 +85,9 @@
 //!              updated model; the final fit; the confounding tests)}
 //! ```
 //!
-//! Version 7 (from 6): `timing.threads` and `timing.stages`.
+//! Version 7 (from 6): `timing.threads` and `timing.stages`; a rival whose only confounded
+//! parameters widen (none moved) is listed under `confounding` only where it is
+//! significant given the model.
 //!
 //! Version 6 (from 5): `final_fit`, `confounding`, each parameter's `determined`,
 //! `timing.final_fit_seconds`; a confounded rival is also in its effect's step's
