@@ -39,7 +39,7 @@
 //! parameters, R's test and the measurement that separates them
 //! ([`crate::candidates::separating_measurement`]), when R moves one of its parameters out
 //! of its interval, or when R is significant given the model (p < α/2, the level at which
-//! backward elimination keeps an effect) and widens one ([`listed`]). A widening alone, by
+//! backward elimination keeps an effect) and widens one. A widening alone, by
 //! a rival the data do not call for, is not listed: a rival with free parameters of its own
 //! widens every interval it shares a direction with, however little of the signal it
 //! explains (a temperature field of four parameters, far from significant, widened a
