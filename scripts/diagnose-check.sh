@@ -196,7 +196,15 @@ for t in truth:
     k, v = t.split("=")
     v = float(v)
     if k not in params:
-        print(f"    {k:<16} truth {v:<8g} not fitted")
+        # Not in the final model: its fit as a rival, at the last kept step that tried it
+        # (added alone to that step's model), if any.
+        rival = [(s["number"], c, q) for s in kept for c in s["candidates"]
+                 for q in c.get("parameters", []) if q["name"] == k]
+        if rival:
+            n, c, q = rival[-1]
+            i = q["interval"]
+            print(f"    {k:<16} truth {v:<8g} not in the final model; {c['name']} as a rival at step {n}: "
+                  f"fit {q['value']:<11.5g} 95 % {i['method']} [{f(i['lower'])}, {f(i['upper'])}]")
         continue
     p = params[k]
     i = p["interval"]

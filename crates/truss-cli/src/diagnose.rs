@@ -34,6 +34,9 @@ pub struct DiagnoseArgs {
     /// Only these candidate effects, comma separated (default: every one that applies).
     #[arg(long, value_delimiter = ',')]
     pub candidates: Option<Vec<String>>,
+    /// Worker threads (default: all cores; results do not depend on it).
+    #[arg(long)]
+    pub threads: Option<usize>,
     /// No SVG plots.
     #[arg(long)]
     pub no_plots: bool,
@@ -86,6 +89,7 @@ pub fn run_diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<(), CliE
             measurement_sigma: args.measurement_sigma,
             quiet: args.quiet,
             candidates: args.candidates.clone(),
+            threads: args.threads,
             ..Default::default()
         },
         plots: !args.no_plots,

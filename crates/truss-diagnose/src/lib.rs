@@ -7,7 +7,8 @@
 //!
 //! ```text
 //! truss diagnose --job BASELINE.json --case NAME --measured M.csv [--measured-members MM.csv]
-//!                [--measurement-sigma MM] [--samples N] [--candidates A,B] --out DIR
+//!                [--measurement-sigma MM] [--samples N] [--candidates A,B] [--threads T]
+//!                --out DIR
 //! truss synth-measured --job J --case NAME --specimens N --seed S --effect 'NAME:P=V,…[;…]'
 //!                [--measurement-sigma MM] [--all-nodes] [--members-out MM.csv] > M.csv
 //! ```
@@ -81,7 +82,8 @@
 //!    parameter whose interval covers most of its plausible range is reported "not
 //!    determined by these data", with no physical reading. Each significant rival is added
 //!    to the final model and all re-fitted: one that moves an effect's parameters out of
-//!    their intervals, or widens them two-fold, is listed as confounded with it (a
+//!    their intervals, or is itself significant given the model and widens them
+//!    two-fold, is listed as confounded with it (a
 //!    temperature field's offset and vertical gradient against a longeron length bias),
 //!    with the measurement that would separate them.
 //!
@@ -203,6 +205,14 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     {
         return Err(DiagnoseError::Usage(format!(
             "--samples {n}: must be from 100 to {MAX_SAMPLES}"
+        )));
+    }
+    if let Some(t) = s.threads
+        && !truss_threads::accepted(t)
+    {
+        return Err(DiagnoseError::Usage(format!(
+            "--threads {t}: must be from 1 to {}",
+            truss_threads::MAX_THREADS
         )));
     }
     // Before any work: no output may go through a link.

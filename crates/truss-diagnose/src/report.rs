@@ -3,7 +3,7 @@
 //! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
 //! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 6)
+//! ## diagnosis.json (format `truss-diagnose`, version 7)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -41,7 +41,9 @@
 //!              moved, widening}, lr_statistic, p_value, delta_bic, separate_by}]   rivals
 //!              that, added to the final model and fitted jointly, move an effect's
 //!              parameters out of their intervals (moved) or widen their Wald intervals
-//!              two-fold or more (widening): the data cannot tell how that part of the
+//!              two-fold or more (widening; listed for a widening alone only where the
+//!              rival is significant given the model, p < α/2): the data cannot tell how
+//!              that part of the
 //!              signal divides between the two; the rival is also listed in the
 //!              `indistinguishable` of the step that named the effect
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
@@ -76,8 +78,16 @@
 //!              model; after = before when no effect is added)
 //! method      {likelihood, fit, intervals, selection, verdicts, steps, statistics, discrepancy}
 //!             (in words)
-//! timing      {simulations, solves, seconds, final_fit_seconds}
+//! timing      {simulations, solves, seconds, final_fit_seconds, threads (of the
+//!              simulations), stages [{stage, seconds, simulations}] (each stage in order:
+//!              the baseline's simulation and comparison; per step, fitting the
+//!              candidates, deciding with the profiles, updating the model, comparing the
+//!              updated model; the final fit; the confounding tests)}
 //! ```
+//!
+//! Version 7 (from 6): `timing.threads` and `timing.stages`; a rival whose only confounded
+//! parameters widen (none moved) is listed under `confounding` only where it is
+//! significant given the model.
 //!
 //! Version 6 (from 5): `final_fit`, `confounding`, each parameter's `determined`,
 //! `timing.final_fit_seconds`; a confounded rival is also in its effect's step's
@@ -129,7 +139,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 6;
+pub const FORMAT_VERSION: u32 = 7;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -157,11 +167,13 @@ struct Baseline0 {
 }
 
 #[derive(Serialize)]
-struct Timing {
+struct Timing<'a> {
     simulations: usize,
     solves: usize,
     seconds: f64,
     final_fit_seconds: f64,
+    threads: usize,
+    stages: &'a [crate::selection::model::StageTime],
 }
 
 #[derive(Serialize)]
@@ -190,7 +202,7 @@ struct Report<'a> {
     discrepancy_before: f64,
     discrepancy_after: f64,
     method: Method,
-    timing: Timing,
+    timing: Timing<'a>,
 }
 
 #[derive(Serialize)]
@@ -312,6 +324,8 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
             solves: d.work.1,
             seconds: d.work.2,
             final_fit_seconds: d.final_seconds,
+            threads: d.threads,
+            stages: &d.stages,
         },
     };
     let mut s = serde_json::to_string_pretty(&report).expect("the report serialises");

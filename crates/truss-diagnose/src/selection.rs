@@ -79,6 +79,10 @@ pub struct Diagnosis {
     pub confounding: Vec<confound::Confounding>,
     /// Wall time of the final fit and the confounding tests \[s\].
     pub final_seconds: f64,
+    /// Each stage's wall time and simulations, in order.
+    pub stages: Vec<model::StageTime>,
+    /// Worker threads of the simulations.
+    pub threads: usize,
     /// Simulated samples per evaluation N.
     pub samples: usize,
     /// The simulations behind `before` and `after` (for plots).
@@ -180,6 +184,7 @@ pub fn diagnose(
         progress,
         simulations: std::cell::Cell::new(0),
         memo: Default::default(),
+        stages: Default::default(),
     };
     progress.note(&format!(
         "{n} specimens, {} coordinates; simulating the baseline case {:?} ({samples} samples)",
@@ -195,8 +200,12 @@ pub fn diagnose(
     let mut steps: Vec<Step> = Vec::new();
     let mut edit = Some(baseline.derived_case());
     while let Some(e) = edit.take() {
+        let stage = match steps.len() {
+            0 => "baseline: simulate and compare".to_string(),
+            k => format!("step {k}: compare the updated model"),
+        };
         let previous = steps.last_mut().zip(models.last());
-        let Some(current) = step::compare(&ctx, e, previous)? else {
+        let Some(current) = ctx.timed(stage, None, || step::compare(&ctx, e, previous))? else {
             break;
         };
         models.push(current);
@@ -242,8 +251,12 @@ pub fn diagnose(
     let clock = std::time::Instant::now();
     let (final_fit, confounding) = match last {
         Some(i) => {
-            let fit = confound::final_fit(&ctx, &steps[..=i], &steps[i], &library);
-            let found = confound::confounding(&ctx, &steps[..=i], &fit, &library);
+            let fit = ctx.timed("final fit", None, || {
+                confound::final_fit(&ctx, &steps[..=i], &steps[i], &library)
+            });
+            let found = ctx.timed("confounding", None, || {
+                confound::confounding(&ctx, &steps[..=i], &fit, &library)
+            });
             (fit.effects, found)
         }
         None => (Vec::new(), Vec::new()),
@@ -259,6 +272,18 @@ pub fn diagnose(
     }
     let final_seconds = clock.elapsed().as_secs_f64();
     let sims = ctx.simulations.get();
+    let stages = ctx.stages.take();
+    progress.note(&format!(
+        "times: {}",
+        stages
+            .iter()
+            .map(|t| format!(
+                "{} {:.1} s ({} simulations)",
+                t.stage, t.seconds, t.simulations
+            ))
+            .collect::<Vec<_>>()
+            .join("; ")
+    ));
     let mut models = models.into_iter();
     let base = models.next().expect("the baseline is there");
     let last = models.nth(kept.max(1) - 1).filter(|_| kept > 0);
@@ -271,6 +296,8 @@ pub fn diagnose(
         final_fit,
         confounding,
         final_seconds,
+        stages,
+        threads: settings.thread_count(),
         baseline_log_likelihood: base.log_likelihood,
         before: base.comparison,
         updated: last.as_ref().map_or(base.edit, |m| m.edit.clone()),
@@ -393,44 +420,7 @@ fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::comparison::statistics::Tolerance;
     use crate::likelihood::score::CandidateScore;
-
-    fn score(name: &str, k: usize, delta_bic: f64, significant: bool) -> CandidateScore {
-        CandidateScore {
-            name: name.into(),
-            mechanism: String::new(),
-            k,
-            parameters: Vec::new(),
-            log_likelihood: 0.0,
-            lr_statistic: 0.0,
-            adjustment: 1.0,
-            p_value: if significant { 1e-6 } else { 0.5 },
-            significant,
-            delta_bic,
-            evaluations: 0,
-            profile_evaluations: 0,
-            seconds: 0.0,
-            vuong_z: None,
-            error: None,
-        }
-    }
-
-    fn comparison() -> Comparison {
-        Comparison {
-            specimens: 200,
-            samples: 4000,
-            statistics: Vec::new(),
-            energy: 0.0,
-            energy_p: 1.0,
-            energy_noise: 0.0,
-            tolerance: Tolerance {
-                within: true,
-                outside: Vec::new(),
-                bands: String::new(),
-            },
-        }
-    }
 
     /// The final model's effects from the steps: each kept step's named effect in turn, a
     /// removed one taken out, a swapped one's replacement in its place, and nothing of a
@@ -455,10 +445,10 @@ mod tests {
             named: Some(0),
             kept,
             indistinguishable: Vec::new(),
-            candidates: vec![score(named, 1, -10.0, true)],
+            candidates: vec![CandidateScore::of_test(named, 1, -10.0, true)],
             log_likelihood_before: 0.0,
             adjusted_p: Some(0.0),
-            before: comparison(),
+            before: Comparison::of_energy(0.0, 1.0, 0.0),
             after: None,
             refitted: Vec::new(),
             removed,

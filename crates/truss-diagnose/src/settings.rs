@@ -27,6 +27,9 @@ pub struct Settings {
     /// draws from the case's distributions (the older, distribution-only use, kept for
     /// comparison).
     pub condition_on_members: bool,
+    /// Worker threads of the simulations and bootstraps (`--threads`); `None`: every core
+    /// this process may use ([`truss_threads::available`]). The results do not depend on it.
+    pub threads: Option<usize>,
 }
 
 impl Settings {
@@ -45,6 +48,7 @@ impl Default for Settings {
             quiet: false,
             candidates: None,
             condition_on_members: true,
+            threads: None,
         }
     }
 }
@@ -53,6 +57,11 @@ impl Settings {
     /// N for `n` specimens.
     pub fn samples_for(&self, n: usize) -> usize {
         self.samples.unwrap_or_else(|| (20 * n).clamp(2000, 10_000))
+    }
+
+    /// The worker threads to use: [`Settings::threads`], or every core.
+    pub fn thread_count(&self) -> usize {
+        truss_threads::or_available(self.threads)
     }
 }
 

@@ -83,7 +83,13 @@ pub fn synth(options: &SynthOptions, out: &mut dyn Write) -> Result<usize, Diagn
         sigma: options.measurement_sigma,
         seed: options.seed ^ 0x7379_6e74_6865_7469,
     };
-    let sim = simulate(&job, &coords, options.specimens, Some((noise, top_ix)))?;
+    let sim = simulate(
+        &job,
+        &coords,
+        options.specimens,
+        Some((noise, top_ix)),
+        truss_threads::available(),
+    )?;
     let io = |e: std::io::Error| DiagnoseError::io(std::path::Path::new("<stdout>"), e);
     writeln!(out, "specimen,node,x,y,z").map_err(io)?;
     let d = coords.len();

@@ -780,31 +780,41 @@ fn one_bad_row_is_an_outlier_not_an_effect() {
 }
 
 /// The refusals, each naming what is wrong: `--samples` above the documented 10 000,
-/// and `synth-measured` parameters outside their range or not finite (`clearance=-0.01`
+/// `--threads 0`, and `synth-measured` parameters outside their range or not finite (`clearance=-0.01`
 /// was silently taken as 0, `gradient_x=nan` gave an internal error).
 #[test]
 fn out_of_range_settings_and_effects_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let m = make(dir.path(), "few", "none", 6, 1);
-    let e = run(&DiagnoseOptions {
-        job: job(),
-        case: "as-built".into(),
-        measured: m,
-        measured_members: None,
-        out: dir.path().join("out"),
-        settings: Settings {
-            samples: Some(100_000_000),
-            quiet: true,
-            ..Settings::default()
-        },
-        plots: false,
-    })
-    .unwrap_err()
-    .to_string();
+    let refused = |settings: Settings| {
+        run(&DiagnoseOptions {
+            job: job(),
+            case: "as-built".into(),
+            measured: m.clone(),
+            measured_members: None,
+            out: dir.path().join("out"),
+            settings: Settings {
+                quiet: true,
+                ..settings
+            },
+            plots: false,
+        })
+        .unwrap_err()
+        .to_string()
+    };
+    let e = refused(Settings {
+        samples: Some(100_000_000),
+        ..Settings::default()
+    });
     assert!(
         e.contains("--samples 100000000: must be from 100 to 10000"),
         "{e}"
     );
+    let e = refused(Settings {
+        threads: Some(0),
+        ..Settings::default()
+    });
+    assert!(e.contains("--threads 0: must be from 1 to 1024"), "{e}");
     let synth_err = |effect: &str| {
         let mut out = Vec::new();
         synth(

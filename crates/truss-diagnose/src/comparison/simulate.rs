@@ -81,14 +81,15 @@ struct Row {
     failure: Option<String>,
 }
 
-/// Simulates samples `0..samples` of the job's only case at `coords`; with `noise`, also the
-/// noisy coordinates and the top surface's angles (`top` gives each top node's x, y, z index
-/// in `coords`).
+/// Simulates samples `0..samples` of the job's only case at `coords` on `threads` threads
+/// (the result does not depend on them); with `noise`, also the noisy coordinates and the
+/// top surface's angles (`top` gives each top node's x, y, z index in `coords`).
 pub fn simulate(
     job: &Job,
     coords: &[Coordinate],
     samples: usize,
     noise: Option<(Noise, [[usize; 3]; 3])>,
+    threads: usize,
 ) -> Result<Simulation, DiagnoseError> {
     let d = coords.len();
     // The coordinates name nodes of the baseline's model; a derived case's model may number
@@ -107,7 +108,7 @@ pub fn simulate(
                 }),
         })
         .collect::<Result<_, _>>()?;
-    let engine = Engine::new(job, truss_threads::available());
+    let engine = Engine::new(job, threads);
     let rows = engine.map(0..samples as u64, |solver, result| {
         if let Outcome::Failed(reason) = result.outcome {
             return Row {

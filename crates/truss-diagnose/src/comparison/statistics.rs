@@ -365,7 +365,7 @@ fn cov_statistic(
     }
 }
 
-fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
+fn percentile_statistics(y: &[f64], x: &[f64], threads: usize) -> Vec<Statistic> {
     let sorted = |v: &[f64], offset: u64| {
         SortedSample::new(
             v.iter()
@@ -383,7 +383,7 @@ fn percentile_statistics(y: &[f64], x: &[f64]) -> Vec<Statistic> {
     let config = |seed| BootstrapConfig {
         replicates: 1000,
         seed,
-        threads: truss_threads::available(),
+        threads,
     };
     let by = bootstrap_quantiles(&sy, &percentiles, &config(1));
     let bx = bootstrap_quantiles(&sx, &percentiles, &config(2));
@@ -561,12 +561,14 @@ fn holm(stats: &mut [Statistic]) {
     }
 }
 
-/// Compares the measured data with a simulation that carries the instrument's noise.
+/// Compares the measured data with a simulation that carries the instrument's noise; the
+/// bootstraps run on `threads` threads (the result does not depend on them).
 pub fn compare(
     measured: &Measured,
     sim: &Simulation,
     top: [[usize; 3]; 3],
     sigma_m: f64,
+    threads: usize,
 ) -> Comparison {
     let d = measured.d();
     let mut stats = Vec::new();
@@ -648,7 +650,11 @@ pub fn compare(
     let (ca, ya, xa) = &columns[t - 2];
     let (cb, yb, xb) = &columns[t - 1];
     stats.push(cov_statistic(ca, cb, ya, yb, xa, xb));
-    stats.extend(percentile_statistics(&measured.theta_p, &sim.theta_p));
+    stats.extend(percentile_statistics(
+        &measured.theta_p,
+        &sim.theta_p,
+        threads,
+    ));
     stats.push(ks_statistic(&measured.theta_p, &sim.theta_p));
     let floor = (sigma_m * sigma_m + crate::likelihood::gaussian::RESOLUTION.powi(2)).sqrt();
     let scale: Vec<f64> = (0..d)
@@ -728,6 +734,27 @@ pub fn compare(
                 "every coordinate's mean within ±{TOL_MEAN} predicted SD, its SD and θ_P's median and 95th percentile within a factor {TOL_RATIO} of the prediction (95 % intervals)"
             ),
         },
+    }
+}
+
+/// A comparison with no statistics, agreeing within tolerance, of the given energy distance,
+/// permutation p and noise (200 specimens, N = 4000): the selection's tests of its rules.
+#[cfg(test)]
+impl Comparison {
+    pub(crate) fn of_energy(energy: f64, energy_p: f64, energy_noise: f64) -> Self {
+        Self {
+            specimens: 200,
+            samples: 4000,
+            statistics: Vec::new(),
+            energy,
+            energy_p,
+            energy_noise,
+            tolerance: Tolerance {
+                within: true,
+                outside: Vec::new(),
+                bands: String::new(),
+            },
+        }
     }
 }
 

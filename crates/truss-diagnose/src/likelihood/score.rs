@@ -187,6 +187,8 @@ pub(crate) struct Evaluator<'a> {
     pub sigma_m: f64,
     /// Condition the node terms on the specimens' measured members.
     pub condition: bool,
+    /// Worker threads of each simulation.
+    pub threads: usize,
     /// Simulations run (cases found in `memo` not counted).
     pub simulations: std::cell::Cell<usize>,
     /// The terms of cases already simulated, if shared.
@@ -204,7 +206,13 @@ impl Evaluator<'_> {
         if let Some(terms) = self.memo.and_then(|m| m.get(&job.id)) {
             return Ok(terms);
         }
-        let sim = simulate(&job, &self.measured.coords, self.samples, None)?;
+        let sim = simulate(
+            &job,
+            &self.measured.coords,
+            self.samples,
+            None,
+            self.threads,
+        )?;
         self.simulations.set(self.simulations.get() + 1);
         let terms = self.score(&job, &sim)?;
         if let Some(m) = self.memo {
@@ -548,6 +556,31 @@ pub(crate) fn profile_candidate(
     fitted.score.profile_evaluations = spent;
     fitted.score.seconds = seconds + clock.elapsed().as_secs_f64();
     fitted.fit = Some(fit);
+}
+
+/// A score of `k` parameters with ΔBIC `delta_bic`, significant (p = 1e-6) or not (p = 0.5),
+/// nothing else filled in: the selection's tests of its rules.
+#[cfg(test)]
+impl CandidateScore {
+    pub(crate) fn of_test(name: &str, k: usize, delta_bic: f64, significant: bool) -> Self {
+        Self {
+            name: name.into(),
+            mechanism: String::new(),
+            k,
+            parameters: Vec::new(),
+            log_likelihood: 0.0,
+            lr_statistic: 0.0,
+            adjustment: 1.0,
+            p_value: if significant { 1e-6 } else { 0.5 },
+            significant,
+            delta_bic,
+            evaluations: 0,
+            profile_evaluations: 0,
+            seconds: 0.0,
+            vuong_z: None,
+            error: None,
+        }
+    }
 }
 
 #[cfg(test)]

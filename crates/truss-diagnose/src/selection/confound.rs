@@ -35,12 +35,18 @@
 //!   cannot say how the signal divides between the two; judged only where both Wald
 //!   intervals were found).
 //!
-//! An effect with a confounded parameter lists R as indistinguishable from it for that
-//! part, with the parameters, R's test and the measurement that separates them
-//! ([`crate::candidates::separating_measurement`]). A rival with no confounded parameter
-//! is not listed, whatever its test: either it explains nothing the model does not
-//! (a rival the model already excludes), or what it adds is separate from the model's
-//! effects, and the selection's own steps judge it.
+//! An effect lists R as indistinguishable from it for that part, with the confounded
+//! parameters, R's test and the measurement that separates them
+//! ([`crate::candidates::separating_measurement`]), when R moves one of its parameters out
+//! of its interval, or when R is significant given the model (p < α/2, the level at which
+//! backward elimination keeps an effect) and widens one. A widening alone, by
+//! a rival the data do not call for, is not listed: a rival with free parameters of its own
+//! widens every interval it shares a direction with, however little of the signal it
+//! explains (a temperature field of four parameters, far from significant, widened a
+//! backlash model's diagonal scatter and pretension four-fold on data with no temperature
+//! change). A rival with no confounded parameter is not listed, whatever its test: either
+//! it explains nothing the model does not (a rival the model already excludes), or what it
+//! adds is separate from the model's effects, and the selection's own steps judge it.
 
 use crate::candidates::candidate::{Candidate, separating_measurement};
 use crate::candidates::parameter::Parameter;
@@ -374,6 +380,7 @@ fn with_rival<'a>(
             .collect::<Vec<_>>()
             .join(", ")
     ));
+    let significant = p < ctx.settings.candidate_level();
     let mut out = Vec::new();
     for (e, (now, with)) in fit.effects.iter().zip(&joint.parameters).enumerate() {
         let c = members[e].0;
@@ -384,7 +391,7 @@ fn with_rival<'a>(
             .zip(c.parameters())
             .filter_map(|((a, b), q)| confounded(q, a, b))
             .collect();
-        if parameters.is_empty() {
+        if !listed(&parameters, significant) {
             continue;
         }
         out.push(Confounding {
@@ -413,6 +420,13 @@ fn contribution(ctx: &Context, joint: &JointFit, l_model: f64, k: usize) -> (f64
     let lr = (2.0 * (joint.log_likelihood - l_model) / (ctx.inflation() * lambda)).max(0.0);
     let p = 1.0 - ChiSquared::new(k as f64).expect("k ≥ 1").cdf(lr);
     (lr, p, lambda * (k as f64 * n.ln() - lr))
+}
+
+/// Whether a rival whose parameters `confounded` with an effect's are these is listed as
+/// confounded with it (module doc): one of them moved out of its interval, or the rival
+/// `significant` given the model and one of them widened.
+fn listed(confounded: &[ConfoundedParameter], significant: bool) -> bool {
+    confounded.iter().any(|p| p.moved) || (significant && !confounded.is_empty())
 }
 
 /// Whether parameter `q`, fitted as `now` in the final model and as `with` with a rival
@@ -470,9 +484,11 @@ mod tests {
 
     /// A parameter is confounded with a rival when the rival moves it out of its interval
     /// (−0.28 K in [−0.4, −0.16] moved to 0.01 K), or widens its Wald interval by 2 or more
-    /// (0.24 K wide to 0.5 K: 2.08); a move within the interval that widens it by 1.5 is not.
+    /// (0.24 K wide to 0.5 K: 2.08); a move within the interval that widens it by 1.5 is
+    /// not. The rival is listed for a move whatever its own test, for a widening only when
+    /// it is significant given the model, and never without a confounded parameter.
     #[test]
-    fn moved_or_widened_is_confounded() {
+    fn moved_or_widened_is_confounded_and_a_widening_lists_only_a_significant_rival() {
         let q = Parameter::linear("offset", "K", -20.0, 20.0, 0.0);
         let now = fitted(-0.28, (-0.4, -0.16), (-0.4, -0.16));
         let moved = confounded(&q, &now, &fitted(0.01, (-0.1, 0.12), (-0.1, 0.12))).unwrap();
@@ -483,5 +499,10 @@ mod tests {
             "{wide:?}"
         );
         assert!(confounded(&q, &now, &fitted(-0.25, (-0.43, -0.07), (-0.43, -0.07))).is_none());
+        assert!(listed(std::slice::from_ref(&moved), false));
+        assert!(listed(&[wide.clone(), moved], false));
+        assert!(listed(std::slice::from_ref(&wide), true));
+        assert!(!listed(&[wide], false));
+        assert!(!listed(&[], true));
     }
 }

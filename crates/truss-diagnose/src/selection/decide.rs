@@ -140,8 +140,13 @@ pub fn decide(
             );
         }
         if !by_vuong.is_empty() {
+            let (verb, they) = if by_vuong.len() == 1 {
+                ("improves", "it does")
+            } else {
+                ("improve", "they do")
+            };
             reason += &format!(
-                "; {} also improve significantly and it does not fit significantly closer than they do ({})",
+                "; {} also {verb} significantly and it does not fit significantly closer than {they} ({})",
                 names(&mut by_vuong.iter().map(|&(j, _)| j)),
                 by_vuong
                     .iter()
@@ -207,42 +212,13 @@ pub fn decide(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::comparison::statistics::Tolerance;
 
     fn score(name: &str, k: usize, delta_bic: f64, significant: bool) -> CandidateScore {
-        CandidateScore {
-            name: name.into(),
-            mechanism: String::new(),
-            k,
-            parameters: Vec::new(),
-            log_likelihood: 0.0,
-            lr_statistic: 0.0,
-            adjustment: 1.0,
-            p_value: if significant { 1e-6 } else { 0.5 },
-            significant,
-            delta_bic,
-            evaluations: 0,
-            profile_evaluations: 0,
-            seconds: 0.0,
-            vuong_z: None,
-            error: None,
-        }
+        CandidateScore::of_test(name, k, delta_bic, significant)
     }
 
     fn comparison() -> Comparison {
-        Comparison {
-            specimens: 200,
-            samples: 4000,
-            statistics: Vec::new(),
-            energy: 0.0,
-            energy_p: 1.0,
-            energy_noise: 0.0,
-            tolerance: Tolerance {
-                within: true,
-                outside: Vec::new(),
-                bands: String::new(),
-            },
-        }
+        Comparison::of_energy(0.0, 1.0, 0.0)
     }
 
     /// The best by BIC is named; a significant candidate 3 BIC worse that it does not fit
@@ -269,7 +245,9 @@ mod tests {
         assert_eq!(d.indistinguishable, vec![3, 1]);
         assert_eq!(*asked.borrow(), vec![(0, 1), (0, 2)]);
         assert!(
-            d.reason.contains("Vuong z = 1.00 against b"),
+            d.reason.contains("b also improves significantly")
+                && d.reason
+                    .contains("closer than it does (Vuong z = 1.00 against b)"),
             "{}",
             d.reason
         );

@@ -10,7 +10,8 @@ use crate::comparison::statistics::{Comparison, compare};
 use crate::errors::DiagnoseError;
 use crate::likelihood::score::{Evaluator, FittedParameter, Memo};
 use crate::settings::{Progress, Settings};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
+use std::time::Instant;
 
 /// What every step shares: the data, the settings, the simulation size and the noise.
 pub(crate) struct Context<'a> {
@@ -25,6 +26,20 @@ pub(crate) struct Context<'a> {
     pub simulations: Cell<usize>,
     /// ℓ's terms of the cases simulated so far.
     pub memo: Memo,
+    /// Each stage's wall time and simulations, in order.
+    pub stages: RefCell<Vec<StageTime>>,
+}
+
+/// The wall time and the simulations of one stage of the diagnosis (`timing.stages` of
+/// `diagnosis.json`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StageTime {
+    /// The stage: `step 2: fit the candidates`, `final fit`, ….
+    pub stage: String,
+    /// Wall time \[s\].
+    pub seconds: f64,
+    /// Simulations of N samples run in it (cases met again are not simulated again).
+    pub simulations: usize,
 }
 
 impl Context<'_> {
@@ -37,6 +52,7 @@ impl Context<'_> {
             samples: self.samples,
             sigma_m: self.settings.measurement_sigma,
             condition: self.settings.condition_on_members,
+            threads: self.settings.thread_count(),
             simulations: Cell::new(0),
             memo: Some(&self.memo),
         }
@@ -46,6 +62,26 @@ impl Context<'_> {
     pub(crate) fn count(&self, ev: &Evaluator) {
         self.simulations
             .set(self.simulations.get() + ev.simulations.get());
+    }
+
+    /// Runs `work` as the stage `stage`, recording its wall time and the simulations it
+    /// ran (those counted into the context, and those of `ev` if given, which is counted
+    /// into the context later).
+    pub(crate) fn timed<T>(
+        &self,
+        stage: impl Into<String>,
+        ev: Option<&Evaluator>,
+        work: impl FnOnce() -> T,
+    ) -> T {
+        let count = || self.simulations.get() + ev.map_or(0, |e| e.simulations.get());
+        let (clock, before) = (Instant::now(), count());
+        let out = work();
+        self.stages.borrow_mut().push(StageTime {
+            stage: stage.into(),
+            seconds: clock.elapsed().as_secs_f64(),
+            simulations: count() - before,
+        });
+        out
     }
 
     /// c = 1 + n/N, the simulation's own noise in the tests.
@@ -75,6 +111,7 @@ pub(crate) fn compare_model(ctx: &Context, edit: CaseEdit) -> Result<ComparedMod
         &ctx.measured.coords,
         ctx.samples,
         Some((ctx.noise, ctx.top)),
+        ctx.settings.thread_count(),
     )?;
     ctx.simulations.set(ctx.simulations.get() + 1);
     let terms = ev.score(&job, &simulation)?;
@@ -85,6 +122,7 @@ pub(crate) fn compare_model(ctx: &Context, edit: CaseEdit) -> Result<ComparedMod
         &simulation,
         ctx.top,
         ctx.settings.measurement_sigma,
+        ctx.settings.thread_count(),
     );
     Ok(ComparedModel {
         edit,

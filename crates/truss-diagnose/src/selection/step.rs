@@ -216,15 +216,25 @@ pub(crate) fn run(
         candidates.len()
     ));
     // 2. Fit each candidate.
-    let mut fitted = fit_each(ctx, &ev, candidates, &test);
+    let mut fitted = ctx.timed(
+        format!("step {number}: fit the candidates"),
+        Some(&ev),
+        || fit_each(ctx, &ev, candidates, &test),
+    );
     // 3. Decide.
-    let (decision, scores) = decide_and_profile(
-        ctx,
-        &ev,
-        candidates,
-        &mut fitted,
-        &test,
-        &current.comparison,
+    let (decision, scores) = ctx.timed(
+        format!("step {number}: decide and profile"),
+        Some(&ev),
+        || {
+            decide_and_profile(
+                ctx,
+                &ev,
+                candidates,
+                &mut fitted,
+                &test,
+                &current.comparison,
+            )
+        },
     );
     ctx.count(&ev);
     let Decision {
@@ -242,7 +252,11 @@ pub(crate) fn run(
         .collect();
     // 4. Update.
     let up = named
-        .map(|i| update(ctx, number, pool, i, &scores))
+        .map(|i| {
+            ctx.timed(format!("step {number}: update the model"), None, || {
+                update(ctx, number, pool, i, &scores)
+            })
+        })
         .transpose()?;
     let mut step = Step {
         number,
@@ -433,22 +447,9 @@ fn fitted_terms(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::comparison::statistics::Tolerance;
 
     fn comparison(energy: f64, energy_p: f64, energy_noise: f64) -> Comparison {
-        Comparison {
-            specimens: 200,
-            samples: 4000,
-            statistics: Vec::new(),
-            energy,
-            energy_p,
-            energy_noise,
-            tolerance: Tolerance {
-                within: true,
-                outside: Vec::new(),
-                bands: String::new(),
-            },
-        }
+        Comparison::of_energy(energy, energy_p, energy_noise)
     }
 
     /// The discrepancy may move within its noise: −0.0119 → −0.0094 with noise 0.011 each

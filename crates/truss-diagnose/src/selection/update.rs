@@ -35,7 +35,11 @@
 //! from the current values and r's fit of that step. The best swap is made when the new
 //! model's BIC, −2ℓ̂/c + tr(A⁻¹B)·ln n (tr(A⁻¹B) ≥ k the joint fit's effective number of
 //! parameters), is lower by at least 2: r explains jointly what e explained, better. A
-//! swap keeps the number of effects. At most one swap per step.
+//! swap keeps the number of effects. At most one swap per step; after a swap the
+//! elimination runs again on the swapped model, since the effect swapped in may leave
+//! another earlier effect unneeded (a temperature field that stood in for part of a
+//! horizontal self-weight while a length bias stood in for a pretension: once the
+//! pretension is swapped in, the field explains nothing the others do not).
 
 use crate::candidates::candidate::{Candidate, separating_measurement};
 use crate::candidates::parameter::Parameter;
@@ -238,6 +242,69 @@ fn refit_and_eliminate<'a>(
         }
     }
     let mut removed = Vec::new();
+    joint = joint.map(|full| eliminate(ctx, &mut members, full, &mut removed));
+    if let Some(full) = joint.take() {
+        let (fit, swap) = best_swap(ctx, &members, added, pool, full);
+        if let Some((e, r, lr, delta_bic)) = swap {
+            let gone = members[e].0;
+            note(&format!(
+                "  {} replaced by {}: jointly the model fits better with it (ΔBIC {delta_bic:.1})",
+                gone.name(),
+                r.name()
+            ));
+            removed.push(Removal {
+                name: gone.name().into(),
+                replaced_by: Some(r.name().into()),
+                added_in_step: members[e].2,
+                lr_statistic: lr,
+                p_value: None,
+                delta_bic,
+                explained_by: Some(r.name().into()),
+                separate_by: separating_measurement(gone, r).into(),
+            });
+            members[e] = (r, Vec::new(), number);
+            // The swapped model may leave another earlier effect unneeded (a stand-in for
+            // the swapped-in effect's part): eliminate again from its fit.
+            joint = Some(eliminate(ctx, &mut members, fit, &mut removed));
+        } else {
+            joint = Some(fit);
+        }
+    }
+    if let Some(j) = &joint {
+        for (m, v) in members.iter_mut().zip(&j.values) {
+            m.1.clone_from(v);
+        }
+    }
+    let refitted = match &joint {
+        Some(j) => members
+            .iter()
+            .zip(&j.parameters)
+            .map(|(m, p)| RefitEffect {
+                name: m.0.name().into(),
+                parameters: p.clone(),
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    Ok((members, refitted, removed, joint))
+}
+
+/// Backward elimination (module doc) from the joint fit `full` of `members` (the last one
+/// just added, never tested): the least needed earlier effect removed while it is not
+/// needed, each removal added to `removed`; returns the joint fit of the members left.
+fn eliminate<'a>(
+    ctx: &Context,
+    members: &mut Vec<Member<'a>>,
+    full: JointFit,
+    removed: &mut Vec<Removal>,
+) -> JointFit {
+    let note = |m: &str| ctx.progress.note(m);
+    let fit_of = |members: &[Member], steps: Option<&[f64]>| {
+        let effects: Vec<(&dyn Candidate, &[f64])> =
+            members.iter().map(|m| (m.0, m.1.as_slice())).collect();
+        fit_jointly(ctx, &effects, steps)
+    };
+    let mut joint = Some(full);
     while let Some(full) = joint.take() {
         for (m, v) in members.iter_mut().zip(&full.values) {
             m.1.clone_from(v);
@@ -322,46 +389,7 @@ fn refit_and_eliminate<'a>(
             break;
         }
     }
-    if let Some(full) = joint.take() {
-        let (fit, swap) = best_swap(ctx, &members, added, pool, full);
-        if let Some((e, r, lr, delta_bic)) = swap {
-            let gone = members[e].0;
-            note(&format!(
-                "  {} replaced by {}: jointly the model fits better with it (ΔBIC {delta_bic:.1})",
-                gone.name(),
-                r.name()
-            ));
-            removed.push(Removal {
-                name: gone.name().into(),
-                replaced_by: Some(r.name().into()),
-                added_in_step: members[e].2,
-                lr_statistic: lr,
-                p_value: None,
-                delta_bic,
-                explained_by: Some(r.name().into()),
-                separate_by: separating_measurement(gone, r).into(),
-            });
-            members[e] = (r, Vec::new(), number);
-        }
-        joint = Some(fit);
-    }
-    if let Some(j) = &joint {
-        for (m, v) in members.iter_mut().zip(&j.values) {
-            m.1.clone_from(v);
-        }
-    }
-    let refitted = match &joint {
-        Some(j) => members
-            .iter()
-            .zip(&j.parameters)
-            .map(|(m, p)| RefitEffect {
-                name: m.0.name().into(),
-                parameters: p.clone(),
-            })
-            .collect(),
-        None => Vec::new(),
-    };
-    Ok((members, refitted, removed, joint))
+    joint.expect("the loop leaves the last joint fit")
 }
 
 /// The best swap of an earlier effect for one of its rivals still in the pool (module doc):
