@@ -1,0 +1,144 @@
+#!/usr/bin/env bash
+# bench-opensees.sh: time per sample of mc-shard against OpenSeesPy on the same problem, in
+# the same run, on the same core, and check that both give the same answer.
+#
+# The problem is the rigid case of bench-instructions.sh: the paper's 5-stage prism
+# (`truss model prism --stages 5`), battens and longerons with length errors N(0, 0.0063²) mm,
+# seed 20210325. OpenSeesPy (scripts/opensees_prism.py) solves the model file with
+# corotational trusses, each member's length error as an initial strain, and the SAME
+# drawn errors as mc-shard (`mc-shard inputs`); the cables' compression ratio
+# is mc-shard's working ratio 1e-4 on both sides (see opensees_prism.py's header).
+# Each run, interleaved:
+#   mc-shard       `mc-shard run --threads 1` of BASE and BASE + SAMPLES samples, whole
+#                  process: (time of the larger − time of the smaller) / SAMPLES, so that
+#                  start-up cancels; once with the default engine (samples solved side by
+#                  side in lanes) and once with TRUSS_LANES=off (one sample at a time)
+#   OpenSeesPy     OPENSEES_SAMPLES samples in one Python process, timed from the first
+#                  sample to the last (model built once before; per sample the materials'
+#                  initial strains and moduli are set, the domain reset and Newton run)
+# Prints each run, then the medians over RUNS runs and the ratios "mc-shard is X times
+# faster per sample", and the largest relative difference of θ_P between the two over the
+# OpenSeesPy samples. All processes are pinned to core CORE with taskset where present.
+#
+# Usage: scripts/bench-opensees.sh [RUNS]        (default 3)
+#   MC_SHARD=path/to/mc-shard  TRUSS=path/to/truss   use these builds (default: cargo build
+#                                                    --release -p mc-shard -p truss-cli)
+#   SAMPLES=20000 BASE=1000 OPENSEES_SAMPLES=500 CORE=0   the sizes and the core
+# Needs python3 with venv and the network to PyPI the first time: OpenSeesPy (pinned below)
+# is installed into target/opensees-venv, and its shared library needs the Debian packages
+# libblas3 and liblapack3, installed here if missing (as root, or with sudo).
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$REPO"
+RUNS="${1:-3}"
+SAMPLES="${SAMPLES:-20000}"
+BASE="${BASE:-1000}"
+OPENSEES_SAMPLES="${OPENSEES_SAMPLES:-500}"
+CORE="${CORE:-0}"
+OPENSEESPY_VERSION=3.7.1.2
+[[ "$RUNS" =~ ^[1-9][0-9]*$ ]] || { echo "bench-opensees: RUNS must be a positive integer, got $RUNS" >&2; exit 2; }
+
+if [[ -z "${MC_SHARD:-}" || -z "${TRUSS:-}" ]]; then
+    cargo build --release --quiet -p mc-shard -p truss-cli
+fi
+MC_SHARD="${MC_SHARD:-$REPO/target/release/mc-shard}"
+TRUSS="${TRUSS:-$REPO/target/release/truss}"
+
+VENV="$REPO/target/opensees-venv"
+if [[ ! -x "$VENV/bin/python" ]]; then
+    python3 -m venv "$VENV" || { echo "bench-opensees: python3 cannot make a virtual environment (Debian: apt-get install python3-venv)" >&2; exit 1; }
+fi
+if ! "$VENV/bin/python" -m pip show --quiet openseespy 2>/dev/null; then
+    "$VENV/bin/python" -m pip install --quiet --disable-pip-version-check "openseespy==$OPENSEESPY_VERSION"
+fi
+if ! "$VENV/bin/python" -c 'import openseespy.opensees' >/dev/null 2>&1; then
+    echo "bench-opensees: OpenSeesPy needs libblas.so.3 and liblapack.so.3; installing libblas3 liblapack3" >&2
+    SUDO=""
+    [[ $(id -u) -eq 0 ]] || SUDO="sudo"
+    $SUDO apt-get update -q
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends libblas3 liblapack3
+    "$VENV/bin/python" -c 'import openseespy.opensees' >/dev/null
+fi
+
+PIN=()
+command -v taskset >/dev/null && PIN=(taskset -c "$CORE")
+WORK="$(mktemp -d /tmp/truss-mc-opensees.XXXXXX)"
+trap 'rm -rf "$WORK"' EXIT
+
+"$TRUSS" model prism --stages 5 > "$WORK/model.json"
+# job SAMPLES -> $WORK/job-SAMPLES.json, the rigid case of bench-instructions.sh
+job() {
+    cat > "$WORK/job-$1.json" <<JOB
+{"model": {"prism": {"stages": 5}}, "seed": 20210325, "cases": [
+  {"name": "rigid", "samples": $1,
+   "length_errors": {"batten": {"normal": {"sigma": 0.0063}}, "longeron": {"normal": {"sigma": 0.0063}}}}]}
+JOB
+}
+small=$BASE
+large=$((BASE + SAMPLES))
+job "$small"
+job "$large"
+"$MC_SHARD" inputs --job "$WORK/job-$large.json" --range "0..$OPENSEES_SAMPLES" --out "$WORK/inputs.csv" >/dev/null
+
+# seconds LANES SAMPLES: wall time of one whole `mc-shard run` (LANES: on or off)
+seconds() {
+    local out="$WORK/out-$1-$2" start end
+    rm -rf "$out"
+    local env=()
+    [[ "$1" == off ]] && env=(TRUSS_LANES=off)
+    start=$EPOCHREALTIME
+    env "${env[@]}" "${PIN[@]}" "$MC_SHARD" run --job "$WORK/job-$2.json" --out "$out" --threads 1 --quiet >/dev/null
+    end=$EPOCHREALTIME
+    echo "$end - $start" | bc -l
+}
+
+# One line per run: lanes µs/sample, lanes-off µs/sample, OpenSeesPy's summary (JSON).
+: > "$WORK/runs"
+echo "bench-opensees: 5-stage prism, rigid (σ = 0.0063 mm, seed 20210325); $RUNS runs of" \
+    "mc-shard $SAMPLES samples (minus $BASE) and OpenSeesPy $OPENSEES_SAMPLES samples, on core $CORE"
+for ((run = 1; run <= RUNS; run++)); do
+    per=()
+    for lanes in on off; do
+        a=$(seconds "$lanes" "$small")
+        b=$(seconds "$lanes" "$large")
+        per+=("$(echo "($b - $a) / $SAMPLES * 1000000" | bc -l)")
+    done
+    cmp -s "$WORK/out-on-$large"/*.jsonl "$WORK/out-off-$large"/*.jsonl \
+        || { echo "bench-opensees: the shard in lanes differs from TRUSS_LANES=off" >&2; exit 1; }
+    opensees=$("${PIN[@]}" "$VENV/bin/python" "$REPO/scripts/opensees_prism.py" \
+        --model "$WORK/model.json" --inputs "$WORK/inputs.csv" \
+        --lines "$(echo "$WORK/out-on-$large"/*.jsonl)" --samples "$OPENSEES_SAMPLES" 2>"$WORK/opensees.err") \
+        || { cat "$WORK/opensees.err" >&2; exit 1; }
+    echo "${per[0]} ${per[1]} $opensees" >> "$WORK/runs"
+    python3 - "$run" "${per[0]}" "${per[1]}" "$opensees" <<'PY'
+import json, sys
+run, lanes, off, o = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3]), json.loads(sys.argv[4])
+ops = o["seconds"] / o["samples"] * 1e6
+print("run %d: mc-shard %.2f µs per sample (lanes), %.2f µs (TRUSS_LANES=off); OpenSeesPy %.1f µs "
+      "(%.2f Newton iterations); ratios %.1f, %.1f" % (run, lanes, off, ops, o["iterations"], ops / lanes, ops / off))
+PY
+done
+
+python3 - "$WORK/runs" "$OPENSEESPY_VERSION" <<'PY'
+import json, statistics, sys
+rows = [line.split(" ", 2) for line in open(sys.argv[1])]
+lanes = [float(r[0]) for r in rows]
+off = [float(r[1]) for r in rows]
+o = [json.loads(r[2]) for r in rows]
+ops = [x["seconds"] / x["samples"] * 1e6 for x in o]
+failed = sum(x["failed"] for x in o)
+worst = max(x["max_relative_difference"] for x in o)
+compared = min(x["compared"] for x in o)
+m = statistics.median
+print("medians of %d runs:" % len(rows))
+print("  mc-shard, lanes (default)    %10.2f µs per sample" % m(lanes))
+print("  mc-shard, TRUSS_LANES=off    %10.2f µs per sample" % m(off))
+print("  OpenSeesPy %-17s %10.1f µs per sample (%.2f Newton iterations, %s)"
+      % (sys.argv[2], m(ops), m(x["iterations"] for x in o), o[0]["per_sample"]))
+print("mc-shard is %.1f times faster per sample than OpenSeesPy (lanes); %.1f times with TRUSS_LANES=off"
+      % (m(a / b for a, b in zip(ops, lanes)), m(a / b for a, b in zip(ops, off))))
+print("θ_P: largest relative difference OpenSeesPy vs mc-shard %.1e over %d samples%s"
+      % (worst, compared, "; %d OpenSeesPy solves FAILED" % failed if failed else ""))
+if failed or compared < o[0]["samples"] or not worst < 1e-6:
+    sys.exit("bench-opensees: the two solvers do not agree")
+PY
