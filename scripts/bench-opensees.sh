@@ -8,17 +8,22 @@
 # corotational trusses, each member's length error as an initial strain, and the SAME
 # drawn errors as mc-shard (`mc-shard inputs`); the cables' compression ratio
 # is mc-shard's working ratio 1e-4 on both sides (see opensees_prism.py's header).
-# Each run, interleaved:
+# Each run, interleaved, by the clock and in CPU time (user + system):
 #   mc-shard       `mc-shard run --threads 1` of BASE and BASE + SAMPLES samples, whole
 #                  process: (time of the larger − time of the smaller) / SAMPLES, so that
 #                  start-up cancels; once with the default engine (samples solved side by
-#                  side in lanes) and once with TRUSS_LANES=off (one sample at a time)
+#                  side in lanes) and once with TRUSS_LANES=off (one sample at a time),
+#                  whose shards must be byte-identical
 #   OpenSeesPy     OPENSEES_SAMPLES samples in one Python process, timed from the first
-#                  sample to the last (model built once before; per sample the materials'
-#                  initial strains and moduli are set, the domain reset and Newton run)
+#                  sample to the last (model built once before; per sample the changed
+#                  materials' initial strains and moduli are set, the domain reset and
+#                  Newton run)
 # Prints each run, then the medians over RUNS runs and the ratios "mc-shard is X times
-# faster per sample", and the largest relative difference of θ_P between the two over the
-# OpenSeesPy samples. All processes are pinned to core CORE with taskset where present.
+# faster per sample" (the median of the runs' own ratios; CPU time is the figure to quote
+# on a machine shared with other work, whose waiting for a core inflates the clock), and
+# the largest relative difference of θ_P between the two over the OpenSeesPy samples
+# (exit 1 if it is not below 1e-6 or an OpenSeesPy solve failed). All processes are
+# pinned to core CORE with taskset where present.
 #
 # Usage: scripts/bench-opensees.sh [RUNS]        (default 3)
 #   MC_SHARD=path/to/mc-shard  TRUSS=path/to/truss   use these builds (default: cargo build
@@ -80,19 +85,34 @@ job "$small"
 job "$large"
 "$MC_SHARD" inputs --job "$WORK/job-$large.json" --range "0..$OPENSEES_SAMPLES" --out "$WORK/inputs.csv" >/dev/null
 
-# seconds LANES SAMPLES: wall time of one whole `mc-shard run` (LANES: on or off)
+# seconds LANES SAMPLES: "wall cpu", the seconds of one whole `mc-shard run` (LANES: on or
+# off), by the clock and in CPU time (user + system, from the kernel's accounting of the
+# process), which a machine shared with other work disturbs far less than the clock.
 seconds() {
-    local out="$WORK/out-$1-$2" start end
+    local out="$WORK/out-$1-$2"
     rm -rf "$out"
-    local env=()
-    [[ "$1" == off ]] && env=(TRUSS_LANES=off)
-    start=$EPOCHREALTIME
-    env "${env[@]}" "${PIN[@]}" "$MC_SHARD" run --job "$WORK/job-$2.json" --out "$out" --threads 1 --quiet >/dev/null
-    end=$EPOCHREALTIME
-    echo "$end - $start" | bc -l
+    local lanes=()
+    [[ "$1" == off ]] && lanes=(TRUSS_LANES=off)
+    python3 - env "${lanes[@]}" "${PIN[@]}" "$MC_SHARD" run --job "$WORK/job-$2.json" --out "$out" --threads 1 --quiet <<'PY'
+import os, subprocess, sys, time
+start = time.perf_counter()
+child = subprocess.Popen(sys.argv[1:], stdout=subprocess.DEVNULL)
+_, status, usage = os.wait4(child.pid, 0)
+wall = time.perf_counter() - start
+if status != 0:
+    sys.exit("bench-opensees: %s failed (wait status %d)" % (" ".join(sys.argv[1:]), status))
+print(wall, usage.ru_utime + usage.ru_stime)
+PY
 }
 
-# One line per run: lanes µs/sample, lanes-off µs/sample, OpenSeesPy's summary (JSON).
+# per_sample SMALL LARGE: µs per sample, "wall cpu", from two `seconds` lines
+per_sample() {
+    python3 -c 'import sys
+a, b = map(float, sys.argv[1].split()), map(float, sys.argv[2].split())
+print(" ".join("%.4f" % ((y - x) / int(sys.argv[3]) * 1e6) for x, y in zip(a, b)))' "$1" "$2" "$SAMPLES"
+}
+
+# One line per run: lanes µs/sample (wall cpu), lanes-off (wall cpu), OpenSeesPy's summary.
 : > "$WORK/runs"
 echo "bench-opensees: 5-stage prism, rigid (σ = 0.0063 mm, seed 20210325); $RUNS runs of" \
     "mc-shard $SAMPLES samples (minus $BASE) and OpenSeesPy $OPENSEES_SAMPLES samples, on core $CORE"
@@ -101,7 +121,7 @@ for ((run = 1; run <= RUNS; run++)); do
     for lanes in on off; do
         a=$(seconds "$lanes" "$small")
         b=$(seconds "$lanes" "$large")
-        per+=("$(echo "($b - $a) / $SAMPLES * 1000000" | bc -l)")
+        per+=("$(per_sample "$a" "$b")")
     done
     cmp -s "$WORK/out-on-$large"/*.jsonl "$WORK/out-off-$large"/*.jsonl \
         || { echo "bench-opensees: the shard in lanes differs from TRUSS_LANES=off" >&2; exit 1; }
@@ -112,31 +132,41 @@ for ((run = 1; run <= RUNS; run++)); do
     echo "${per[0]} ${per[1]} $opensees" >> "$WORK/runs"
     python3 - "$run" "${per[0]}" "${per[1]}" "$opensees" <<'PY'
 import json, sys
-run, lanes, off, o = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3]), json.loads(sys.argv[4])
-ops = o["seconds"] / o["samples"] * 1e6
-print("run %d: mc-shard %.2f µs per sample (lanes), %.2f µs (TRUSS_LANES=off); OpenSeesPy %.1f µs "
-      "(%.2f Newton iterations); ratios %.1f, %.1f" % (run, lanes, off, ops, o["iterations"], ops / lanes, ops / off))
+run = int(sys.argv[1])
+lanes, off = (list(map(float, a.split())) for a in sys.argv[2:4])
+o = json.loads(sys.argv[4])
+ops = [o["seconds"] / o["samples"] * 1e6, o["cpu_seconds"] / o["samples"] * 1e6]
+print("run %d (µs per sample, wall/CPU): mc-shard %.1f/%.1f in lanes, %.1f/%.1f TRUSS_LANES=off; "
+      "OpenSeesPy %.0f/%.0f (%.2f Newton iterations)"
+      % (run, lanes[0], lanes[1], off[0], off[1], ops[0], ops[1], o["iterations"]))
 PY
 done
 
 python3 - "$WORK/runs" "$OPENSEESPY_VERSION" <<'PY'
 import json, statistics, sys
-rows = [line.split(" ", 2) for line in open(sys.argv[1])]
-lanes = [float(r[0]) for r in rows]
-off = [float(r[1]) for r in rows]
-o = [json.loads(r[2]) for r in rows]
-ops = [x["seconds"] / x["samples"] * 1e6 for x in o]
+rows = [line.split(" ", 4) for line in open(sys.argv[1])]
+o = [json.loads(r[4]) for r in rows]
+m = statistics.median
+times = {  # µs per sample, (wall, cpu) per run
+    "lanes": [(float(r[0]), float(r[1])) for r in rows],
+    "off": [(float(r[2]), float(r[3])) for r in rows],
+    "opensees": [(x["seconds"] / x["samples"] * 1e6, x["cpu_seconds"] / x["samples"] * 1e6) for x in o],
+}
+def med(name, k):
+    return m(t[k] for t in times[name])
+def ratio(name, k):  # median over runs of the run's own ratio
+    return m(a[k] / b[k] for a, b in zip(times["opensees"], times[name]))
+print("medians of %d runs, µs per sample:            wall       CPU" % len(rows))
+print("  mc-shard, lanes (the default)      %10.2f %9.2f" % (med("lanes", 0), med("lanes", 1)))
+print("  mc-shard, TRUSS_LANES=off          %10.2f %9.2f" % (med("off", 0), med("off", 1)))
+print("  OpenSeesPy %-23s %10.1f %9.1f  (%.2f Newton iterations, %s per sample)"
+      % (sys.argv[2], med("opensees", 0), med("opensees", 1), m(x["iterations"] for x in o), o[0]["per_sample"]))
+print("mc-shard is %.1f times faster per sample than OpenSeesPy in CPU time (%.1f by the clock);"
+      % (ratio("lanes", 1), ratio("lanes", 0)))
+print("  with TRUSS_LANES=off %.1f times (%.1f by the clock)" % (ratio("off", 1), ratio("off", 0)))
 failed = sum(x["failed"] for x in o)
 worst = max(x["max_relative_difference"] for x in o)
 compared = min(x["compared"] for x in o)
-m = statistics.median
-print("medians of %d runs:" % len(rows))
-print("  mc-shard, lanes (default)    %10.2f µs per sample" % m(lanes))
-print("  mc-shard, TRUSS_LANES=off    %10.2f µs per sample" % m(off))
-print("  OpenSeesPy %-17s %10.1f µs per sample (%.2f Newton iterations, %s)"
-      % (sys.argv[2], m(ops), m(x["iterations"] for x in o), o[0]["per_sample"]))
-print("mc-shard is %.1f times faster per sample than OpenSeesPy (lanes); %.1f times with TRUSS_LANES=off"
-      % (m(a / b for a, b in zip(ops, lanes)), m(a / b for a, b in zip(ops, off))))
 print("θ_P: largest relative difference OpenSeesPy vs mc-shard %.1e over %d samples%s"
       % (worst, compared, "; %d OpenSeesPy solves FAILED" % failed if failed else ""))
 if failed or compared < o[0]["samples"] or not worst < 1e-6:
