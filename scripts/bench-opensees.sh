@@ -24,11 +24,18 @@
 # the largest relative difference of θ_P between the two over the OpenSeesPy samples
 # (exit 1 if it is not below 1e-6 or an OpenSeesPy solve failed). All processes are
 # pinned to core CORE with taskset where present.
+# Where valgrind is installed (and INSTRUCTIONS is not 0), the script then counts the
+# instructions per sample of each, once (cachegrind --cache-sim=no; they repeat to a
+# fraction of a percent):
+# mc-shard's as bench-instructions.sh counts them (2,200 samples minus 200), OpenSeesPy's
+# as the difference between OPENSEES_SAMPLES and a fifth of them in its Python process,
+# and prints their ratios: machine-independent, unlike the times.
 #
 # Usage: scripts/bench-opensees.sh [RUNS]        (default 3)
 #   MC_SHARD=path/to/mc-shard  TRUSS=path/to/truss   use these builds (default: cargo build
 #                                                    --release -p mc-shard -p truss-cli)
 #   SAMPLES=20000 BASE=1000 OPENSEES_SAMPLES=500 CORE=0   the sizes and the core
+#   INSTRUCTIONS=0                                   skip the instruction counts (40 s)
 # Needs python3 with venv and the network to PyPI the first time: OpenSeesPy (pinned below)
 # is installed into target/opensees-venv, and its shared library needs the Debian packages
 # libblas3 and liblapack3, installed here if missing (as root, or with sudo).
@@ -40,7 +47,9 @@ SAMPLES="${SAMPLES:-20000}"
 BASE="${BASE:-1000}"
 OPENSEES_SAMPLES="${OPENSEES_SAMPLES:-500}"
 CORE="${CORE:-0}"
+INSTRUCTIONS="${INSTRUCTIONS:-1}"
 OPENSEESPY_VERSION=3.7.1.2
+[[ "$OPENSEES_SAMPLES" =~ ^[0-9]+$ && "$OPENSEES_SAMPLES" -ge 5 ]] || { echo "bench-opensees: OPENSEES_SAMPLES must be at least 5, got $OPENSEES_SAMPLES" >&2; exit 2; }
 [[ "$RUNS" =~ ^[1-9][0-9]*$ ]] || { echo "bench-opensees: RUNS must be a positive integer, got $RUNS" >&2; exit 2; }
 
 if [[ -z "${MC_SHARD:-}" || -z "${TRUSS:-}" ]]; then
@@ -114,7 +123,7 @@ print(" ".join("%.4f" % ((y - x) / int(sys.argv[3]) * 1e6) for x, y in zip(a, b)
 
 # One line per run: lanes µs/sample (wall cpu), lanes-off (wall cpu), OpenSeesPy's summary.
 : > "$WORK/runs"
-echo "bench-opensees: 5-stage prism, rigid (σ = 0.0063 mm, seed 20210325); $RUNS runs of" \
+echo "bench-opensees: 5-stage prism, rigid (σ = 0.0063 mm, seed 20210325); RUNS=$RUNS of" \
     "mc-shard $SAMPLES samples (minus $BASE) and OpenSeesPy $OPENSEES_SAMPLES samples, on core $CORE"
 for ((run = 1; run <= RUNS; run++)); do
     per=()
@@ -174,4 +183,38 @@ print("θ_P: largest relative difference OpenSeesPy vs mc-shard %.1e over %d sam
       % (worst, compared, "; %d OpenSeesPy solves FAILED" % failed if failed else ""))
 if failed or compared < o[0]["samples"] or not worst < 1e-6:
     sys.exit("bench-opensees: the two solvers do not agree")
+PY
+
+[[ "$INSTRUCTIONS" != 0 ]] && command -v valgrind >/dev/null || exit 0
+# instructions LANES COMMAND...: the instructions one run of COMMAND executes, with
+# TRUSS_LANES=LANES in its environment (on: the default engine)
+instructions() {
+    env "TRUSS_LANES=$1" valgrind --tool=cachegrind --cache-sim=no \
+        --cachegrind-out-file="$WORK/cg.out" "${@:2}" >/dev/null 2>&1
+    awk '/^summary:/ {print $2}' "$WORK/cg.out"
+}
+job 200
+job 2200
+counts=()
+for lanes in on off; do
+    for n in 200 2200; do
+        rm -rf "$WORK/out-count"
+        counts+=("$(instructions "$lanes" "$MC_SHARD" run --job "$WORK/job-$n.json" --out "$WORK/out-count" --threads 1 --quiet)")
+    done
+done
+few=$((OPENSEES_SAMPLES / 5))
+for n in "$few" "$OPENSEES_SAMPLES"; do
+    counts+=("$(instructions on "$VENV/bin/python" "$REPO/scripts/opensees_prism.py" \
+        --model "$WORK/model.json" --inputs "$WORK/inputs.csv" --samples "$n")")
+done
+python3 - "$few" "$OPENSEES_SAMPLES" "${counts[@]}" <<'PY'
+import sys
+few, many = int(sys.argv[1]), int(sys.argv[2])
+c = list(map(int, sys.argv[3:]))
+lanes, off = (c[1] - c[0]) / 2000, (c[3] - c[2]) / 2000
+ops = (c[5] - c[4]) / (many - few)
+print("instructions per sample: mc-shard %.0f in lanes, %.0f TRUSS_LANES=off; OpenSeesPy %.0f;"
+      % (lanes, off, ops))
+print("  OpenSeesPy executes %.1f times mc-shard's instructions (lanes), %.1f times (TRUSS_LANES=off)"
+      % (ops / lanes, ops / off))
 PY
