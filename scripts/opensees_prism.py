@@ -19,7 +19,8 @@ nodes, e its drawn length error, L₀ = natural_length + e its stress-free lengt
     material InitStrainMaterial(ε₀) around Elastic(E', 0, E'_neg), σ = E'·(ε + ε₀)
         ε₀ = (L_r − L₀)/L_r     zero stress at L = L₀: a member too long by e has ε₀ = −e/L_r
         E' = E·L_r/L₀           so that N = E'·A·(L − L₀)/L_r = E·A·(L − L₀)/L₀, mc-shard's
-                                 force (crates/truss-core/src/element.rs)
+                                 force (crates/truss-core/src/element.rs); with E' = E,
+                                 θ_P moves by some 1e-5 of itself, the order of e/L_r
         E'_neg = E' for bars; r·E' for cables (tension only), r the compression ratio
 
 A cable of compression ratio 0 (the model's default, the paper's) is what mc-shard solves
