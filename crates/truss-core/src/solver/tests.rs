@@ -149,11 +149,12 @@ fn tangent_is_the_residual_jacobian() {
     }
 }
 
-/// SplitMix64 + Box–Muller, as in the benchmark (`benches/solve.rs`): its samples.
-struct Normals(u64);
+/// SplitMix64 + Box–Muller, as in the benchmark (`benches/solve.rs`): its samples (also
+/// the batched path's tests' stream).
+pub(super) struct Normals(pub(super) u64);
 
 impl Normals {
-    fn uniform(&mut self) -> f64 {
+    pub(super) fn uniform(&mut self) -> f64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -161,7 +162,7 @@ impl Normals {
         z ^= z >> 31;
         ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
     }
-    fn normal(&mut self) -> f64 {
+    pub(super) fn normal(&mut self) -> f64 {
         let (a, b) = (self.uniform(), self.uniform());
         (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
     }

@@ -16,6 +16,7 @@
 //! Units as in [`crate::block`]: stiffness entries \[N/mm\], right-hand sides \[N\],
 //! solutions \[mm\].
 
+use super::lanes;
 use crate::block::{BlockBandMatrix, PIVOT_TOLERANCE, PivotFailure};
 
 /// A 3×3 block of `W` lanes.
@@ -210,12 +211,6 @@ fn scatter<const W: usize>(blocks: &mut [crate::block::Block], lanes: &[BlockLan
     {
         *b = x[l];
     }
-}
-
-/// `[f(0), …, f(W − 1)]`.
-#[inline(always)]
-fn lanes<const W: usize>(f: impl Fn(usize) -> f64) -> [f64; W] {
-    std::array::from_fn(f)
 }
 
 /// The factorisation's arguments, for `pulp`'s dispatch (compiled once per instruction set).

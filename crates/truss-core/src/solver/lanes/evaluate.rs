@@ -12,6 +12,7 @@
 //! stiffnesses \[N/mm\], energy \[N·mm\].
 
 use super::super::evaluate::{Evaluation, max_abs};
+use super::lanes;
 use crate::element::{AxialMember, AxialState};
 use crate::structure::Structure;
 
@@ -196,12 +197,6 @@ impl<const W: usize> pulp::WithSimd for Kernel<'_, W> {
             self.states,
         )
     }
-}
-
-/// `[f(0), …, f(W − 1)]`.
-#[inline(always)]
-fn lanes<const W: usize>(f: impl Fn(usize) -> f64) -> [f64; W] {
-    std::array::from_fn(f)
 }
 
 /// Lane-wise `f(a, b)`.

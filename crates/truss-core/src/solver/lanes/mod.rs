@@ -51,6 +51,12 @@ use std::future::Future;
 use std::sync::Arc;
 use std::task::{Context, Poll, Waker};
 
+/// `[f(0), …, f(W − 1)]`: one operation over all lanes, for the kernels to vectorise.
+#[inline(always)]
+fn lanes<const W: usize>(f: impl Fn(usize) -> f64) -> [f64; W] {
+    std::array::from_fn(f)
+}
+
 /// Lanes per batch: four f64 lanes fill an AVX2 register (two SSE2 ones).
 pub const LANES: usize = 4;
 

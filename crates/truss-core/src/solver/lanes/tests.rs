@@ -7,27 +7,9 @@ use super::evaluate::{EvalBuffers, EvalLanes};
 use super::*;
 use crate::element::AxialState;
 use crate::prism::{BacklashOptions, PrismOptions};
+use crate::solver::tests::Normals as Stream;
 use crate::solver::{Perturbation, SolveOptions, SolveReport, Solver};
 use crate::{Model, SolveError};
-
-/// SplitMix64 with Box–Muller normals.
-struct Stream(u64);
-
-impl Stream {
-    fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-    }
-
-    fn normal(&mut self) -> f64 {
-        let (a, b) = (self.uniform(), self.uniform());
-        (-2.0 * a.ln()).sqrt() * (2.0 * std::f64::consts::PI * b).cos()
-    }
-}
 
 /// The paper's prism of `stages` stages (with pin joints in free play for `backlash`).
 fn prism(stages: usize, backlash: bool) -> Model {
