@@ -16,7 +16,7 @@
 //! Units as in [`crate::block`]: stiffness entries \[N/mm\], right-hand sides \[N\],
 //! solutions \[mm\].
 
-use super::lanes;
+use super::lane::lanes;
 use crate::block::{BlockBandMatrix, PIVOT_TOLERANCE, PivotFailure};
 
 /// A 3×3 block of `W` lanes.

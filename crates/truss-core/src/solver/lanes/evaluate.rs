@@ -12,7 +12,7 @@
 //! stiffnesses \[N/mm\], energy \[N·mm\].
 
 use super::super::evaluate::{Evaluation, max_abs};
-use super::lanes;
+use super::lane::lanes;
 use crate::element::{AxialMember, AxialState};
 use crate::structure::Structure;
 

@@ -37,6 +37,7 @@
 mod band;
 mod drive;
 mod evaluate;
+mod lane;
 
 pub use drive::{LaneSolve, LaneWork, run_lanes};
 
@@ -50,12 +51,6 @@ use std::cell::{Cell, RefCell};
 use std::future::Future;
 use std::sync::Arc;
 use std::task::{Context, Poll, Waker};
-
-/// `[f(0), …, f(W − 1)]`: one operation over all lanes, for the kernels to vectorise.
-#[inline(always)]
-fn lanes<const W: usize>(f: impl Fn(usize) -> f64) -> [f64; W] {
-    std::array::from_fn(f)
-}
 
 /// Lanes per batch: four f64 lanes fill an AVX2 register (two SSE2 ones).
 pub const LANES: usize = 4;
