@@ -38,12 +38,14 @@
 //!              cut at the range; for a model of one effect, its step's fit (profile
 //!              intervals); empty when no effect was added
 //! confounding [{effect, rival, parameters[] {name, unit, value, with_rival, interval,
-//!              moved, widening}, lr_statistic, p_value, delta_bic, separate_by}]   rivals
-//!              that, added to the final model and fitted jointly, move an effect's
-//!              parameters out of their intervals (moved) or widen their Wald intervals
-//!              two-fold or more (widening; listed for a widening alone only where the
-//!              rival is significant given the model, p < α/2): the data cannot tell how
-//!              that part of the
+//!              moved, widening}, lr_statistic, p_value, delta_bic, separate_by,
+//!              along_ridge}]   rivals that, added to the final model and fitted jointly,
+//!              move an effect's parameters out of their intervals (moved) or widen their
+//!              Wald intervals two-fold or more (widening; listed for a widening alone only
+//!              where the rival is significant given the model, p < α/2); or, where the
+//!              joint maximum moves nothing, open a flat direction along which a fit ends as
+//!              good as the model with a parameter outside its interval (along_ridge; its
+//!              with_rival is that fit's value): the data cannot tell how that part of the
 //!              signal divides between the two; the rival is also listed in the
 //!              `indistinguishable` of the step that named the effect
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
@@ -84,6 +86,10 @@
 //!              candidates, deciding with the profiles, updating the model, comparing the
 //!              updated model; the final fit; the confounding tests)}
 //! ```
+//!
+//! Version 8 (from 7): `confounding[].along_ridge`; a rival that moves nothing at the joint
+//! maximum is listed where the ridge probe finds a fit as good as the model's with an
+//! effect's parameter outside its interval.
 //!
 //! Version 7 (from 6): `timing.threads` and `timing.stages`; a rival whose only confounded
 //! parameters widen (none moved) is listed under `confounding` only where it is
@@ -139,7 +145,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 7;
+pub const FORMAT_VERSION: u32 = 8;
 
 #[derive(Serialize)]
 struct JobRef<'a> {

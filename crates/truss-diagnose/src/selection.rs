@@ -34,6 +34,7 @@ pub mod confound;
 pub mod decide;
 pub mod eliminate;
 pub mod model;
+pub mod ridge;
 pub mod step;
 pub mod update;
 

@@ -136,10 +136,15 @@ fn confounding_section(m: &mut String, d: &Diagnosis) {
         push(
             m,
             &format!(
-                "**Cannot be told apart: `{}` and `{}`.** With `{}` added and every effect fitted jointly, {} of `{}` {} confounded with it: {}; `{}` given the model: Λ = {:.1}, {}, ΔBIC = {:.1}. These data cannot say how that part of the signal divides between the two, so the values above are one reading of it. What would separate them: {}.\n",
+                "**Cannot be told apart: `{}` and `{}`.** With `{}` added and every effect fitted jointly{}, {} of `{}` {} confounded with it: {}; `{}` given the model: Λ = {:.1}, {}, ΔBIC = {:.1}. These data cannot say how that part of the signal divides between the two, so the values above are one reading of it. What would separate them: {}.\n",
                 c.effect,
                 c.rival,
                 c.rival,
+                if c.along_ridge {
+                    " from along the flat direction the two share (the joint maximum itself moves nothing)"
+                } else {
+                    ""
+                },
                 code_list(
                     &c.parameters.iter().map(|p| &p.name).collect::<Vec<_>>(),
                     ", "
@@ -149,7 +154,15 @@ fn confounding_section(m: &mut String, d: &Diagnosis) {
                 c.parameters
                     .iter()
                     .map(|p| {
-                        if p.moved && p.widening >= WIDENED {
+                        if p.moved && c.along_ridge {
+                            format!(
+                                "`{}` fits as well at {} {} as at {}, outside its interval",
+                                p.name,
+                                g(p.with_rival),
+                                p.unit,
+                                g(p.value)
+                            )
+                        } else if p.moved && p.widening >= WIDENED {
                             format!(
                                 "`{}` moves from {} to {} {}, outside its interval, which widens {:.1}-fold",
                                 p.name,

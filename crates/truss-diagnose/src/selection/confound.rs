@@ -39,7 +39,31 @@
 //! parameters, R's test and the measurement that separates them
 //! ([`crate::candidates::separating_measurement`]), when R moves one of its parameters out
 //! of its interval, or when R is significant given the model (p < α/2, the level at which
-//! backward elimination keeps an effect) and widens one. A widening alone, by
+//! backward elimination keeps an effect) and widens one.
+//!
+//! ## The ridge probe
+//!
+//! Where R and an effect explain the same signal equally well, ℓ has a flat ridge: the
+//! joint maximum with R added may sit anywhere along it, and often at R's null, where it
+//! moves nothing (a 2 K temperature offset with every batten 3 µm long was explained by an
+//! offset and a vertical gradient, and a batten bias added to that fit stayed at 0, though
+//! ℓ at the truth is only 3 units below). So where R is not significant and moves nothing,
+//! the joint fit's curvature is asked where the ridge would be. Moving R by r with the
+//! model's parameters following it (their maximum given R) moves them by −X·r,
+//! X = A_MM⁻¹·A_MR, and costs ½·rᵀSr in ℓ, S = A_RR − A_RM·X (R's curvature given the
+//! model; taken as |S|, floored, since a flat or negative curvature is what is looked
+//! for). Parameter j moves most cheaply along r ∝ S⁻¹xⱼ (xⱼ row j of X), and its Wald
+//! interval would widen √(1 + 1.96²·xⱼᵀS⁻¹xⱼ/hⱼ²)-fold (hⱼ its interval's half-width).
+//! For each parameter predicted to widen by [`WIDENED`] or more (at most [`RIDGE_PROBES`],
+//! the widest first), the fit is moved along that direction until the parameter lies
+//! [`RIDGE_BEYOND`] of the way past its interval's end, and all effects are fitted jointly
+//! again from there. A fit that ends within [`NESTED_SLACK`] of ℓ̂_M with a parameter
+//! still outside its interval shows, on ℓ itself and not on its quadratic model, that R
+//! can take over part of what the effect explains (with R held at its null, such a point
+//! would lie more than 1.92 units of ℓ below the maximum: outside the profile interval).
+//! The rival is then listed with the parameters this fit moved (`along_ridge`). The Wald
+//! prediction alone lists nothing: on data with one clear effect it predicts widenings
+//! that ℓ does not bear out (the fit climbs back), and those are not listed. A widening alone, by
 //! a rival the data do not call for, is not listed: a rival with free parameters of its own
 //! widens every interval it shares a direction with, however little of the signal it
 //! explains (a temperature field of four parameters, far from significant, widened a
@@ -56,6 +80,7 @@ use crate::likelihood::joint::{Combined, JointFit};
 use crate::likelihood::profile::{Problem, Profile, profile_some};
 use crate::likelihood::score::{FittedParameter, p_text, projection};
 use crate::selection::model::{Context, RefitEffect};
+use crate::selection::ridge::ridges;
 use crate::selection::step::Step;
 use crate::selection::update::fit_jointly;
 use serde::Serialize;
@@ -72,6 +97,13 @@ pub const WIDENED: f64 = 2.0;
 /// as a maximum (the model is the rival's null, so the maximum is at least ℓ̂_M; a fit that
 /// ends lower stopped on the way and is started again from the rival's null).
 pub const NESTED_SLACK: f64 = 1.0;
+
+/// How far past its interval's end the ridge probe moves a widened parameter, in units of
+/// the distance from its value to that end.
+pub const RIDGE_BEYOND: f64 = 0.5;
+
+/// Most ridge probes per rival.
+pub const RIDGE_PROBES: usize = 3;
 
 /// The final model's effects fitted jointly.
 pub struct FinalFit {
@@ -119,6 +151,11 @@ pub struct Confounding {
     pub delta_bic: f64,
     /// The measurement that would separate the two.
     pub separate_by: String,
+    /// Whether the moves were found by the ridge probe (module doc): the joint fit's
+    /// maximum did not move them, but a fit from along the flat direction the rival opens
+    /// ended as good as the model with them outside their intervals (`with_rival` is that
+    /// fit's value).
+    pub along_ridge: bool,
 }
 
 /// The final model's effects fitted jointly: `last` the final model's step (the last kept
@@ -381,30 +418,172 @@ fn with_rival<'a>(
             .join(", ")
     ));
     let significant = p < ctx.settings.candidate_level();
+    let mut judged = judge(fit, &joint, &members);
+    let mut along_ridge = false;
+    if !significant && !judged.iter().flatten().any(|p| p.moved) {
+        // Nothing moved, and the rival is not called for: does ℓ itself hold a ridge the
+        // two share?
+        if let Some(probe) = ridge_probe(ctx, fit, &joint, &members, l_model) {
+            judged = judge(fit, &probe, &members);
+            along_ridge = true;
+        }
+    }
     let mut out = Vec::new();
-    for (e, (now, with)) in fit.effects.iter().zip(&joint.parameters).enumerate() {
-        let c = members[e].0;
-        let parameters: Vec<ConfoundedParameter> = now
-            .parameters
-            .iter()
-            .zip(with)
-            .zip(c.parameters())
-            .filter_map(|((a, b), q)| confounded(q, a, b))
-            .collect();
+    for (e, parameters) in judged.into_iter().enumerate() {
         if !listed(&parameters, significant) {
             continue;
         }
         out.push(Confounding {
-            effect: now.name.clone(),
+            effect: fit.effects[e].name.clone(),
             rival: rival.name().into(),
             parameters,
             lr_statistic: lr,
             p_value: p,
             delta_bic,
-            separate_by: separating_measurement(c, rival).into(),
+            separate_by: separating_measurement(members[e].0, rival).into(),
+            along_ridge,
         });
     }
     Ok(out)
+}
+
+/// Each model effect's parameters confounded with the rival of `joint` (the model's
+/// effects and the rival fitted jointly; `members` the model's effects, then the rival).
+fn judge(
+    fit: &FinalFit,
+    joint: &JointFit,
+    members: &[(&dyn Candidate, &[f64])],
+) -> Vec<Vec<ConfoundedParameter>> {
+    fit.effects
+        .iter()
+        .zip(&joint.parameters)
+        .zip(members)
+        .map(|((now, with), (c, _))| {
+            now.parameters
+                .iter()
+                .zip(with)
+                .zip(c.parameters())
+                .filter_map(|((a, b), q)| confounded(q, a, b))
+                .collect()
+        })
+        .collect()
+}
+
+/// The ridge probe (module doc): where the rival `joint` fitted with the model's effects
+/// widened one of their Wald intervals by [`WIDENED`] or more, or left it undetermined (`A`
+/// not positive definite: a flat direction), each parameter predicted to widen by
+/// [`WIDENED`] or more ([`ridges`]; at most [`RIDGE_PROBES`], the widest first) is moved
+/// [`RIDGE_BEYOND`] of the way past its interval's end along its ridge, and the effects are
+/// fitted jointly again from there. The first such fit that ends as good as the model with
+/// a parameter outside its interval; `None` where none does.
+fn ridge_probe(
+    ctx: &Context,
+    fit: &FinalFit,
+    joint: &JointFit,
+    members: &[(&dyn Candidate, &[f64])],
+    l_model: f64,
+) -> Option<JointFit> {
+    let found = |w: &Interval| w.lower.is_some() && w.upper.is_some();
+    let opened = fit
+        .effects
+        .iter()
+        .zip(&joint.parameters)
+        .zip(members)
+        .flat_map(|((now, with), (c, _))| now.parameters.iter().zip(with).zip(c.parameters()))
+        .any(|((a, b), q)| {
+            let width = |w: &Interval| {
+                q.internal(w.upper.unwrap_or(0.0)) - q.internal(w.lower.unwrap_or(0.0))
+            };
+            found(&a.wald_interval)
+                && (!found(&b.wald_interval)
+                    || width(&b.wald_interval) >= WIDENED * width(&a.wald_interval))
+        });
+    if !opened {
+        return None;
+    }
+    // Each parameter's interval half-width, internal coordinates, and the effect it is of.
+    let mut half = Vec::new();
+    let mut owner = Vec::new();
+    for (e, (now, (c, _))) in fit.effects.iter().zip(members).enumerate() {
+        for (i, (p, q)) in now.parameters.iter().zip(c.parameters()).enumerate() {
+            half.push(match (p.interval.lower, p.interval.upper) {
+                (Some(lo), Some(hi)) => Some(0.5 * (q.internal(hi) - q.internal(lo))),
+                _ => None,
+            });
+            owner.push((e, i));
+        }
+    }
+    let k_r = members.last()?.0.parameters().len();
+    let found = ridges(&joint.fit.curvature, k_r, &half)?;
+    let combined = Combined::new(members.iter().map(|m| m.0).collect());
+    let params = combined.parameters();
+    for ridge in found
+        .into_iter()
+        .filter(|r| r.widening >= WIDENED)
+        .take(RIDGE_PROBES)
+    {
+        let (j, widening, per_unit) = (ridge.parameter, ridge.widening, ridge.per_unit);
+        let (e, i) = owner[j];
+        let p = &fit.effects[e].parameters[i];
+        let q = &members[e].0.parameters()[i];
+        let value = q.internal(p.value);
+        let Some(target) = [
+            (p.interval.upper, p.interval.upper_at_range_end),
+            (p.interval.lower, p.interval.lower_at_range_end),
+        ]
+        .into_iter()
+        .filter_map(|(end, cut)| end.filter(|_| !cut))
+        .map(|end| {
+            let end = q.internal(end);
+            end + RIDGE_BEYOND * (end - value)
+        })
+        .find(|t| (0.0..=1.0).contains(t)) else {
+            continue;
+        };
+        if per_unit == 0.0 {
+            continue;
+        }
+        let scale = (target - joint.fit.internal[j]) / per_unit;
+        let mut t: Vec<f64> = (0..params.len())
+            .map(|k| (joint.fit.internal[k] + scale * ridge.direction[k]).clamp(0.0, 1.0))
+            .collect();
+        projection(&combined)(&mut t, Some(j));
+        let values: Vec<f64> = params.iter().zip(&t).map(|(p, &x)| p.value(x)).collect();
+        let parts = combined.split(&values);
+        let start: Vec<(&dyn Candidate, &[f64])> = members
+            .iter()
+            .zip(&parts)
+            .map(|(&(c, _), v)| (c, v.as_slice()))
+            .collect();
+        ctx.progress.note(&format!(
+            "  {}'s interval would widen {widening:.1}-fold with {}: fitting again from {} = {:.4e}",
+            p.name,
+            members.last().expect("the rival is there").0.name(),
+            p.name,
+            q.value(t[j])
+        ));
+        match fit_jointly(ctx, &start, Some(&joint.fit.steps)) {
+            Ok(probe) if probe.log_likelihood >= l_model - NESTED_SLACK => {
+                ctx.progress.note(&format!(
+                    "  ℓ̂ {:.1} (the model's {l_model:.1}); {} {:.4e}",
+                    probe.log_likelihood, p.name, probe.parameters[e][i].value
+                ));
+                let moved = judge(fit, &probe, members)
+                    .iter()
+                    .flatten()
+                    .any(|c| c.moved);
+                if moved {
+                    return Some(probe);
+                }
+            }
+            Ok(probe) => ctx.progress.note(&format!(
+                "  ended below the model (ℓ̂ {:.1}): no ridge",
+                probe.log_likelihood
+            )),
+            Err(err) => ctx.progress.note(&format!("  failed ({err})")),
+        }
+    }
+    None
 }
 
 /// The rival's test given the model's effects (module doc): Λ_R, p, ΔBIC_R; the rival's
