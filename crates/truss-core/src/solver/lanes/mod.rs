@@ -105,13 +105,24 @@ enum Request {
     },
 }
 
+/// The kernels a lane can wait for: requests of one kind and one structure run together.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    /// [`Request::Evaluate`].
+    Evaluate,
+    /// [`Request::Factor`].
+    Factor,
+    /// [`Request::Solve`].
+    Solve,
+}
+
 impl Request {
-    /// Which kernel: requests of one kind and one structure run together.
-    fn kind(&self) -> u8 {
+    /// Which kernel.
+    fn kind(&self) -> Kind {
         match self {
-            Request::Evaluate(_) => 0,
-            Request::Factor { .. } => 1,
-            Request::Solve { .. } => 2,
+            Request::Evaluate(_) => Kind::Evaluate,
+            Request::Factor { .. } => Kind::Factor,
+            Request::Solve { .. } => Kind::Solve,
         }
     }
 }
@@ -316,7 +327,7 @@ impl BatchKernels {
             .iter_mut()
             .map(|p| p.as_mut().and_then(|p| p.as_mut()));
         match kind {
-            0 => {
+            Kind::Evaluate => {
                 let mut io: [Option<(SampleKey, &mut EvalBuffers)>; LANES] =
                     std::array::from_fn(|_| match mine.next().flatten() {
                         Some(Posted {
@@ -333,7 +344,7 @@ impl BatchKernels {
                     }
                 }
             }
-            1 => {
+            Kind::Factor => {
                 let mut io: [Option<FactorLane<'_>>; LANES] =
                     std::array::from_fn(|_| match mine.next().flatten() {
                         Some(Posted {
@@ -349,7 +360,7 @@ impl BatchKernels {
                     });
                 band.factor(&mut io);
             }
-            _ => {
+            Kind::Solve => {
                 let mut io: [Option<SolveLane<'_>>; LANES] =
                     std::array::from_fn(|_| match mine.next().flatten() {
                         Some(Posted {
@@ -379,7 +390,7 @@ impl BatchKernels {
 pub const PATIENCE: u32 = 2;
 
 /// The kernel to run next (see [`BatchKernels::run`]): its structure and kind.
-fn choose(slots: &LaneSlots) -> Option<(Arc<Structure>, u8)> {
+fn choose(slots: &LaneSlots) -> Option<(Arc<Structure>, Kind)> {
     let posted: [_; LANES] = std::array::from_fn(|l| slots.slots[l].posted.borrow());
     let same = |a: &Posted, b: &Posted| {
         a.request.kind() == b.request.kind() && Arc::ptr_eq(&a.structure, &b.structure)
