@@ -39,7 +39,14 @@
 //! parameters, R's test and the measurement that separates them
 //! ([`crate::candidates::separating_measurement`]), when R moves one of its parameters out
 //! of its interval, or when R is significant given the model (p < α/2, the level at which
-//! backward elimination keeps an effect) and widens one.
+//! backward elimination keeps an effect) and widens one. A widening alone, by
+//! a rival the data do not call for, is not listed: a rival with free parameters of its own
+//! widens every interval it shares a direction with, however little of the signal it
+//! explains (a temperature field of four parameters, far from significant, widened a
+//! backlash model's diagonal scatter and pretension four-fold on data with no temperature
+//! change). A rival with no confounded parameter is not listed, whatever its test: either
+//! it explains nothing the model does not (a rival the model already excludes), or what it
+//! adds is separate from the model's effects, and the selection's own steps judge it.
 //!
 //! ## The ridge probe
 //!
@@ -47,7 +54,7 @@
 //! joint maximum with R added may sit anywhere along it, and often at R's null, where it
 //! moves nothing (a 2 K temperature offset with every batten 3 µm long was explained by an
 //! offset and a vertical gradient, and a batten bias added to that fit stayed at 0, though
-//! ℓ at the truth is only 3 units below). So where R is not significant and moves nothing,
+//! ℓ at the truth is only a few units below). So where R is not significant and moves nothing,
 //! the joint fit's curvature is asked where the ridge would be. Moving R by r with the
 //! model's parameters following it (their maximum given R) moves them by −X·r,
 //! X = A_MM⁻¹·A_MR, and costs ½·rᵀSr in ℓ, S = A_RR − A_RM·X (R's curvature given the
@@ -62,15 +69,8 @@
 //! can take over part of what the effect explains (with R held at its null, such a point
 //! would lie more than 1.92 units of ℓ below the maximum: outside the profile interval).
 //! The rival is then listed with the parameters this fit moved (`along_ridge`). The Wald
-//! prediction alone lists nothing: on data with one clear effect it predicts widenings
-//! that ℓ does not bear out (the fit climbs back), and those are not listed. A widening alone, by
-//! a rival the data do not call for, is not listed: a rival with free parameters of its own
-//! widens every interval it shares a direction with, however little of the signal it
-//! explains (a temperature field of four parameters, far from significant, widened a
-//! backlash model's diagonal scatter and pretension four-fold on data with no temperature
-//! change). A rival with no confounded parameter is not listed, whatever its test: either
-//! it explains nothing the model does not (a rival the model already excludes), or what it
-//! adds is separate from the model's effects, and the selection's own steps judge it.
+//! prediction alone lists nothing: where ℓ does not bear it out, the fit climbs back
+//! inside the interval and the rival is not listed.
 
 use crate::candidates::candidate::{Candidate, separating_measurement};
 use crate::candidates::parameter::Parameter;
