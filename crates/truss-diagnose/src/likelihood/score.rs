@@ -64,9 +64,18 @@ impl FittedParameter {
     /// interval is the likelihood's own curvature, without the feasible set: where a
     /// profile's ends are set by a constraint that couples the parameter to others
     /// (gravity's \|g\| ≤ 1 holding g_z small because g_x and g_y are large), the interval
-    /// is narrow while the data say nothing of the parameter itself.
+    /// is narrow while the data say nothing of the parameter itself. A Wald interval with an
+    /// end not found (the curvature not positive definite, as at a fit on the range's edge:
+    /// backlash's spread at 0) says nothing either way, and the interval decides alone
+    /// where both its ends were found.
     pub fn coverage(&self, p: &Parameter) -> f64 {
-        coverage(p, &self.interval).max(coverage(p, &self.wald_interval))
+        let found = |i: &Interval| i.lower.is_some() && i.upper.is_some();
+        let own = coverage(p, &self.interval);
+        if found(&self.interval) && !found(&self.wald_interval) {
+            own
+        } else {
+            own.max(coverage(p, &self.wald_interval))
+        }
     }
 
     /// Sets the interval the report uses, and whether the parameter is determined.
@@ -594,5 +603,42 @@ mod tests {
         assert_eq!(p_is(1e-20), "p < 1e-16");
         assert_eq!(p_is(0.034), "p = 0.03");
         assert_eq!(p_text(2.5e-7), "2.5e-7");
+    }
+
+    /// A profile interval of 0.11 µm out of a 0.05 mm range is determined, also where the
+    /// Wald interval was not found (a backlash fit with its spread at 0: the curvature not
+    /// positive definite); a Wald interval over most of the range makes it undetermined
+    /// (gravity's g_z held small by |g| ≤ 1); with neither interval found, nothing is.
+    #[test]
+    fn an_unfound_wald_interval_leaves_the_decision_to_the_profile() {
+        let p = Parameter::linear("clearance", "mm", 0.0, 0.05, 0.0);
+        let interval = |lower: Option<f64>, upper: Option<f64>, method| Interval {
+            lower,
+            upper,
+            lower_at_range_end: false,
+            upper_at_range_end: false,
+            method,
+            threshold: None,
+        };
+        let mut fitted = FittedParameter {
+            name: p.name.clone(),
+            unit: p.unit,
+            value: 0.01049,
+            interval: interval(None, None, "wald"),
+            wald_interval: interval(None, None, "wald"),
+            joint_interval: None,
+            range: [p.low, p.high],
+            null: p.null,
+            determined: false,
+        };
+        assert_eq!(fitted.coverage(&p), 1.0);
+        fitted.set_interval(&p, interval(Some(0.010444), Some(0.010554), "profile"));
+        assert!(
+            fitted.determined && fitted.coverage(&p) < 0.01,
+            "{fitted:?}"
+        );
+        fitted.wald_interval = interval(Some(0.0), Some(0.04), "wald");
+        fitted.set_interval(&p, interval(Some(0.010444), Some(0.010554), "profile"));
+        assert!(!fitted.determined, "{fitted:?}");
     }
 }
