@@ -167,6 +167,27 @@ fn diagnose_with(
     v
 }
 
+/// `effect` hidden in `specimens` specimens of the baseline made under `seed` (named `name`
+/// in `dir`), diagnosed with N = `samples` against only `candidates`.
+fn hidden(
+    dir: &Path,
+    name: &str,
+    effect: &str,
+    (specimens, seed): (usize, u64),
+    samples: usize,
+    candidates: &[&str],
+) -> serde_json::Value {
+    let m = make(dir, name, effect, specimens, seed);
+    diagnose_with(
+        (&job(), "as-built"),
+        dir,
+        &m,
+        None,
+        samples,
+        Some(candidates),
+    )
+}
+
 /// The discrepancy at least halved by the named effect.
 fn check_halved(v: &serde_json::Value) {
     let (before, after) = (
@@ -255,14 +276,13 @@ fn hidden_length_sigma_is_named_and_recovered() {
 #[test]
 fn no_hidden_effect_gives_none() {
     let dir = tempfile::tempdir().unwrap();
-    let m = make(dir.path(), "none", "none", 40, 1);
-    let v = diagnose_with(
-        (&job(), "as-built"),
+    let v = hidden(
         dir.path(),
-        &m,
-        None,
+        "none",
+        "none",
+        (40, 1),
         300,
-        Some(&["diagonal_pretension", "length_sigma"]),
+        &["diagonal_pretension", "length_sigma"],
     );
     assert_eq!(v["named_effects"], serde_json::json!([]));
     assert_eq!(v["steps"].as_array().unwrap().len(), 1);
@@ -281,20 +301,13 @@ fn no_hidden_effect_gives_none() {
 #[test]
 fn too_few_specimens_cannot_tell() {
     let dir = tempfile::tempdir().unwrap();
-    let m = make(
+    let v = hidden(
         dir.path(),
         "few",
         "thermal_gradient:gradient_x=0.0005",
-        12,
-        25,
-    );
-    let v = diagnose_with(
-        (&job(), "as-built"),
-        dir.path(),
-        &m,
-        None,
+        (12, 25),
         300,
-        Some(&["thermal_gradient", "length_bias"]),
+        &["thermal_gradient", "length_bias"],
     );
     assert_eq!(v["verdict"], "cannot_tell", "{}", v["reason"]);
     assert_eq!(v["named_effect"], "none");
@@ -579,20 +592,13 @@ fn hidden_backlash_is_named_fast() {
 #[ignore = "about 20 s in the debug build since backlash and the confounding re-fits run at the cables' limit: scripts/test.sh runs it in release"]
 fn two_hidden_effects_are_both_named_fast() {
     let dir = tempfile::tempdir().unwrap();
-    let m = make(
+    let v = hidden(
         dir.path(),
         "two",
         "gravity:g_x=1;length_sigma:sigma.longeron=0.0126",
-        60,
-        26,
-    );
-    let v = diagnose_with(
-        (&job(), "as-built"),
-        dir.path(),
-        &m,
-        None,
+        (60, 26),
         300,
-        Some(&["gravity", "length_sigma", "diagonal_pretension"]),
+        &["gravity", "length_sigma", "diagonal_pretension"],
     );
     let named: Vec<&str> = v["named_effects"]
         .as_array()
@@ -637,20 +643,13 @@ fn two_hidden_effects_are_both_named_fast() {
 #[test]
 fn hidden_thermal_gradient_is_named_fast() {
     let dir = tempfile::tempdir().unwrap();
-    let m = make(
+    let v = hidden(
         dir.path(),
         "thermal",
         "thermal_gradient:gradient_x=0.002,offset=2",
-        40,
-        21,
-    );
-    let v = diagnose_with(
-        (&job(), "as-built"),
-        dir.path(),
-        &m,
-        None,
+        (40, 21),
         300,
-        Some(&["thermal_gradient", "diagonal_pretension"]),
+        &["thermal_gradient", "diagonal_pretension"],
     );
     assert_eq!(
         v["named_effects"],

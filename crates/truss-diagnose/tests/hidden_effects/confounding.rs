@@ -1,7 +1,7 @@
 //! What the data cannot tell apart, and what they do not determine: the final model's
 //! joint fit, its undetermined parameters and the rivals confounded with its effects.
 
-use super::{diagnose_with, final_parameter, job, make};
+use super::{final_parameter, hidden};
 
 /// Self-weight at 45° in the horizontal plane (g_x = g_y = −0.707 g) in 60 specimens,
 /// tried against gravity and a diagonal pretension: gravity is named, g_x and g_y are
@@ -11,20 +11,13 @@ use super::{diagnose_with, final_parameter, job, make};
 #[test]
 fn horizontal_self_weight_leaves_g_z_undetermined_fast() {
     let dir = tempfile::tempdir().unwrap();
-    let m = make(
+    let v = hidden(
         dir.path(),
         "horizontal",
         "gravity:g_x=-0.7071,g_y=-0.7071",
-        60,
-        27,
-    );
-    let v = diagnose_with(
-        (&job(), "as-built"),
-        dir.path(),
-        &m,
-        None,
+        (60, 27),
         300,
-        Some(&["gravity", "diagonal_pretension"]),
+        &["gravity", "diagonal_pretension"],
     );
     assert_eq!(
         v["named_effects"],
@@ -70,20 +63,13 @@ fn horizontal_self_weight_leaves_g_z_undetermined_fast() {
 #[test]
 fn an_absorbed_length_bias_is_said_fast() {
     let dir = tempfile::tempdir().unwrap();
-    let m = make(
+    let v = hidden(
         dir.path(),
         "field-longeron",
         "thermal_gradient:gradient_x=-0.001;length_bias:bias.longeron=-0.003",
-        60,
-        31,
-    );
-    let v = diagnose_with(
-        (&job(), "as-built"),
-        dir.path(),
-        &m,
-        None,
+        (60, 31),
         300,
-        Some(&["thermal_gradient", "length_bias"]),
+        &["thermal_gradient", "length_bias"],
     );
     let named: Vec<&str> = v["named_effects"]
         .as_array()
@@ -150,20 +136,13 @@ fn an_absorbed_length_bias_is_said_fast() {
 #[ignore = "slow statistical check (tens of seconds): scripts/test.sh runs it in release"]
 fn a_batten_bias_on_a_flat_ridge_is_said() {
     let dir = tempfile::tempdir().unwrap();
-    let m = make(
+    let v = hidden(
         dir.path(),
         "offset-batten",
         "thermal_gradient:offset=2;length_bias:bias.batten=0.003",
-        100,
-        302,
-    );
-    let v = diagnose_with(
-        (&job(), "as-built"),
-        dir.path(),
-        &m,
-        None,
+        (100, 302),
         300,
-        Some(&["thermal_gradient", "length_bias"]),
+        &["thermal_gradient", "length_bias"],
     );
     let named = v["named_effects"].as_array().unwrap();
     if named.len() == 2 {
@@ -195,14 +174,13 @@ fn a_batten_bias_on_a_flat_ridge_is_said() {
 #[test]
 fn one_clear_effect_lists_no_confounding_fast() {
     let dir = tempfile::tempdir().unwrap();
-    let m = make(dir.path(), "gravity-x", "gravity:g_x=1", 60, 33);
-    let v = diagnose_with(
-        (&job(), "as-built"),
+    let v = hidden(
         dir.path(),
-        &m,
-        None,
+        "gravity-x",
+        "gravity:g_x=1",
+        (60, 33),
         300,
-        Some(&["gravity", "diagonal_pretension"]),
+        &["gravity", "diagonal_pretension"],
     );
     assert_eq!(
         v["named_effects"],
