@@ -423,8 +423,8 @@ fn with_rival<'a>(
     if !significant && !judged.iter().flatten().any(|p| p.moved) {
         // Nothing moved, and the rival is not called for: does ℓ itself hold a ridge the
         // two share?
-        if let Some(probe) = ridge_probe(ctx, fit, &joint, &members, l_model) {
-            judged = judge(fit, &probe, &members);
+        if let Some(moved) = ridge_probe(ctx, fit, &joint, &members, l_model) {
+            judged = moved;
             along_ridge = true;
         }
     }
@@ -474,15 +474,16 @@ fn judge(
 /// not positive definite: a flat direction), each parameter predicted to widen by
 /// [`WIDENED`] or more ([`ridges`]; at most [`RIDGE_PROBES`], the widest first) is moved
 /// [`RIDGE_BEYOND`] of the way past its interval's end along its ridge, and the effects are
-/// fitted jointly again from there. The first such fit that ends as good as the model with
-/// a parameter outside its interval; `None` where none does.
+/// fitted jointly again from there. The confounded parameters ([`judge`]) of the first such
+/// fit that ends as good as the model with a parameter outside its interval; `None` where
+/// none does.
 fn ridge_probe(
     ctx: &Context,
     fit: &FinalFit,
     joint: &JointFit,
     members: &[(&dyn Candidate, &[f64])],
     l_model: f64,
-) -> Option<JointFit> {
+) -> Option<Vec<Vec<ConfoundedParameter>>> {
     let found = |w: &Interval| w.lower.is_some() && w.upper.is_some();
     let opened = fit
         .effects
@@ -568,12 +569,9 @@ fn ridge_probe(
                     "  ℓ̂ {:.1} (the model's {l_model:.1}); {} {:.4e}",
                     probe.log_likelihood, p.name, probe.parameters[e][i].value
                 ));
-                let moved = judge(fit, &probe, members)
-                    .iter()
-                    .flatten()
-                    .any(|c| c.moved);
-                if moved {
-                    return Some(probe);
+                let judged = judge(fit, &probe, members);
+                if judged.iter().flatten().any(|c| c.moved) {
+                    return Some(judged);
                 }
             }
             Ok(probe) => ctx.progress.note(&format!(
