@@ -79,7 +79,9 @@ class Samples:
     (``"converged"``/``"failed"``), ``iterations``, ``theta_p`` [rad], ``tan_theta_x``,
     ``tan_theta_y``, ``residual`` [N], ``slack_cables``, ``loose_joints`` (float, NaN where a
     record has none), ``reason`` (empty unless failed), and any other field the lines carry,
-    such as ``floating`` (a boolean: 1.0 or 0.0, NaN where a line has none). Read a field as
+    such as ``floating`` (a boolean: 1.0 or 0.0, NaN where a line has none) and
+    ``holding_force`` [N] (the largest force on a top node that, to first order, moves
+    θ_P by at most 1 % and lets no bearing member go; NaN where a line has none). Read a field as
     an attribute (``samples.theta_p``) or an item (``samples["theta_p"]``)."""
 
     def __init__(

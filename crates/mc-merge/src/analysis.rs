@@ -4,6 +4,7 @@
 use crate::bootstrap::{
     self, BootstrapConfig, QuantileReplicates, SortedSample, bootstrap_quantiles,
 };
+use crate::definitions::LOOSE_HOLDING_FORCE;
 use crate::gof::{self, CalibrationCache, GofConfig};
 use crate::load::CaseData;
 use crate::quantile::{order_statistic_interval, quantile_sorted};
@@ -24,10 +25,65 @@ pub struct CaseAnalysis {
     pub target_replicates: Vec<Option<f64>>,
 }
 
+/// The holding forces of a case's converged samples (see [`HoldingForces`]); `target` is
+/// the empirical target percentile of θ_P \[rad\], if any, whose tail is summarised apart.
+pub fn holding_forces(case: &CaseData, target: Option<f64>, conf: f64) -> HoldingForces {
+    let mut forces: Vec<f64> = case
+        .points()
+        .map(|p| p.holding)
+        .filter(|h| !h.is_nan())
+        .collect();
+    forces.sort_by(f64::total_cmp);
+    let loose = forces.iter().filter(|&&f| f < LOOSE_HOLDING_FORCE).count() as u64;
+    let (tail_recorded, tail_loose) = match target {
+        Some(t) => case
+            .points()
+            .filter(|p| p.theta > t && !p.holding.is_nan())
+            .fold((0u64, 0u64), |(n, k), p| {
+                (n + 1, k + u64::from(p.holding < LOOSE_HOLDING_FORCE))
+            }),
+        None => (0, 0),
+    };
+    let recorded = forces.len() as u64;
+    HoldingForces {
+        recorded,
+        percentiles: [5.0, 50.0, 95.0]
+            .iter()
+            .map(|&pct| {
+                let value = quantile_sorted(&forces, pct / 100.0).and_then(real);
+                HoldingPercentile {
+                    percentile: Real(pct),
+                    reason: value.is_none().then(|| {
+                        "no converged sample records a holding force (models whose bars \
+                         frame the tilt do not)"
+                            .into()
+                    }),
+                    value,
+                }
+            })
+            .collect(),
+        loose_below: Real(LOOSE_HOLDING_FORCE),
+        loose,
+        loose_fraction: clopper_pearson(loose, recorded, conf),
+        tail_recorded,
+        tail_loose,
+        tail_loose_fraction: clopper_pearson(tail_loose, tail_recorded, conf),
+    }
+}
+
 /// The caveats every figure of a case carries; `tail` is the fraction of samples above the
-/// target percentile (0.05 for P95).
-pub fn caveats(case: &CaseData, tail: f64) -> Vec<String> {
+/// target percentile (0.05 for P95), `holding` the case's holding forces.
+pub fn caveats(case: &CaseData, tail: f64, holding: &HoldingForces) -> Vec<String> {
     let mut out = vec![];
+    if holding.tail_loose > 0 {
+        out.push(format!(
+            "{} of the {} samples above the target percentile are held by less than 1 µN \
+             on a top node (holding force): a force that small, or a joint's friction the \
+             model leaves out, moves their θ_P by 1 % or more, so the target percentile \
+             rests on how the model resolves loose joints and slack cables",
+            holding.tail_loose, holding.tail_recorded
+        ));
+    }
     let (recorded, floating) = case.floating();
     if recorded > 0 && floating as f64 > tail * recorded as f64 {
         out.push(format!(
@@ -350,9 +406,11 @@ pub fn analyse_case(
     settings: &Settings,
     cache: &mut CalibrationCache,
 ) -> CaseAnalysis {
-    let caveats = caveats(case, 1.0 - settings.target_percentile / 100.0);
     let conf = settings.confidence;
     let sample = SortedSample::new(case.points().map(|p| (p.theta, p.index)).collect());
+    let empirical_target = quantile_sorted(&sample.values, settings.target_percentile / 100.0);
+    let holding = holding_forces(case, empirical_target, conf);
+    let caveats = caveats(case, 1.0 - settings.target_percentile / 100.0, &holding);
     let n = sample.len();
     let levels: Vec<f64> = settings.percentiles.iter().map(|p| p / 100.0).collect();
     let boot = (n >= 2).then(|| {
@@ -436,7 +494,6 @@ pub fn analyse_case(
         percentiles: rayleigh_pcts,
         caveats: caveats.clone(),
     };
-    let empirical_target = quantile_sorted(&sample.values, settings.target_percentile / 100.0);
     let gof = gof_report(
         &sample,
         fit.map(|f| f.sigma),
@@ -488,6 +545,7 @@ pub fn analyse_case(
             floating,
             fraction: clopper_pearson(floating, floating_recorded, conf),
         },
+        holding_force: holding,
         bootstrap: BootstrapCase {
             replicates: if boot.is_some() {
                 settings.replicates

@@ -40,6 +40,13 @@ pub const LOOSE: &str = "fraction of converged samples that record loose_joints 
 /// Floating stages.
 pub const FLOATING: &str = "fraction of converged samples that record floating with floating = true (some stage's tilt held by pretension alone, not by the members that bear), Clopper-Pearson exact interval; where it exceeds the tail the target percentile reads (1 - target/100), a case caveat says so";
 
+/// The holding force.
+pub const HOLDING: &str = "holding force [N] of a converged sample (recorded where floating is): the largest force on one node of the top surface, in any direction, that to first order moves θ_P by at most 1 % and lets no bearing one-sided member (a taut cable, a joint on its hole's edge) go, from the tangent stiffness at the equilibrium (0 where the equilibrium is not stable against some small load); percentiles by the θ_P percentile definition; loose: held by less than loose_below = 1e-6 N, Clopper-Pearson exact interval, among all samples that record it and among those above the target percentile of θ_P (tail); where any sample of the tail is loose, a case caveat says so";
+
+/// A sample held by less than this force \[N\] on a top node is loosely held (the holding
+/// force's summaries and caveat).
+pub const LOOSE_HOLDING_FORCE: f64 = 1e-6;
+
 /// The definitions block of the report.
 pub fn definitions(settings: &Settings) -> Definitions {
     Definitions {
@@ -61,5 +68,6 @@ pub fn definitions(settings: &Settings) -> Definitions {
         sweep: SWEEP,
         loose_joints: LOOSE,
         floating: FLOATING,
+        holding_force: HOLDING,
     }
 }

@@ -11,7 +11,8 @@
 //!   the case), `status` (`converged` or `failed`), `theta_p` \[rad\], `tan_theta_x` \[-\],
 //!   `tan_theta_y` \[-\], `iterations` (Newton iterations), `slack_cables` (slack
 //!   tension-only members), `loose_joints` (loose pin joints; empty for models without
-//!   joints). A field a sample does not have (the angles of a failed sample) is empty. Case
+//!   joints), `holding_force` \[N\] (the largest force on a top node that, to first order,
+//!   moves θ_P by at most 1 % and lets no bearing member go; empty where not recorded). A field a sample does not have (the angles of a failed sample) is empty. Case
 //!   names are quoted as RFC 4180 says when they hold a comma, a quote or a line break.
 //! - `.jsonl`: one object per sample with the same keys, absent fields as `null`.
 //!
@@ -38,7 +39,7 @@ use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
 /// The exported columns, in order.
-pub const COLUMNS: [&str; 10] = [
+pub const COLUMNS: [&str; 11] = [
     "index",
     "case",
     "sample",
@@ -49,6 +50,7 @@ pub const COLUMNS: [&str; 10] = [
     "iterations",
     "slack_cables",
     "loose_joints",
+    "holding_force",
 ];
 
 /// An export format, from the file's extension.
@@ -327,23 +329,23 @@ mod tests {
     /// case name with a comma and a quote is quoted.
     #[test]
     fn rows_copy_the_bytes() {
-        let line = br#"{"record":"sample","index":12,"case":"a,\"b\"","sample":2,"status":"converged","iterations":3,"theta_p":0.000015191290325887272,"tan_theta_x":-9.12659139265723e-6,"tan_theta_y":1e-5,"residual":7.5e-15,"slack_cables":6}"#;
+        let line = br#"{"record":"sample","index":12,"case":"a,\"b\"","sample":2,"status":"converged","iterations":3,"theta_p":0.000015191290325887272,"tan_theta_x":-9.12659139265723e-6,"tan_theta_y":1e-5,"residual":7.5e-15,"slack_cables":6,"floating":false,"holding_force":2.5e-9}"#;
         let fields = flat_fields(line).unwrap();
         let mut row = Vec::new();
         csv_row(&fields, &mut row);
         assert_eq!(
             String::from_utf8(row).unwrap(),
-            "12,\"a,\"\"b\"\"\",2,converged,0.000015191290325887272,-9.12659139265723e-6,1e-5,3,6,\n"
+            "12,\"a,\"\"b\"\"\",2,converged,0.000015191290325887272,-9.12659139265723e-6,1e-5,3,6,,2.5e-9\n"
         );
         let failed = br#"{"record":"sample","index":1,"case":"c","sample":1,"status":"failed","iterations":60,"reason":"Newton did not converge, {really}"}"#;
         let mut row = Vec::new();
         csv_row(&flat_fields(failed).unwrap(), &mut row);
-        assert_eq!(String::from_utf8(row).unwrap(), "1,c,1,failed,,,,60,,\n");
+        assert_eq!(String::from_utf8(row).unwrap(), "1,c,1,failed,,,,60,,,\n");
         let mut row = Vec::new();
         json_row(&flat_fields(failed).unwrap(), &mut row);
         let v: serde_json::Value = serde_json::from_slice(&row).unwrap();
         assert_eq!(v["status"], "failed");
-        assert!(v["theta_p"].is_null());
+        assert!(v["theta_p"].is_null() && v["holding_force"].is_null());
         assert!(flat_fields(br#"{"a":{"b":1}}"#).is_none());
     }
 }

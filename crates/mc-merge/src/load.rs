@@ -77,6 +77,8 @@ pub struct Point {
     pub tan_x: f64,
     /// tan θ_y (dimensionless).
     pub tan_y: f64,
+    /// The holding force \[N\] (NaN where the sample does not record it).
+    pub holding: f64,
 }
 
 #[derive(Debug, Default)]
@@ -90,6 +92,8 @@ struct Columns {
     loose: Vec<u8>,
     /// 0: not recorded, 1: not floating, 2: floating.
     floating: Vec<u8>,
+    /// The holding force \[N\]; NaN: not recorded.
+    holding: Vec<f64>,
 }
 
 fn zeroed<T: Clone>(n: usize, v: T) -> Result<Vec<T>, String> {
@@ -110,6 +114,7 @@ impl Columns {
             tan_y: zeroed(n, 0.0)?,
             loose: zeroed(n, 0)?,
             floating: zeroed(n, 0)?,
+            holding: zeroed(n, f64::NAN)?,
         })
     }
 }
@@ -152,6 +157,7 @@ impl CaseData {
                     theta: c.theta[k],
                     tan_x: c.tan_x[k],
                     tan_y: c.tan_y[k],
+                    holding: c.holding[k],
                 })
         })
     }
@@ -410,6 +416,8 @@ struct Rec {
     loose: u8,
     /// 0: not recorded, 1: not floating, 2: floating.
     floating: u8,
+    /// The holding force \[N\]; NaN: not recorded.
+    holding: f64,
     /// `Some` for a failed sample.
     reason: Option<Box<str>>,
 }
@@ -434,6 +442,7 @@ impl Rec {
                 Some(false) => 1,
                 Some(true) => 2,
             },
+            holding: s.holding_force.unwrap_or(f64::NAN),
             reason: match a {
                 Some(_) => None,
                 None => Some(s.reason.clone().unwrap_or_default().into_boxed_str()),
@@ -498,6 +507,7 @@ impl Store {
         cols.tan_y[k] = r.tan_y;
         cols.loose[k] = r.loose;
         cols.floating[k] = r.floating;
+        cols.holding[k] = r.holding;
         match r.reason {
             None => cols.state[k] = CONVERGED,
             Some(why) => {

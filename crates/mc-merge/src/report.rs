@@ -217,6 +217,8 @@ pub struct Definitions {
     pub loose_joints: &'static str,
     /// How the floating fraction is computed.
     pub floating: &'static str,
+    /// The holding force and its summaries.
+    pub holding_force: &'static str,
 }
 
 /// The bootstrap's definition and parameters.
@@ -261,6 +263,8 @@ pub struct CaseReport {
     pub loose_joints: LooseJoints,
     /// Fraction of samples with a floating stage.
     pub floating: Floating,
+    /// How firmly the samples are held: their holding forces.
+    pub holding_force: HoldingForces,
     /// Bootstrap bookkeeping.
     pub bootstrap: BootstrapCase,
     /// Empirical percentiles of θ_P with intervals.
@@ -312,6 +316,43 @@ pub struct Floating {
     pub floating: u64,
     /// `floating / recorded` with its Clopper–Pearson interval.
     pub fraction: Figure,
+}
+
+/// How firmly a case's samples are held: the distribution of their holding forces (the
+/// largest force on one top-surface node that, to first order, moves θ_P by at most 1 % and
+/// lets no bearing one-sided member go), written where the samples record it.
+#[derive(Debug, Clone, Serialize)]
+pub struct HoldingForces {
+    /// Converged samples that record `holding_force`.
+    pub recorded: u64,
+    /// Its 5th, 50th and 95th percentiles \[N\] (the percentile definition of θ_P's).
+    pub percentiles: Vec<HoldingPercentile>,
+    /// The force below which a sample counts as loosely held \[N\]: 1e-6 (1 µN).
+    pub loose_below: Real,
+    /// Samples held by less than `loose_below`, with their fraction of `recorded` and its
+    /// Clopper–Pearson interval.
+    pub loose: u64,
+    /// `loose / recorded` with its Clopper–Pearson interval.
+    pub loose_fraction: Figure,
+    /// Of the samples above the target percentile of θ_P that record a holding force, how
+    /// many.
+    pub tail_recorded: u64,
+    /// Of those, how many are held by less than `loose_below`.
+    pub tail_loose: u64,
+    /// `tail_loose / tail_recorded` with its Clopper–Pearson interval.
+    pub tail_loose_fraction: Figure,
+}
+
+/// One percentile of the holding force.
+#[derive(Debug, Clone, Serialize)]
+pub struct HoldingPercentile {
+    /// The percentile, in percent.
+    pub percentile: Real,
+    /// The holding force \[N\]; null where no sample records one.
+    pub value: Option<Real>,
+    /// Why the value is null.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 /// Bootstrap bookkeeping of a case.

@@ -66,6 +66,7 @@ pub fn record(job: &Job, r: &SampleResult) -> Sample {
         slack_cables: None,
         loose_joints: None,
         floating: None,
+        holding_force: None,
         reason: None,
     };
     match &r.outcome {
@@ -77,6 +78,7 @@ pub fn record(job: &Job, r: &SampleResult) -> Sample {
             slack_cables: Some(c.slack_cables),
             loose_joints: c.loose_joints,
             floating: c.floating,
+            holding_force: c.holding_force,
             ..base
         },
         Outcome::Failed(reason) => Sample {

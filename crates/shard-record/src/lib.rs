@@ -31,7 +31,10 @@
 //!      (how many tension-only members ended slack), `loose_joints` (backlash joints whose
 //!      virtual cable ended slack) and `floating` (`true` when some stage's tilt is held by
 //!      pretension alone, not by the members that bear; written for models whose bars do
-//!      not frame the top surface's tilt, such as the prism with pin joints in free play);
+//!      not frame the top surface's tilt, such as the prism with pin joints in free play)
+//!      and, where `floating` is written, `holding_force` (N: the smallest force on one
+//!      node of the top surface that moves θ_P by 1 %, in the linear response at the
+//!      equilibrium; 0 where that equilibrium is not stable against some small load);
 //!    - when failed: `reason`, a sentence saying why.
 //!
 //!    A failed solve is a line with its status, never a missing line.
@@ -283,6 +286,11 @@ pub struct Sample {
     /// (a floating stage); written for models whose bars do not frame the tilt.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub floating: Option<bool>,
+    /// The holding force \[N\]: the smallest force on one node of the top surface that moves
+    /// θ_P by 1 % (linear response at the equilibrium; 0 where the equilibrium is not
+    /// stable against some small load); written where `floating` is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub holding_force: Option<f64>,
     /// Why the solve failed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
@@ -322,10 +330,18 @@ impl Sample {
     }
 
     /// Checks that the fields present agree with `status`: a converged sample carries three
-    /// finite angles with θ_P ≥ 0; a failed one carries a reason.
+    /// finite angles with θ_P ≥ 0, and a holding force, where it has one, finite and ≥ 0; a
+    /// failed one carries a reason.
     pub fn check(&self) -> Result<(), String> {
         match self.status {
             Status::Converged => match self.angles() {
+                Some(_)
+                    if self
+                        .holding_force
+                        .is_some_and(|f| !(f.is_finite() && f >= 0.0)) =>
+                {
+                    Err("holding_force must be a finite number of newtons ≥ 0".into())
+                }
                 Some(a) if a.theta_p >= 0.0 => Ok(()),
                 Some(_) => Err("theta_p is negative".into()),
                 None => Err(

@@ -48,6 +48,7 @@ fn sample(index: u64, theta: f64) -> Sample {
         slack_cables: Some(2),
         loose_joints: None,
         floating: None,
+        holding_force: None,
         reason: None,
     }
 }
@@ -173,6 +174,21 @@ fn converged_without_angles_is_refused() {
     assert!(s.check().is_err());
     s.theta_p = Some(f64::NAN);
     assert!(s.check().is_err());
+}
+
+/// A holding force must be a finite number of newtons ≥ 0 where a sample has one.
+#[test]
+fn a_holding_force_that_is_no_force_is_refused() {
+    let mut s = sample(0, 1e-5);
+    for ok in [None, Some(0.0), Some(2.5e-9)] {
+        s.holding_force = ok;
+        assert!(s.check().is_ok(), "{ok:?}");
+    }
+    for bad in [-1e-9, f64::NAN, f64::INFINITY] {
+        s.holding_force = Some(bad);
+        let err = s.check().unwrap_err();
+        assert!(err.contains("holding_force"), "{bad}: {err}");
+    }
 }
 
 #[test]

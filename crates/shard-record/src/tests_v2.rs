@@ -43,6 +43,7 @@ fn sample(index: u64) -> Sample {
         slack_cables: None,
         loose_joints: None,
         floating: None,
+        holding_force: None,
         reason: (index == 3).then(|| "Newton did not converge".to_string()),
     }
 }

@@ -59,9 +59,83 @@ pub fn distortion(x: [[f64; 3]; 3], u: [[f64; 3]; 3], n_b: [f64; 3]) -> Distorti
     }
 }
 
+/// The gradient of θ_P with respect to the three nodes' displacements, `∂θ_P/∂u_k` \[rad/mm\]
+/// (rows in the nodes' order), at the point [`distortion`] measures; `None` where θ_P = 0
+/// (its gradient is not defined there) or the surface is degenerate.
+///
+/// With `n = e₁ × e₂` (`e₁ = p₂ − p₁`, `e₂ = p₃ − p₁`), `w = n × n_b`, `s = |w|`, `c = n·n_b`:
+///
+/// ```text
+/// ∂s/∂n = (n_b × w)/s,   ∂c/∂n = n_b,   a = ∂θ_P/∂n = (c·∂s/∂n − s·∂c/∂n)/(s² + c²)
+/// δθ_P = a·(δe₁ × e₂ + e₁ × δe₂)  ⇒  ∂θ_P/∂u₂ = e₂ × a,  ∂θ_P/∂u₃ = a × e₁,
+///                                     ∂θ_P/∂u₁ = −(∂θ_P/∂u₂ + ∂θ_P/∂u₃)
+/// ```
+pub fn theta_gradient(x: [[f64; 3]; 3], u: [[f64; 3]; 3], n_b: [f64; 3]) -> Option<[[f64; 3]; 3]> {
+    let e1 = add(sub(x[1], x[0]), sub(u[1], u[0]));
+    let e2 = add(sub(x[2], x[0]), sub(u[2], u[0]));
+    let n = cross(e1, e2);
+    let w = cross(n, n_b);
+    let s = norm(w);
+    let c = dot(n, n_b);
+    let r2 = s * s + c * c;
+    if !(s > 0.0 && r2 > 0.0 && r2.is_finite()) {
+        return None;
+    }
+    let ds = cross(n_b, w);
+    let a = [
+        (c * ds[0] / s - s * n_b[0]) / r2,
+        (c * ds[1] / s - s * n_b[1]) / r2,
+        (c * ds[2] / s - s * n_b[2]) / r2,
+    ];
+    let g2 = cross(e2, a);
+    let g3 = cross(a, e1);
+    let g1 = [-(g2[0] + g3[0]), -(g2[1] + g3[1]), -(g2[2] + g3[2])];
+    Some([g1, g2, g3])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`theta_gradient`] against central differences of [`distortion`] on a tilted,
+    /// displaced triangle and a reference normal off the axes.
+    #[test]
+    fn theta_gradient_matches_central_differences() {
+        let x = [
+            [0.0, 0.0, 1900.0],
+            [380.0, 0.0, 1900.0],
+            [190.0, 329.09, 1900.0],
+        ];
+        let u = [
+            [0.011, -0.004, 0.021],
+            [-0.007, 0.013, -0.018],
+            [0.002, 0.009, 0.034],
+        ];
+        let nb = {
+            let v = [0.01, -0.02, 1.0];
+            let l = norm(v);
+            [v[0] / l, v[1] / l, v[2] / l]
+        };
+        let g = theta_gradient(x, u, nb).unwrap();
+        let largest = g.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let h = 1e-6;
+        for k in 0..3 {
+            for d in 0..3 {
+                let (mut up, mut down) = (u, u);
+                up[k][d] += h;
+                down[k][d] -= h;
+                let fd =
+                    (distortion(x, up, nb).theta_p - distortion(x, down, nb).theta_p) / (2.0 * h);
+                assert!(
+                    (fd - g[k][d]).abs() <= 1e-6 * largest,
+                    "node {k} dir {d}: {fd} vs {}",
+                    g[k][d]
+                );
+            }
+        }
+        // A flat, undisplaced surface against its own normal: θ_P = 0, no gradient.
+        assert!(theta_gradient(x, [[0.0; 3]; 3], [0.0, 0.0, 1.0]).is_none());
+    }
 
     /// Paper eqs. 8, 9 and 17: for vertical displacements of an equilateral triangle of side
     /// `l` in the plane z = 0, tan θ_x = (z₂ − z₁)/l and tan θ_y = (2z₃ − z₁ − z₂)/(√3·l),

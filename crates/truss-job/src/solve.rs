@@ -24,6 +24,9 @@ pub struct Converged {
     /// Whether some stage's tilt is held by pretension alone (see
     /// [`truss_core::limit`]), for a model whose bars do not frame the tilt.
     pub floating: Option<bool>,
+    /// The holding force \[N\]: the smallest force on one top-surface node that moves θ_P
+    /// by 1 % (see [`truss_core::SolveReport::holding_force`]); where `floating` is given.
+    pub holding_force: Option<f64>,
 }
 
 /// How a sample ended.
@@ -139,6 +142,7 @@ impl<'j> SampleSolver<'j> {
                         slack_cables: report.slack_cables,
                         loose_joints: has_joints.then_some(report.loose_joints),
                         floating: (!case.structure.tilt_framed()).then_some(report.floating),
+                        holding_force: report.holding_force,
                     }),
                     Some(_) => Outcome::Failed("the top surface's angles are not finite".into()),
                     None => Outcome::Failed("the model names no top surface to measure".into()),

@@ -89,11 +89,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "62b7ba44d8cf23420c8d8b1236bbd72d0115787cdb32f970c3d839743400426e",
+        "eff1ebfec9e37a41ac7d6f085613e96c8dda168b569ac5e37aac842a050c7d87",
         "250ebc35d731f68192faca6b4669b8f390d78b9f27cebefb5b7b50bee177ec38",
-        "45ae317fcd3f2c30de3de463854d13b33db21beceae65d44bfeb56ca9df061d8",
+        "098aa180429d0cc97595bed509b793c37bb7f0b0d30d29c5cf63ec6347cd8528",
         "7f95eed1a842b547589bf84637c37505cc0c2cfdc91b76242878045a89080f26",
-        "359730580b0421a9ff472d1e789583d2187a43b1cb3f11d1ed2409dfa04d95bf",
+        "95691c3b1c3819a508808f3facd918ce6a7864e2a042b0a408d51c5eef8d582d",
     ];
     for (what, (g, w)) in [
         "job id",

@@ -509,6 +509,79 @@ fn completions_and_man_page() {
     );
 }
 
+/// The holding forces of a case, against the same figures computed here from the samples:
+/// the 5th, 50th and 95th percentiles (definition 1: the `⌈p·n⌉`-th smallest), the samples
+/// held by less than 1 µN among all and among those above θ_P95, and a caveat naming the
+/// latter; a case that records none reports none and no caveat.
+#[test]
+fn holding_forces_are_summarised_and_a_loosely_held_tail_is_named() {
+    let mut loose = SynthCase::rayleigh("loose", 400, 2e-5, &[("sigma", 0.0067)]);
+    loose.floating_every = Some(4);
+    let framed = SynthCase::rayleigh("framed", 400, 2e-5, &[("sigma", 0.05)]);
+    let job = SynthJob::new(11, vec![loose, framed]);
+    let dir = tempfile::tempdir().unwrap();
+    job.write_split(dir.path(), 3);
+    let out = dir.path().join("report");
+    let run = mc_merge(
+        &["--out", out.to_str().unwrap()],
+        &[dir.path().to_path_buf()],
+    );
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let v: Value = serde_json::from_str(&report(&out)).unwrap();
+    let h = &v["cases"][0]["holding_force"];
+    let samples: Vec<_> = (0..400).map(|i| job.sample(i)).collect();
+    let mut forces: Vec<f64> = samples.iter().map(|s| s.holding_force.unwrap()).collect();
+    forces.sort_by(f64::total_cmp);
+    let nth = |p: f64| forces[(p * 400.0_f64).ceil() as usize - 1];
+    assert_eq!(h["recorded"], 400);
+    for (i, p) in [0.05, 0.5, 0.95].iter().enumerate() {
+        assert_eq!(
+            h["percentiles"][i]["value"].as_f64().unwrap(),
+            nth(*p),
+            "{p}"
+        );
+    }
+    let mut thetas: Vec<f64> = samples.iter().map(|s| s.theta_p.unwrap()).collect();
+    thetas.sort_by(f64::total_cmp);
+    let p95 = thetas[(0.95 * 400.0_f64).ceil() as usize - 1];
+    let tail: Vec<_> = samples
+        .iter()
+        .filter(|s| s.theta_p.unwrap() > p95)
+        .collect();
+    let tail_loose = tail
+        .iter()
+        .filter(|s| s.holding_force.unwrap() < 1e-6)
+        .count();
+    assert_eq!(h["loose"], 100);
+    assert_eq!(h["loose_fraction"]["value"], 0.25);
+    assert_eq!(h["tail_recorded"], tail.len());
+    assert_eq!(h["tail_loose"], tail_loose);
+    assert!(
+        tail_loose > 0,
+        "the synthetic tail holds a loosely held sample"
+    );
+    let caveats = v["cases"][0]["caveats"].as_array().unwrap();
+    let named = format!("{tail_loose} of the {} samples above", tail.len());
+    assert!(
+        caveats
+            .iter()
+            .any(|c| c.as_str().unwrap().starts_with(&named)),
+        "{caveats:?}"
+    );
+    let framed = &v["cases"][1];
+    assert_eq!(framed["holding_force"]["recorded"], 0);
+    assert!(framed["holding_force"]["percentiles"][1]["value"].is_null());
+    assert!(
+        !framed["caveats"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|c| c.as_str().unwrap().contains("held by less than 1 µN"))
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("Holding forces [N]"), "{md}");
+}
+
 /// The fraction of samples with a floating stage, per case, with its Clopper–Pearson
 /// interval; where it exceeds the 5 % tail that θ_P95 reads, a caveat says that the upper
 /// percentiles rest on what the model leaves out and names the lever. Cases whose lines do

@@ -66,7 +66,7 @@ fn csv_export_has_one_row_per_sample_with_the_shard_bytes() {
     let mut rows = text.lines();
     assert_eq!(
         rows.next().unwrap(),
-        "index,case,sample,status,theta_p,tan_theta_x,tan_theta_y,iterations,slack_cables,loose_joints"
+        "index,case,sample,status,theta_p,tan_theta_x,tan_theta_y,iterations,slack_cables,loose_joints,holding_force"
     );
     let rows: Vec<&str> = rows.collect();
     let lines = shard_lines(&files);

@@ -146,11 +146,11 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "2c8241470acad2f26673cfd172c5a0faf03528e4c36c7eb12483af57bc53e98e"
+        "56288efb7ae33d0035c9b0894f623bef5c5a861bf21b2f4377079669b469cfa2"
     );
     assert_eq!(
         digest,
-        "81ca9febb6d271fec822e422055fdf74ae8d7a042732d7a64e9e7dda75415b74"
+        "0800f1eff1ff051fe373207d684753017c20717f6ca9d5b95982594742a6b0b1"
     );
 }
 

@@ -82,12 +82,15 @@ use crate::measure::{Distortion, distortion};
 use crate::structure::Structure;
 use crate::{ModelError, SolveError};
 use evaluate::{Evaluation, dot_n};
+pub use held::{HOLDING_FRACTION, Holding, HoldingLimit};
 use lanes::{Kernels, finish};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 mod evaluate;
 mod floating;
+mod held;
+mod holding;
 pub mod lanes;
 mod line_search;
 mod newton;
@@ -170,6 +173,12 @@ pub struct SolveReport {
     /// the members that bear (a *floating* stage; see [`crate::limit`]): the answer then
     /// rests on effects the model leaves out. Never where the model's bars frame the tilt.
     pub floating: bool,
+    /// The holding force \[N\]: the largest force on one node of the top surface that, to
+    /// first order, moves θ_P by at most 1 % and makes no bearing one-sided member let go
+    /// (0 where the equilibrium is not stable against some small load; see
+    /// [`Solver::holding`]). Computed, like [`SolveReport::floating`], only where the
+    /// model's bars do not frame the tilt.
+    pub holding_force: Option<f64>,
 }
 
 /// One Newton iteration, recorded when [`SolveOptions::record_iterations`] is set.
@@ -241,6 +250,8 @@ pub struct Solver {
     step: StepState,
     log: Vec<IterationRecord>,
     last: Option<SolveReport>,
+    /// The last converged sample's holding force and the load that reaches it.
+    holding: Option<Holding>,
     evaluations: u32,
     /// The last chord step's secant minimiser along its line, relative to that step
     /// (NaN when the last step was not a chord step, or switched a one-sided member):
@@ -287,6 +298,11 @@ struct Workspace {
     trial_u: Vec<f64>,
     trial_r: Vec<f64>,
     scratch: Vec<f64>,
+    /// `∂θ_P/∂u` for the holding force (see the `holding` module).
+    holding_gradient: Vec<f64>,
+    /// Each member's rates of axial force per unit load along x, y, z at one top node
+    /// \[N/N\] (see the `holding` module).
+    holding_rates: Vec<[f64; 3]>,
     stretch: Vec<f64>,
     breakpoints: Vec<(f64, f64)>,
     failures: Vec<crate::block::PivotFailure>,
@@ -358,6 +374,8 @@ impl Solver {
                 trial_u: vec![0.0; n + 1],
                 trial_r: vec![0.0; n + 1],
                 scratch: vec![0.0; n + 1],
+                holding_gradient: vec![0.0; n + 1],
+                holding_rates: vec![[0.0; 3]; m],
                 stretch: vec![0.0; m],
                 breakpoints: Vec::with_capacity(m),
                 failures: Vec::with_capacity(64),
@@ -376,6 +394,7 @@ impl Solver {
             },
             log: Vec::new(),
             last: None,
+            holding: None,
             evaluations: 0,
             chord_secant: f64::NAN,
             sample_key: (SOLVERS.fetch_add(1, Ordering::Relaxed) as usize, 0),
@@ -415,6 +434,7 @@ impl Solver {
         kernels: Kernels<'_>,
     ) -> Result<SolveReport, SolveError> {
         self.last = None;
+        self.holding = None;
         self.log.clear();
         self.evaluations = 0;
         self.sample_key.1 += 1;
@@ -512,6 +532,12 @@ impl Solver {
         self.last
     }
 
+    /// The last successful solve's holding force, with the load on the top surface that
+    /// reaches it and what it reaches (see [`SolveReport::holding_force`]).
+    pub fn holding(&self) -> Option<Holding> {
+        self.holding
+    }
+
     /// Displacement of node `node` at the last equilibrium \[mm\]: a hole node's is its
     /// shaft's plus its joint's offset.
     pub fn displacement(&self, node: usize) -> [f64; 3] {
@@ -577,6 +603,13 @@ impl Solver {
     /// Whether model member `m` is a slack cable at the last equilibrium.
     pub fn is_slack(&self, m: usize) -> bool {
         self.structure.members[m].band.is_none() && self.work.states[m].slack
+    }
+
+    /// Whether compiled member `m` (a model member, or the compression-only half of a
+    /// member in clearance holes, numbered after the model's members, as in
+    /// [`HoldingLimit::Release`]) is slack at the last equilibrium.
+    pub fn compiled_member_slack(&self, m: usize) -> bool {
+        self.work.states[m].slack
     }
 
     /// Number of the model's cables that are slack at the current point.

@@ -166,6 +166,8 @@ impl Solver {
                 break;
             }
         }
+        let floating = self.floating();
+        self.holding = self.compute_holding(kernels).await;
         Ok(SolveReport {
             iterations: p.iterations,
             factorisations: p.factorisations,
@@ -175,7 +177,8 @@ impl Solver {
             evaluations: self.evaluations,
             loose_joints: self.loose_joint_count(),
             soft_directions: p.soft_directions,
-            floating: self.floating(),
+            floating,
+            holding_force: self.holding.map(|h| h.force),
         })
     }
 

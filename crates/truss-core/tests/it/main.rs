@@ -4,6 +4,7 @@
 mod backlash;
 mod common;
 mod hand_solutions;
+mod holding;
 mod invariance;
 mod limit;
 mod model_errors;

@@ -152,6 +152,12 @@ impl SynthJob {
                 .floating_every
                 .filter(|_| !failed)
                 .map(|n| k.is_multiple_of(n)),
+            // Where `floating` is recorded: a floating sample held by nanonewtons, the
+            // others by millinewtons, each times 1 to 7.
+            holding_force: case.floating_every.filter(|_| !failed).map(|n| {
+                let scale = if k.is_multiple_of(n) { 1e-9 } else { 1e-3 };
+                scale * (1 + k % 7) as f64
+            }),
             reason: failed
                 .then(|| format!("Newton did not converge in 60 iterations (sample {k})")),
         }
