@@ -1,36 +1,46 @@
 //! A writer's output directory: locked while it writes, and a manifest of what it wrote, so
-//! that a rerun removes only its own earlier files.
+//! that a rerun removes or replaces only files it can prove it wrote.
 //!
 //! [`OutputDir::open`] creates the directory the user named (links are followed there: the
 //! user chose the path), takes the lock of `.truss-mc.lock` in it ([`LOCK_FILE`]: one writer
 //! at a time, every writer of the workspace alike; a second is refused with
 //! [`RunDirError::Locked`] rather than left to wait behind a run that may take long), and
-//! reads the writer's manifest `.WRITER.manifest`: a comment line, then the name of each file
-//! the writer wrote in the directory, one a line.
+//! reads the writer's manifest `.WRITER.manifest` ([`crate::record`]: trusted only when it is
+//! the writer's own, whole and unedited; each file listed with its device, inode, size and
+//! SHA-256).
 //!
-//! [`OutputDir::write`] lists a new name in the manifest *before* it writes the file (so a
-//! crash never leaves a file of ours unlisted), then writes it as [`crate::write_file`] does.
-//! [`OutputDir::finish`] removes the files of the earlier manifest that this run did not
-//! write again (a renamed case's plots, the plots of a run with plots when this one has
-//! none), and the temporary files a killed run of ours left, and writes the manifest of
-//! this run. Only regular files are removed: a link or a directory at a listed name is left
-//! as it is. A directory without a manifest (written before manifests existed) loses
-//! nothing: its files of the same names are replaced, and no other file is touched.
+//! **Replacing.** [`OutputDir::write`] writes a name only when nothing is there, or the file
+//! there is provably the writer's: its manifest lists it with the identity it still has, or
+//! claims the name (below), or this run wrote it. Any other file at the name (a user's, another
+//! writer's such as a diagnosis's `theta_p-ecdf-before.svg`, one edited since) is refused with
+//! [`RunDirError::NotOurs`], naming it and, when another writer's manifest lists it, that
+//! writer: the file is left as it is. [`OutputDir::check`] makes the same check for every name
+//! before any work, so a refusal never leaves a half-updated directory. A new name is listed
+//! as a `claim` *before* it is written, so a crash never leaves a file of ours unlisted.
+//!
+//! **Removing.** [`OutputDir::finish`] removes the files of the earlier manifest that this run
+//! did not write again (a renamed case's plots, the plots of a run with plots when this one
+//! has none), but only those that are still the very file listed; a listed file that changed,
+//! a name only claimed, the lock file and any manifest are kept, and each kept file is named
+//! in one line on stderr (`warning: …`; the run still succeeds). It removes the temporary
+//! files a killed run of ours left (`.NAME.tmp-` and exactly 16 hex digits, NAME one of our
+//! names, owned by this user), and writes the manifest of this run. An untrusted manifest
+//! (another user's, writable by others, edited, or of an older format) lists nothing: it is
+//! named in one line on stderr and replaced by this run's.
 
 use crate::errors::RunDirError;
 use crate::input::open_own;
 use crate::lock::{Lock, try_lock};
-use crate::output::{TEMP_INFIX, write_file};
-use std::collections::BTreeSet;
+use crate::output::OutputFile;
+use crate::record::{self, Entry, Identity};
+use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
-use std::io::Read;
+use std::io::{Read, Write};
+use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 
 /// The lock file of an output directory.
 pub const LOCK_FILE: &str = ".truss-mc.lock";
-
-/// The longest manifest read \[bytes\]: a million plot names.
-pub const MAX_MANIFEST_BYTES: u64 = 64 << 20;
 
 /// The manifest file of `writer`.
 pub fn manifest_name(writer: &str) -> String {
@@ -43,6 +53,14 @@ pub fn is_plain_name(name: &str) -> bool {
     !name.is_empty() && name != "." && name != ".." && !name.contains(['/', '\n', '\r', '\0'])
 }
 
+/// Whether `name` is never removed by a writer: the lock file, or a manifest.
+fn is_kept_always(name: &str) -> bool {
+    name == LOCK_FILE || (name.starts_with('.') && name.ends_with(".manifest"))
+}
+
+/// What a writer's earlier manifest gives it: the entries, or why it is not trusted.
+type Earlier = Result<BTreeMap<String, Entry>, String>;
+
 /// An output directory being written by one writer (see the module doc).
 #[derive(Debug)]
 pub struct OutputDir {
@@ -50,12 +68,14 @@ pub struct OutputDir {
     writer: String,
     /// Held until the writer is done.
     _lock: File,
-    /// What the previous run listed.
-    earlier: BTreeSet<String>,
+    /// What the previous run's trusted manifest listed, or why it is not trusted.
+    earlier: Earlier,
     /// What the manifest on disk lists now.
-    listed: BTreeSet<String>,
-    /// What this run wrote, in order.
-    written: Vec<String>,
+    listed: BTreeMap<String, Entry>,
+    /// What this run wrote.
+    written: BTreeMap<String, Identity>,
+    /// The warnings printed, one line each.
+    warnings: Vec<String>,
 }
 
 impl OutputDir {
@@ -76,23 +96,45 @@ impl OutputDir {
                 });
             }
         }
-        let earlier = read_manifest(&dir.join(manifest_name(writer)))?;
-        Ok(Self {
+        let manifest = dir.join(manifest_name(writer));
+        let earlier = record::read(&manifest)?;
+        let mut out = Self {
             dir: dir.to_path_buf(),
             writer: writer.to_string(),
             _lock: lock,
-            listed: earlier.clone(),
+            listed: earlier.clone().unwrap_or_default(),
             earlier,
-            written: Vec::new(),
-        })
+            written: BTreeMap::new(),
+            warnings: Vec::new(),
+        };
+        if let Err(why) = &out.earlier {
+            out.warn(format!(
+                "{}: not trusted ({why}); no file it lists is removed or replaced",
+                manifest.display()
+            ));
+        }
+        Ok(out)
     }
 
     /// Refuses, before any work and without creating anything, the names among `names` in
-    /// `dir` that could not be written: a link or a non-file stands there.
-    pub fn check(dir: &Path, names: &[&str]) -> Result<(), RunDirError> {
+    /// `dir` that `writer` could not write: a link or a non-file stands there, or a file
+    /// it cannot prove it wrote (see the module doc).
+    pub fn check(dir: &Path, writer: &str, names: &[&str]) -> Result<(), RunDirError> {
+        let earlier = match std::fs::symlink_metadata(dir) {
+            Ok(_) => record::read(&dir.join(manifest_name(writer)))?,
+            Err(_) => Ok(BTreeMap::new()),
+        };
         names
             .iter()
-            .try_for_each(|n| crate::output::check_final(&dir.join(n)))
+            .try_for_each(|n| provable(dir, writer, &earlier, &BTreeMap::new(), n))
+    }
+
+    /// Like [`OutputDir::check`], under the lock: refuses the first of `names` this writer
+    /// could not write.
+    pub fn check_names<S: AsRef<str>>(&self, names: &[S]) -> Result<(), RunDirError> {
+        names.iter().try_for_each(|n| {
+            provable(&self.dir, &self.writer, &self.earlier, &self.written, n.as_ref())
+        })
     }
 
     /// The directory.
@@ -100,94 +142,177 @@ impl OutputDir {
         &self.dir
     }
 
-    /// The files the writer's previous run wrote here, by name.
-    pub fn earlier(&self) -> &BTreeSet<String> {
-        &self.earlier
+    /// The files the writer's previous run wrote here, by name, as its trusted manifest
+    /// lists them (none when it is not trusted).
+    pub fn earlier(&self) -> BTreeMap<String, Entry> {
+        self.earlier.clone().unwrap_or_default()
     }
 
-    /// Writes the file `name` (a plain file name) in the directory: listed in the manifest
-    /// first, then written whole through a temporary file; refused at a link or a non-file.
-    /// Returns its path.
+    /// The warnings this writer printed so far, one line each.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Writes the file `name` (a plain file name) in the directory: refused at a link, a
+    /// non-file or a file not provably ours; listed in the manifest first, then written whole
+    /// through a temporary file. Returns its path.
     pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<PathBuf, RunDirError> {
         let path = self.dir.join(name);
-        if !is_plain_name(name) {
+        if !is_plain_name(name) || is_kept_always(name) {
             return Err(RunDirError::io(
                 path,
                 std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a plain file name"),
             ));
         }
-        if !self.listed.contains(name) {
-            self.listed.insert(name.to_string());
+        provable(&self.dir, &self.writer, &self.earlier, &self.written, name)?;
+        if !self.listed.contains_key(name) {
+            self.listed.insert(name.to_string(), Entry::Claim);
             self.save(&self.listed)?;
         }
-        write_file(&path, bytes)?;
-        self.written.push(name.to_string());
+        let mut out = OutputFile::create(&path)?;
+        out.write_all(bytes).map_err(|e| RunDirError::io(&path, e))?;
+        let id = out.commit_identity(bytes)?;
+        self.listed.insert(name.to_string(), Entry::File(id.clone()));
+        self.written.insert(name.to_string(), id);
         Ok(path)
     }
 
-    /// Removes the earlier run's files this run did not write again and our stale
-    /// temporary files, and writes the manifest of this run.
-    pub fn finish(self) -> Result<(), RunDirError> {
-        let written: BTreeSet<String> = self.written.iter().cloned().collect();
-        for name in self.earlier.difference(&written) {
-            remove_regular(&self.dir.join(name))?;
+    /// Removes the earlier run's files this run did not write again, when each is still the
+    /// file listed (else it is kept and named on stderr), and our stale temporary files; writes
+    /// the manifest of this run. Returns the warnings printed.
+    pub fn finish(mut self) -> Result<Vec<String>, RunDirError> {
+        let earlier = self.earlier.clone().unwrap_or_default();
+        for (name, entry) in &earlier {
+            if self.written.contains_key(name) || is_kept_always(name) {
+                continue;
+            }
+            let path = self.dir.join(name);
+            let there = std::fs::symlink_metadata(&path).is_ok();
+            match entry {
+                Entry::File(id) if id.matches(&path)? => {
+                    std::fs::remove_file(&path).map_err(|e| RunDirError::io(&path, e))?;
+                }
+                Entry::File(_) if there => self.warn(format!(
+                    "{}: kept: it is not the file {} wrote here (changed or replaced since)",
+                    path.display(),
+                    self.writer
+                )),
+                Entry::Claim if there => self.warn(format!(
+                    "{}: kept: an earlier {} run was stopped before it could record this file",
+                    path.display(),
+                    self.writer
+                )),
+                Entry::File(_) | Entry::Claim => {}
+            }
         }
+        self.remove_stale_temporaries()?;
+        let mine: BTreeMap<String, Entry> = self
+            .written
+            .iter()
+            .map(|(n, id)| (n.clone(), Entry::File(id.clone())))
+            .collect();
+        self.save(&mine)?;
+        Ok(self.warnings)
+    }
+
+    /// Removes `.NAME.tmp-` + 16 hex digits where NAME is one of ours, owned by this user.
+    fn remove_stale_temporaries(&self) -> Result<(), RunDirError> {
+        let me = rustix::process::geteuid().as_raw();
         let entries = std::fs::read_dir(&self.dir).map_err(|e| RunDirError::io(&self.dir, e))?;
         for entry in entries {
             let entry = entry.map_err(|e| RunDirError::io(&self.dir, e))?;
             let name = entry.file_name();
             let Some(name) = name.to_str() else { continue };
-            let stale = name
-                .strip_prefix('.')
-                .and_then(|n| n.rsplit_once(TEMP_INFIX))
-                .is_some_and(|(base, _)| self.listed.contains(base));
-            if stale {
-                remove_regular(&entry.path())?;
+            let ours = crate::output::temporary_base(name).is_some_and(|base| {
+                self.listed.contains_key(base) && !is_kept_always(base)
+            });
+            if !ours {
+                continue;
+            }
+            let path = entry.path();
+            match std::fs::symlink_metadata(&path) {
+                Ok(m) if m.is_file() && m.uid() == me && m.nlink() == 1 => {
+                    std::fs::remove_file(&path).map_err(|e| RunDirError::io(&path, e))?;
+                }
+                _ => {}
             }
         }
-        self.save(&written)
+        Ok(())
     }
 
-    fn save(&self, names: &BTreeSet<String>) -> Result<(), RunDirError> {
-        let mut text = format!(
-            "# the files {} wrote in this directory; a rerun removes only these\n",
-            self.writer
-        );
-        for n in names {
-            text.push_str(n);
-            text.push('\n');
-        }
-        write_file(&self.dir.join(manifest_name(&self.writer)), text.as_bytes())
+    fn warn(&mut self, line: String) {
+        eprintln!("warning: {line}");
+        self.warnings.push(line);
+    }
+
+    fn save(&self, entries: &BTreeMap<String, Entry>) -> Result<(), RunDirError> {
+        let path = self.dir.join(manifest_name(&self.writer));
+        crate::write_file(&path, record::render(entries).as_bytes())
     }
 }
 
-/// Removes `path` if it is a regular file (never a link's target, never a directory).
-fn remove_regular(path: &Path) -> Result<(), RunDirError> {
-    match std::fs::symlink_metadata(path) {
-        Ok(m) if m.is_file() => std::fs::remove_file(path).map_err(|e| RunDirError::io(path, e)),
-        _ => Ok(()),
+/// Refuses `name` in `dir` unless `writer` may write it: nothing there, or a regular file
+/// this run wrote, or one its trusted earlier manifest lists with the identity it has (or
+/// claims). A link or a non-file is refused as [`crate::output::check_final`] does.
+fn provable(
+    dir: &Path,
+    writer: &str,
+    earlier: &Earlier,
+    written: &BTreeMap<String, Identity>,
+    name: &str,
+) -> Result<(), RunDirError> {
+    let path = dir.join(name);
+    crate::output::check_final(&path)?;
+    if std::fs::symlink_metadata(&path).is_err() {
+        return Ok(());
     }
-}
-
-/// The names a manifest lists (none if it does not exist); lines that are not plain names
-/// are ignored.
-fn read_manifest(path: &Path) -> Result<BTreeSet<String>, RunDirError> {
-    let file = match open_own(path, OpenOptions::new().read(true)) {
-        Ok(f) => f,
-        Err(RunDirError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
-            return Ok(BTreeSet::new());
-        }
-        Err(e) => return Err(e),
+    let listed = match earlier {
+        Ok(entries) => entries.get(name),
+        Err(_) => None,
     };
-    let mut bytes = Vec::new();
-    file.take(MAX_MANIFEST_BYTES)
-        .read_to_end(&mut bytes)
-        .map_err(|e| RunDirError::io(path, e))?;
-    Ok(String::from_utf8_lossy(&bytes)
-        .lines()
-        .filter(|l| !l.starts_with('#') && is_plain_name(l))
-        .map(String::from)
-        .collect())
+    let ours = match (written.get(name), listed) {
+        (Some(id), _) => id.matches(&path)?,
+        (None, Some(Entry::Claim)) => true,
+        (None, Some(Entry::File(id))) => id.matches(&path)?,
+        (None, None) => false,
+    };
+    if ours {
+        return Ok(());
+    }
+    let why = match (earlier, listed) {
+        (Err(why), _) => format!("{writer}'s manifest is not trusted: {why}"),
+        (Ok(_), Some(_)) => format!("it changed since {writer} wrote it"),
+        (Ok(_), None) => match other_writer(dir, writer, name) {
+            Some(other) => format!("it is listed by {other}, another writer in this directory"),
+            None => format!("{writer}'s manifest does not list it"),
+        },
+    };
+    Err(RunDirError::NotOurs {
+        path,
+        writer: writer.to_string(),
+        why,
+    })
+}
+
+/// Another writer whose manifest in `dir` (trusted or not: this only names it) lists `name`.
+fn other_writer(dir: &Path, writer: &str, name: &str) -> Option<String> {
+    let mine = manifest_name(writer);
+    std::fs::read_dir(dir).ok()?.find_map(|entry| {
+        let file_name = entry.ok()?.file_name().into_string().ok()?;
+        let other = file_name.strip_prefix('.')?.strip_suffix(".manifest")?;
+        if file_name == mine {
+            return None;
+        }
+        let file = open_own(&dir.join(&file_name), OpenOptions::new().read(true)).ok()?;
+        let mut text = String::new();
+        file.take(record::MAX_MANIFEST_BYTES)
+            .read_to_string(&mut text)
+            .ok()?;
+        let suffix = format!(" {name}");
+        text.lines()
+            .any(|l| l == name || l.ends_with(&suffix))
+            .then(|| other.to_string())
+    })
 }
 
 #[cfg(test)]
@@ -252,5 +377,138 @@ mod tests {
         out.finish().unwrap();
         assert_eq!(std::fs::read_to_string(&target).unwrap(), "precious");
         assert!(dir.path().join("p.png").is_symlink());
+    }
+
+    /// A manifest of identity for `name` in `dir` as the writer would record it.
+    fn identity(dir: &Path, name: &str) -> Identity {
+        let path = dir.join(name);
+        let bytes = std::fs::read(&path).unwrap();
+        Identity::of_written(&File::open(&path).unwrap(), &bytes).unwrap()
+    }
+
+    fn plant(dir: &Path, writer: &str, text: &str) {
+        std::fs::write(dir.join(manifest_name(writer)), text).unwrap();
+    }
+
+    /// A manifest the writer did not write removes nothing: one of an older format (names
+    /// only), one with a line appended, one others may write; the run succeeds and names it.
+    #[test]
+    fn untrusted_manifests_remove_nothing() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        for n in ["notes.txt", "data.csv"] {
+            std::fs::write(dir.path().join(n), n).unwrap();
+        }
+        plant(dir.path(), "w", "# the files w wrote\nnotes.txt\ndata.csv\n");
+        let mut out = OutputDir::open(dir.path(), "w").unwrap();
+        assert!(out.earlier().is_empty());
+        out.write("a.svg", b"a").unwrap();
+        let warnings = out.finish().unwrap();
+        assert_eq!(names(dir.path()), ["a.svg", "data.csv", "notes.txt"]);
+        assert!(warnings[0].contains(".w.manifest: not trusted"), "{warnings:?}");
+        // One appended line in a real manifest.
+        let manifest = dir.path().join(manifest_name("w"));
+        let mut text = std::fs::read_to_string(&manifest).unwrap();
+        text.push_str("claim notes.txt\n");
+        std::fs::write(&manifest, &text).unwrap();
+        let out = OutputDir::open(dir.path(), "w").unwrap();
+        let warnings = out.finish().unwrap();
+        assert!(warnings[0].contains("do not match its own digest"), "{warnings:?}");
+        assert_eq!(names(dir.path()), ["a.svg", "data.csv", "notes.txt"]);
+        // A whole manifest that others may write, listing a.svg as it is.
+        let whole = record::render(
+            &[("a.svg".to_string(), Entry::File(identity(dir.path(), "a.svg")))].into(),
+        );
+        std::fs::write(&manifest, whole).unwrap();
+        std::fs::set_permissions(&manifest, std::fs::Permissions::from_mode(0o666)).unwrap();
+        let out = OutputDir::open(dir.path(), "w").unwrap();
+        assert!(out.warnings()[0].contains("mode 666"), "{:?}", out.warnings());
+        out.finish().unwrap();
+        assert_eq!(names(dir.path()), ["a.svg", "data.csv", "notes.txt"]);
+    }
+
+    /// A well-formed manifest whose identities do not match (a forged one, a file replaced
+    /// or edited since) removes nothing and names what it kept; the lock file and manifests
+    /// are never removed, even listed with their true identity.
+    #[test]
+    fn only_the_very_files_written_are_removed() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut out = OutputDir::open(dir.path(), "w").unwrap();
+        out.write("a.svg", b"a").unwrap();
+        out.write("b.svg", b"b").unwrap();
+        out.finish().unwrap();
+        std::fs::write(dir.path().join("b.svg"), "the user's edit").unwrap();
+        std::fs::write(dir.path().join("notes.txt"), "notes").unwrap();
+        let forged = Identity {
+            sha256: "0".repeat(64),
+            ..identity(dir.path(), "notes.txt")
+        };
+        let mut entries: BTreeMap<String, Entry> = record::read(&dir.path().join(".w.manifest"))
+            .unwrap()
+            .unwrap();
+        entries.insert("notes.txt".into(), Entry::File(forged));
+        for n in [LOCK_FILE, ".v.manifest"] {
+            std::fs::write(dir.path().join(n), "x").unwrap();
+            entries.insert(n.into(), Entry::File(identity(dir.path(), n)));
+        }
+        plant(dir.path(), "w", &record::render(&entries));
+        let out = OutputDir::open(dir.path(), "w").unwrap();
+        let warnings = out.finish().unwrap();
+        assert_eq!(names(dir.path()), ["b.svg", "notes.txt"]);
+        assert!(dir.path().join(LOCK_FILE).exists());
+        assert!(dir.path().join(".v.manifest").exists());
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        assert!(warnings.iter().all(|w| w.contains("kept")), "{warnings:?}");
+    }
+
+    /// A file at a name to write that the writer cannot prove it wrote is refused and left
+    /// as it is: a user's file, another writer's (named), one edited since.
+    #[test]
+    fn files_not_provably_ours_are_not_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut diagnosis = OutputDir::open(dir.path(), "truss-diagnose").unwrap();
+        diagnosis.write("theta_p-ecdf-before.svg", b"diagnosis").unwrap();
+        diagnosis.finish().unwrap();
+        std::fs::write(dir.path().join("notes.md"), "mine").unwrap();
+        let e = OutputDir::check(dir.path(), "mc-merge", &["theta_p-ecdf-before.svg"]).unwrap_err();
+        assert!(e.to_string().contains("listed by truss-diagnose"), "{e}");
+        let mut merge = OutputDir::open(dir.path(), "mc-merge").unwrap();
+        for name in ["theta_p-ecdf-before.svg", "notes.md"] {
+            let e = merge.write(name, b"merge").unwrap_err();
+            assert!(matches!(e, RunDirError::NotOurs { .. }), "{e}");
+            assert!(e.to_string().contains("left as it is"), "{e}");
+        }
+        merge.write("report.md", b"r").unwrap();
+        merge.write("report.md", b"r2").unwrap();
+        merge.finish().unwrap();
+        let read = |n: &str| std::fs::read_to_string(dir.path().join(n)).unwrap();
+        assert_eq!(read("theta_p-ecdf-before.svg"), "diagnosis");
+        assert_eq!(read("notes.md"), "mine");
+        std::fs::write(dir.path().join("report.md"), "edited").unwrap();
+        let mut merge = OutputDir::open(dir.path(), "mc-merge").unwrap();
+        let e = merge.write("report.md", b"r3").unwrap_err();
+        assert!(e.to_string().contains("changed since mc-merge wrote it"), "{e}");
+        assert_eq!(read("report.md"), "edited");
+    }
+
+    /// The sweep removes only temporary files of our names with the writers' 16-hex-digit
+    /// suffix.
+    #[test]
+    fn the_sweep_matches_only_our_temporary_names() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut out = OutputDir::open(dir.path(), "w").unwrap();
+        out.write("report.md", b"r").unwrap();
+        out.finish().unwrap();
+        let kept = [".report.md.tmp-mynotes", ".report.md.tmp-0123456789ABCDEF", ".other.tmp-0123456789abcdef"];
+        for n in kept.iter().chain(&[".report.md.tmp-0123456789abcdef"]) {
+            std::fs::write(dir.path().join(n), "x").unwrap();
+        }
+        let mut out = OutputDir::open(dir.path(), "w").unwrap();
+        out.write("report.md", b"r").unwrap();
+        out.finish().unwrap();
+        for n in kept {
+            assert!(dir.path().join(n).exists(), "{n} was removed");
+        }
+        assert!(!dir.path().join(".report.md.tmp-0123456789abcdef").exists());
     }
 }
