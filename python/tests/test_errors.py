@@ -113,3 +113,14 @@ def test_damaged_and_foreign_shards_do_not_verify(small_job: Path, shard_dir: Pa
     tool("mc-shard", "run", "--job", str(other_job), "--out", str(tmp_path / "other"), "--shard", "1/3", "--quiet")
     with pytest.raises(truss_mc.VerificationError, match="shards of two jobs"):
         truss_mc.read_shards([files[0], *(tmp_path / "other").glob("*.jsonl")])
+
+
+def test_a_fifo_is_refused_before_it_is_opened(tmp_path: Path) -> None:
+    """``read_shards`` checks the file type before it opens a file, as ``mc-merge`` does: a
+    FIFO (which an open would wait on forever) is invalid input at once."""
+    import os
+
+    fifo = tmp_path / "shard.jsonl"
+    os.mkfifo(fifo)
+    with pytest.raises(truss_mc.InvalidInputError, match="not a regular file"):
+        truss_mc.read_shards(fifo)

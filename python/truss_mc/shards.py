@@ -35,9 +35,11 @@ def _shard_files(paths: Union[PathLike, Iterable[PathLike]]) -> List[str]:
 
 def read_shards(paths: Union[PathLike, Iterable[PathLike]], *, partial: bool = False) -> Samples:
     """The samples of shard files (directories contribute their ``*.jsonl`` files) in index
-    order. Every file is verified (each line's form and place, every checkpoint, the digests
-    of its end line); files of two jobs, or overlapping files whose lines differ, raise
-    :class:`~truss_mc.errors.VerificationError`. With ``partial``, an incomplete file (a run
+    order. Every file is verified as ``mc-merge`` verifies it (each line's form and place,
+    every checkpoint, the digests of its end line, a converged θ_P in [0, π/2] rad); files of
+    two jobs, or overlapping files whose lines differ, raise
+    :class:`~truss_mc.errors.VerificationError`. A path that is not a regular file (a FIFO, a
+    device) raises :class:`~truss_mc.errors.InvalidInputError` before it is opened. With ``partial``, an incomplete file (a run
     still going) gives the samples its last checkpoint verifies. Missing ranges are not an
     error here (``mc-merge`` checks coverage)."""
     r = _native.read_shard_files(_shard_files(paths), partial)
