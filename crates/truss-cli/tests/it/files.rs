@@ -220,7 +220,7 @@ fn planted_manifests_delete_nothing() {
         "--case",
         "c",
         "--target-arcsec",
-        "2000",
+        "20",
         "--samples",
         "1000",
         "--sensitivity-samples",
