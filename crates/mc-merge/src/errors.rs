@@ -237,8 +237,8 @@ impl MergeError {
                 RunDirError::Link { .. }
                 | RunDirError::NotAFile { .. }
                 | RunDirError::Locked { .. }
-            | RunDirError::NotOurs { .. }
-            | RunDirError::HardLinked { .. } => IN_THE_WAY,
+                | RunDirError::NotOurs { .. }
+                | RunDirError::HardLinked { .. } => IN_THE_WAY,
                 RunDirError::NotRegular { .. } => INVALID_INPUT,
             },
             MergeError::Internal { .. } => INTERNAL,

@@ -151,7 +151,9 @@ pub fn select(
         digits.parse().map(Some).map_err(|_| {
             RunError::Usage(
                 if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
-                    format!("environment variable {name}={v:?} is too large for a shard index or count")
+                    format!(
+                        "environment variable {name}={v:?} is too large for a shard index or count"
+                    )
                 } else {
                     format!("environment variable {name}={v:?} is not a whole number")
                 },

@@ -74,7 +74,10 @@ pub fn open_to_append(path: &Path, options: &OpenOptions) -> Result<File, RunDir
 /// ([`RunDirError::HardLinked`]): to be called before it is appended to or truncated.
 pub fn check_single_name(file: &File, path: &Path) -> Result<(), RunDirError> {
     use std::os::unix::fs::MetadataExt;
-    let links = file.metadata().map_err(|e| RunDirError::io(path, e))?.nlink();
+    let links = file
+        .metadata()
+        .map_err(|e| RunDirError::io(path, e))?
+        .nlink();
     if links > 1 {
         return Err(RunDirError::HardLinked {
             path: path.to_path_buf(),

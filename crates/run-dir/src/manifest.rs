@@ -133,7 +133,13 @@ impl OutputDir {
     /// could not write.
     pub fn check_names<S: AsRef<str>>(&self, names: &[S]) -> Result<(), RunDirError> {
         names.iter().try_for_each(|n| {
-            provable(&self.dir, &self.writer, &self.earlier, &self.written, n.as_ref())
+            provable(
+                &self.dir,
+                &self.writer,
+                &self.earlier,
+                &self.written,
+                n.as_ref(),
+            )
         })
     }
 
@@ -170,9 +176,11 @@ impl OutputDir {
             self.save(&self.listed)?;
         }
         let mut out = OutputFile::create(&path)?;
-        out.write_all(bytes).map_err(|e| RunDirError::io(&path, e))?;
+        out.write_all(bytes)
+            .map_err(|e| RunDirError::io(&path, e))?;
         let id = out.commit_identity(bytes)?;
-        self.listed.insert(name.to_string(), Entry::File(id.clone()));
+        self.listed
+            .insert(name.to_string(), Entry::File(id.clone()));
         self.written.insert(name.to_string(), id);
         Ok(path)
     }
@@ -223,9 +231,8 @@ impl OutputDir {
             let entry = entry.map_err(|e| RunDirError::io(&self.dir, e))?;
             let name = entry.file_name();
             let Some(name) = name.to_str() else { continue };
-            let ours = crate::output::temporary_base(name).is_some_and(|base| {
-                self.listed.contains_key(base) && !is_kept_always(base)
-            });
+            let ours = crate::output::temporary_base(name)
+                .is_some_and(|base| self.listed.contains_key(base) && !is_kept_always(base));
             if !ours {
                 continue;
             }
@@ -399,13 +406,20 @@ mod tests {
         for n in ["notes.txt", "data.csv"] {
             std::fs::write(dir.path().join(n), n).unwrap();
         }
-        plant(dir.path(), "w", "# the files w wrote\nnotes.txt\ndata.csv\n");
+        plant(
+            dir.path(),
+            "w",
+            "# the files w wrote\nnotes.txt\ndata.csv\n",
+        );
         let mut out = OutputDir::open(dir.path(), "w").unwrap();
         assert!(out.earlier().is_empty());
         out.write("a.svg", b"a").unwrap();
         let warnings = out.finish().unwrap();
         assert_eq!(names(dir.path()), ["a.svg", "data.csv", "notes.txt"]);
-        assert!(warnings[0].contains(".w.manifest: not trusted"), "{warnings:?}");
+        assert!(
+            warnings[0].contains(".w.manifest: not trusted"),
+            "{warnings:?}"
+        );
         // One appended line in a real manifest.
         let manifest = dir.path().join(manifest_name("w"));
         let mut text = std::fs::read_to_string(&manifest).unwrap();
@@ -413,16 +427,27 @@ mod tests {
         std::fs::write(&manifest, &text).unwrap();
         let out = OutputDir::open(dir.path(), "w").unwrap();
         let warnings = out.finish().unwrap();
-        assert!(warnings[0].contains("do not match its own digest"), "{warnings:?}");
+        assert!(
+            warnings[0].contains("do not match its own digest"),
+            "{warnings:?}"
+        );
         assert_eq!(names(dir.path()), ["a.svg", "data.csv", "notes.txt"]);
         // A whole manifest that others may write, listing a.svg as it is.
         let whole = record::render(
-            &[("a.svg".to_string(), Entry::File(identity(dir.path(), "a.svg")))].into(),
+            &[(
+                "a.svg".to_string(),
+                Entry::File(identity(dir.path(), "a.svg")),
+            )]
+            .into(),
         );
         std::fs::write(&manifest, whole).unwrap();
         std::fs::set_permissions(&manifest, std::fs::Permissions::from_mode(0o666)).unwrap();
         let out = OutputDir::open(dir.path(), "w").unwrap();
-        assert!(out.warnings()[0].contains("mode 666"), "{:?}", out.warnings());
+        assert!(
+            out.warnings()[0].contains("mode 666"),
+            "{:?}",
+            out.warnings()
+        );
         out.finish().unwrap();
         assert_eq!(names(dir.path()), ["a.svg", "data.csv", "notes.txt"]);
     }
@@ -467,7 +492,9 @@ mod tests {
     fn files_not_provably_ours_are_not_replaced() {
         let dir = tempfile::tempdir().unwrap();
         let mut diagnosis = OutputDir::open(dir.path(), "truss-diagnose").unwrap();
-        diagnosis.write("theta_p-ecdf-before.svg", b"diagnosis").unwrap();
+        diagnosis
+            .write("theta_p-ecdf-before.svg", b"diagnosis")
+            .unwrap();
         diagnosis.finish().unwrap();
         std::fs::write(dir.path().join("notes.md"), "mine").unwrap();
         let e = OutputDir::check(dir.path(), "mc-merge", &["theta_p-ecdf-before.svg"]).unwrap_err();
@@ -487,7 +514,10 @@ mod tests {
         std::fs::write(dir.path().join("report.md"), "edited").unwrap();
         let mut merge = OutputDir::open(dir.path(), "mc-merge").unwrap();
         let e = merge.write("report.md", b"r3").unwrap_err();
-        assert!(e.to_string().contains("changed since mc-merge wrote it"), "{e}");
+        assert!(
+            e.to_string().contains("changed since mc-merge wrote it"),
+            "{e}"
+        );
         assert_eq!(read("report.md"), "edited");
     }
 
@@ -499,7 +529,11 @@ mod tests {
         let mut out = OutputDir::open(dir.path(), "w").unwrap();
         out.write("report.md", b"r").unwrap();
         out.finish().unwrap();
-        let kept = [".report.md.tmp-mynotes", ".report.md.tmp-0123456789ABCDEF", ".other.tmp-0123456789abcdef"];
+        let kept = [
+            ".report.md.tmp-mynotes",
+            ".report.md.tmp-0123456789ABCDEF",
+            ".other.tmp-0123456789abcdef",
+        ];
         for n in kept.iter().chain(&[".report.md.tmp-0123456789abcdef"]) {
             std::fs::write(dir.path().join(n), "x").unwrap();
         }

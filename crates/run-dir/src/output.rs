@@ -25,7 +25,10 @@ pub const TEMP_INFIX: &str = ".tmp-";
 /// [`OutputFile::create`] makes them), or `None` for any other name.
 pub fn temporary_base(file_name: &str) -> Option<&str> {
     let (base, suffix) = file_name.strip_prefix('.')?.rsplit_once(TEMP_INFIX)?;
-    let hex = suffix.len() == 16 && suffix.bytes().all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'));
+    let hex = suffix.len() == 16
+        && suffix
+            .bytes()
+            .all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'));
     (hex && !base.is_empty()).then_some(base)
 }
 

@@ -92,7 +92,9 @@ impl Identity {
         let mut buf = vec![0u8; 1 << 16];
         let mut reader = file.take(self.size + 1);
         loop {
-            let n = reader.read(&mut buf).map_err(|e| RunDirError::io(path, e))?;
+            let n = reader
+                .read(&mut buf)
+                .map_err(|e| RunDirError::io(path, e))?;
             if n == 0 {
                 break;
             }

@@ -49,7 +49,9 @@ fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
     }
     for f in files {
         run_dir::input::check_regular(f).map_err(|e| match e {
-            run_dir::RunDirError::NotRegular { .. } => Failure::new(Kind::InvalidInput, e.to_string()),
+            run_dir::RunDirError::NotRegular { .. } => {
+                Failure::new(Kind::InvalidInput, e.to_string())
+            }
             e => Failure::new(Kind::Io, e.to_string()),
         })?;
     }
@@ -190,7 +192,11 @@ mod tests {
         let path = shard(dir.path(), 2.0);
         let e = read(std::slice::from_ref(&path), false).err().unwrap();
         assert_eq!(e.kind, Kind::Verification);
-        assert!(e.message.contains("not a distortion angle"), "{}", e.message);
+        assert!(
+            e.message.contains("not a distortion angle"),
+            "{}",
+            e.message
+        );
         let path = shard(dir.path(), 0.5);
         read(&[path], false).unwrap();
     }
@@ -200,7 +206,10 @@ mod tests {
     fn a_fifo_is_refused_at_once() {
         let dir = tempfile::tempdir().unwrap();
         let fifo = dir.path().join("shard.jsonl");
-        let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
         assert!(made.success());
         let e = read(&[fifo], false).err().unwrap();
         assert_eq!(e.kind, Kind::InvalidInput);

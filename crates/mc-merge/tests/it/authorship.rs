@@ -46,7 +46,10 @@ fn a_planted_manifest_deletes_nothing() {
     .unwrap();
     let (status, stderr) = code(&merge_into(shards.path(), out.path(), &[]));
     assert_eq!(status, Some(0), "{stderr}");
-    assert!(stderr.contains(".mc-merge.manifest: not trusted"), "{stderr}");
+    assert!(
+        stderr.contains(".mc-merge.manifest: not trusted"),
+        "{stderr}"
+    );
     assert_eq!(read(out.path(), "notes.txt"), "notes");
     assert_eq!(read(out.path(), "data.csv"), "1,2");
     assert!(out.path().join(".truss-mc.lock").exists());
@@ -67,14 +70,18 @@ fn an_appended_line_deletes_nothing() {
     let mut text = read(out.path(), ".mc-merge.manifest");
     text.push_str("notes.txt\n");
     std::fs::write(&manifest, text).unwrap();
-    let inode = std::fs::metadata(out.path().join("report.json")).unwrap().ino();
+    let inode = std::fs::metadata(out.path().join("report.json"))
+        .unwrap()
+        .ino();
     let (status, stderr) = code(&merge_into(shards.path(), out.path(), &["--no-plots"]));
     assert_eq!(status, Some(5), "{stderr}");
     assert!(stderr.contains("not trusted"), "{stderr}");
     assert!(stderr.contains("report.json: not replaced"), "{stderr}");
     assert_eq!(read(out.path(), "notes.txt"), "notes");
     assert!(out.path().join("theta_p-a.svg").exists());
-    let after = std::fs::metadata(out.path().join("report.json")).unwrap().ino();
+    let after = std::fs::metadata(out.path().join("report.json"))
+        .unwrap()
+        .ino();
     assert_eq!(after, inode, "report.json was replaced");
 }
 
@@ -85,7 +92,11 @@ fn another_writers_file_is_not_replaced() {
     let shards = tempfile::tempdir().unwrap();
     let out = tempfile::tempdir().unwrap();
     job(13, "ecdf-before").write_split(shards.path(), 1);
-    std::fs::write(out.path().join("theta_p-ecdf-before.svg"), "the diagnosis's").unwrap();
+    std::fs::write(
+        out.path().join("theta_p-ecdf-before.svg"),
+        "the diagnosis's",
+    )
+    .unwrap();
     let (status, stderr) = code(&merge_into(shards.path(), out.path(), &[]));
     assert_eq!(status, Some(5), "{stderr}");
     assert!(stderr.contains("theta_p-ecdf-before.svg"), "{stderr}");

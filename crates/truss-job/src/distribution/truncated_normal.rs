@@ -517,9 +517,17 @@ mod tests {
         };
         d.check().unwrap();
         let uniform = 0.01 / 3f64.sqrt();
-        assert!((d.std_dev() / uniform - 1.0).abs() < 1e-15, "{}", d.std_dev());
+        assert!(
+            (d.std_dev() / uniform - 1.0).abs() < 1e-15,
+            "{}",
+            d.std_dev()
+        );
         let d = TruncatedNormal { sigma: 1e300, ..d };
-        assert!((d.std_dev() / uniform - 1.0).abs() < 1e-15, "{}", d.std_dev());
+        assert!(
+            (d.std_dev() / uniform - 1.0).abs() < 1e-15,
+            "{}",
+            d.std_dev()
+        );
         let d = TruncatedNormal { sigma: 0.02, ..d };
         assert_eq!(
             d.std_dev(),
