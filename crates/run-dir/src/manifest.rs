@@ -32,6 +32,7 @@ use crate::errors::RunDirError;
 use crate::input::open_own;
 use crate::lock::{Lock, try_lock};
 use crate::output::OutputFile;
+pub use crate::record::is_plain_name;
 use crate::record::{self, Entry, Identity};
 use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
@@ -45,12 +46,6 @@ pub const LOCK_FILE: &str = ".truss-mc.lock";
 /// The manifest file of `writer`.
 pub fn manifest_name(writer: &str) -> String {
     format!(".{writer}.manifest")
-}
-
-/// Whether `name` is a plain file name (no directory part, not `.` or `..`, no line break),
-/// the only kind a manifest lists.
-pub fn is_plain_name(name: &str) -> bool {
-    !name.is_empty() && name != "." && name != ".." && !name.contains(['/', '\n', '\r', '\0'])
 }
 
 /// Whether `name` is never removed by a writer: the lock file, or a manifest.

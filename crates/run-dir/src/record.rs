@@ -44,6 +44,12 @@ pub const HEADER: &str = "# truss-mc manifest 2 (the files one writer wrote here
 /// The longest manifest read \[bytes\]: a million plot names.
 pub const MAX_MANIFEST_BYTES: u64 = 64 << 20;
 
+/// Whether `name` is a plain file name (no directory part, not `.` or `..`, no line break),
+/// the only kind a manifest lists.
+pub fn is_plain_name(name: &str) -> bool {
+    !name.is_empty() && name != "." && name != ".." && !name.contains(['/', '\n', '\r', '\0'])
+}
+
 /// A file as its writer left it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Identity {
@@ -191,7 +197,7 @@ fn parse(bytes: &[u8]) -> Result<BTreeMap<String, Entry>, String> {
     let mut entries = BTreeMap::new();
     for line in body.lines().skip(1) {
         let (name, entry) = parse_line(line).ok_or_else(|| format!("unreadable line {line:?}"))?;
-        if !crate::manifest::is_plain_name(name) {
+        if !is_plain_name(name) {
             return Err(format!("line {line:?} does not name a plain file"));
         }
         entries.insert(name.to_string(), entry);
