@@ -115,10 +115,8 @@ impl OutputDir {
     /// `dir` that `writer` could not write: a link or a non-file stands there, or a file
     /// it cannot prove it wrote (see the module doc).
     pub fn check(dir: &Path, writer: &str, names: &[&str]) -> Result<(), RunDirError> {
-        let earlier = match std::fs::symlink_metadata(dir) {
-            Ok(_) => record::read(&dir.join(manifest_name(writer)))?,
-            Err(_) => Ok(BTreeMap::new()),
-        };
+        // A directory not made yet has no manifest: nothing there to prove.
+        let earlier = record::read(&dir.join(manifest_name(writer)))?;
         names
             .iter()
             .try_for_each(|n| provable(dir, writer, &earlier, &BTreeMap::new(), n))
@@ -539,5 +537,33 @@ mod tests {
             assert!(dir.path().join(n).exists(), "{n} was removed");
         }
         assert!(!dir.path().join(".report.md.tmp-0123456789abcdef").exists());
+    }
+
+    /// A whole, well-formed manifest owned by another user (who may create files in a shared
+    /// directory) lists nothing, even with every identity right. Needs root to give a file
+    /// away; skipped otherwise.
+    #[test]
+    fn another_users_manifest_lists_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("notes.txt"), "notes").unwrap();
+        let entries = [(
+            "notes.txt".to_string(),
+            Entry::File(identity(dir.path(), "notes.txt")),
+        )]
+        .into();
+        plant(dir.path(), "w", &record::render(&entries));
+        let manifest = dir.path().join(manifest_name("w"));
+        if std::os::unix::fs::chown(&manifest, Some(65534), None).is_err() {
+            eprintln!("skipped: cannot give a file to another user here");
+            return;
+        }
+        let out = OutputDir::open(dir.path(), "w").unwrap();
+        assert!(
+            out.warnings()[0].contains("owned by user 65534"),
+            "{:?}",
+            out.warnings()
+        );
+        let _ = out.finish();
+        assert_eq!(names(dir.path()), ["notes.txt"]);
     }
 }
