@@ -113,3 +113,42 @@ def test_damaged_and_foreign_shards_do_not_verify(small_job: Path, shard_dir: Pa
     tool("mc-shard", "run", "--job", str(other_job), "--out", str(tmp_path / "other"), "--shard", "1/3", "--quiet")
     with pytest.raises(truss_mc.VerificationError, match="shards of two jobs"):
         truss_mc.read_shards([files[0], *(tmp_path / "other").glob("*.jsonl")])
+
+
+def test_a_fifo_is_refused_before_it_is_opened(tmp_path: Path) -> None:
+    """``read_shards`` and ``read_report`` check the file type before they open a file, as
+    ``mc-merge`` does: a FIFO (which an open would wait on forever) is invalid input at once."""
+    import os
+
+    fifo = tmp_path / "shard.jsonl"
+    os.mkfifo(fifo)
+    with pytest.raises(truss_mc.InvalidInputError, match="not a regular file"):
+        truss_mc.read_shards(fifo)
+    with pytest.raises(truss_mc.InvalidInputError, match="not a regular file"):
+        truss_mc.read_report(fifo)
+
+
+def test_arguments_of_the_wrong_type_are_named(small_job: Path, tmp_path: Path) -> None:
+    """A bool is not 1 mm, a list or a string is not a mapping of length errors, a thread
+    count out of range is the tools' usage error, a prism option that is NaN names its
+    field, and a malformed report.json is invalid input, not a KeyError."""
+    model = truss_mc.prism(stages=2)
+    with pytest.raises(TypeError, match=r'length_errors\["batten.0.0"\]: expected a number, got bool'):
+        truss_mc.solve(model, {"batten.0.0": True})
+    for wrong in (["batten.0.0", 0.01], "batten.0.0"):
+        with pytest.raises(TypeError, match="length_errors: expected a mapping"):
+            truss_mc.solve(model, wrong)  # type: ignore[arg-type]
+    job = truss_mc.Job.from_file(small_job)
+    for threads in (-1, 0, 1025, True):
+        with pytest.raises(truss_mc.UsageError, match="threads must be 1 to 1024"):
+            job.run(threads=threads)
+    with pytest.raises(truss_mc.InvalidInputError, match="prism.side: nan is not a finite number") as e:
+        truss_mc.prism(stages=3, side=float("nan"))
+    assert e.value.json_path == "prism.side"
+    with pytest.raises(TypeError, match="prism.height: expected a number"):
+        truss_mc.prism(stages=3, height=True)
+    report = tmp_path / "report.json"
+    for text in ('{"format": "truss-mc-merge-report"}', '{"cases": []}', "[1, 2]", "not json"):
+        report.write_text(text)
+        with pytest.raises(truss_mc.InvalidInputError, match="report"):
+            truss_mc.read_report(report)

@@ -9,10 +9,14 @@ import os
 from typing import Any, Dict, List, Optional, Tuple, Union
 
 from . import _columns, _native
+from .errors import UsageError
 from .model import Model
 from .results import Inputs, Samples
 
 __all__ = ["Job", "IndexRange"]
+
+#: The most threads a run starts (the tools' ``--threads`` bound).
+MAX_THREADS = 1024
 
 #: Global sample indices: ``"A..B"``, ``(A, B)`` or ``range(A, B)`` (half-open).
 IndexRange = Union[str, Tuple[int, int], range]
@@ -90,6 +94,10 @@ class Job:
         in index order: the numbers of their shard lines. With ``inputs``, also each sample's
         drawn inputs (:class:`~truss_mc.results.Inputs`). Ctrl-C stops it
         (``KeyboardInterrupt``)."""
+        if threads is not None and (
+            isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= MAX_THREADS
+        ):
+            raise UsageError(f"threads must be 1 to {MAX_THREADS}, not {threads!r}")
         r = self._native.run(case, _range_text(range), threads, inputs)
         raw = r["inputs"]
         return Samples(

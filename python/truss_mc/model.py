@@ -5,6 +5,8 @@
 from __future__ import annotations
 
 import json
+import math
+import numbers
 import os
 from dataclasses import dataclass
 from typing import Any, Dict, List, Mapping, Optional, Union
@@ -12,6 +14,7 @@ from typing import Any, Dict, List, Mapping, Optional, Union
 import numpy as np
 
 from . import _columns, _native
+from .errors import InvalidInputError
 
 __all__ = ["Model", "Solution", "prism", "solve"]
 
@@ -100,7 +103,33 @@ def prism(
         "compression_ratio": compression_ratio,
     }
     options = {k: v for k, v in given.items() if v is not None}
+    for key, value in options.items():
+        if key in ("stages", "backlash") or (key == "diagonal_length" and value == "exact"):
+            continue
+        _check_option(value, f"prism.{key}")
+    if isinstance(options.get("backlash"), dict):
+        for key, value in options["backlash"].items():
+            _check_option(value, f"prism.backlash.{key}")
     return Model(_native.Model.prism(json.dumps(options, allow_nan=True)))
+
+
+def _check_number(value: Any, name: str) -> float:
+    """``value`` as a float if it is a real number; a bool (which Python would take as 0 or
+    1 mm), a string or anything else raises TypeError naming it."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name}: expected a number, got {type(value).__name__} {value!r}")
+    return float(value)
+
+
+def _check_option(value: Any, name: str) -> None:
+    """A prism option: a real number (else TypeError), finite (else
+    :class:`~truss_mc.errors.InvalidInputError` with ``json_path`` ``name``: JSON has no NaN,
+    and the job reader's message for one would name no field)."""
+    x = _check_number(value, name)
+    if not math.isfinite(x):
+        e = InvalidInputError(f"{name}: {x} is not a finite number")
+        e.json_path = name
+        raise e
 
 
 @dataclass(frozen=True)
@@ -154,7 +183,13 @@ def solve(model: Model, length_errors: Optional[Mapping[str, float]] = None) -> 
     Raises :class:`~truss_mc.errors.UsageError` for an unknown member or an error beyond 1 %
     of the member's length, and :class:`~truss_mc.errors.SolveFailedError` when Newton's
     method does not converge. The interpreter lock is released while it solves."""
-    items = [(str(k), float(v)) for k, v in (length_errors or {}).items()]
+    if length_errors is None:
+        length_errors = {}
+    if not isinstance(length_errors, Mapping):
+        raise TypeError(
+            f"length_errors: expected a mapping {{member id: mm}}, got {type(length_errors).__name__}"
+        )
+    items = [(str(k), _check_number(v, f'length_errors["{k}"]')) for k, v in length_errors.items()]
     r = model._native.solve(items)
     joints = len(r["joint_ids"])
     return Solution(

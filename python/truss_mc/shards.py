@@ -12,11 +12,18 @@ from typing import Any, Dict, Iterable, List, Union
 import numpy as np
 
 from . import _columns, _native
+from .errors import InvalidInputError
 from .results import Samples
 
 __all__ = ["read_shards", "read_report", "Report"]
 
 PathLike = Union[str, "os.PathLike[str]"]
+
+#: What ``report.json`` says it is (mc-merge's ``REPORT_FORMAT``).
+REPORT_FORMAT = "truss-mc-merge-report"
+
+#: The longest ``report.json`` read [bytes] (mc-merge's own bound).
+MAX_REPORT_BYTES = 256 << 20
 
 
 def _shard_files(paths: Union[PathLike, Iterable[PathLike]]) -> List[str]:
@@ -35,9 +42,11 @@ def _shard_files(paths: Union[PathLike, Iterable[PathLike]]) -> List[str]:
 
 def read_shards(paths: Union[PathLike, Iterable[PathLike]], *, partial: bool = False) -> Samples:
     """The samples of shard files (directories contribute their ``*.jsonl`` files) in index
-    order. Every file is verified (each line's form and place, every checkpoint, the digests
-    of its end line); files of two jobs, or overlapping files whose lines differ, raise
-    :class:`~truss_mc.errors.VerificationError`. With ``partial``, an incomplete file (a run
+    order. Every file is verified as ``mc-merge`` verifies it (each line's form and place,
+    every checkpoint, the digests of its end line, a converged θ_P in [0, π/2] rad); files of
+    two jobs, or overlapping files whose lines differ, raise
+    :class:`~truss_mc.errors.VerificationError`. A path that is not a regular file (a FIFO, a
+    device) raises :class:`~truss_mc.errors.InvalidInputError` before it is opened. With ``partial``, an incomplete file (a run
     still going) gives the samples its last checkpoint verifies. Missing ranges are not an
     error here (``mc-merge`` checks coverage)."""
     r = _native.read_shard_files(_shard_files(paths), partial)
@@ -125,10 +134,25 @@ class Report:
 
 
 def read_report(path: PathLike) -> Report:
-    """Reads ``report.json`` (or the report directory holding it)."""
+    """Reads ``report.json`` (or the report directory holding it). A path that is not a
+    regular file (a FIFO, a device) is refused before it is opened, and a file that is not a
+    whole mc-merge report raises :class:`~truss_mc.errors.InvalidInputError`."""
     p = Path(path)
     if p.is_dir():
         p = p / "report.json"
+    # The file type before the open: a FIFO would block it, a device never end.
+    if p.exists() and not p.is_file():
+        raise InvalidInputError(f"{p}: not a regular file; give the path of a report.json")
+    if p.exists() and p.stat().st_size > MAX_REPORT_BYTES:
+        raise InvalidInputError(f"{p}: longer than {MAX_REPORT_BYTES} bytes, not a report")
     with open(p, encoding="utf-8") as f:
-        data = json.load(f, parse_constant=lambda c: math.nan)
-    return Report(data)
+        try:
+            data = json.load(f, parse_constant=lambda c: math.nan)
+        except ValueError as e:  # not JSON, not UTF-8
+            raise InvalidInputError(f"{p}: not a readable mc-merge report ({e})") from e
+    if not isinstance(data, dict) or data.get("format") != REPORT_FORMAT:
+        raise InvalidInputError(f'{p}: not an mc-merge report (no "format": "{REPORT_FORMAT}")')
+    try:
+        return Report(data)
+    except (KeyError, TypeError, ValueError, AttributeError) as e:
+        raise InvalidInputError(f"{p}: a malformed mc-merge report ({type(e).__name__}: {e})") from e

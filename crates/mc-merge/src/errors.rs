@@ -236,7 +236,9 @@ impl MergeError {
                 RunDirError::Io { .. } => IO,
                 RunDirError::Link { .. }
                 | RunDirError::NotAFile { .. }
-                | RunDirError::Locked { .. } => IN_THE_WAY,
+                | RunDirError::Locked { .. }
+                | RunDirError::NotOurs { .. }
+                | RunDirError::HardLinked { .. } => IN_THE_WAY,
                 RunDirError::NotRegular { .. } => INVALID_INPUT,
             },
             MergeError::Internal { .. } => INTERNAL,

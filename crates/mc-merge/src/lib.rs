@@ -285,7 +285,12 @@ pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError>
     let json = report_json(&merge.report)?;
     let mut text = table::render(&merge.report, merge.dataset.files.len());
     if let Some(dir) = &options.out {
-        let mut files = report_dir::open(dir, &merge.report.job_id)?;
+        let mut names = vec![report_dir::REPORT_FILE.to_string()];
+        if options.plots {
+            names.extend(plot::file_names(&merge.report));
+        }
+        names.extend([readable::MARKDOWN_FILE, readable::HTML_FILE].map(String::from));
+        let mut files = report_dir::open(dir, &merge.report.job_id, &names)?;
         let path = files.write(report_dir::REPORT_FILE, json.as_bytes())?;
         text.push_str(&format!("\nwrote {}\n", path.display()));
         let plots = if options.plots {

@@ -535,19 +535,6 @@ enum Conflict {
     Memory(String),
 }
 
-/// Refuses a converged sample whose θ_P is not an angle between the surfaces, in
-/// [0, π/2] rad (the tangents are finite: [`Sample::angles`]). Its digests may well verify
-/// (a line rewritten with fresh ones): a θ_P of 1e308 would otherwise wreck every statistic.
-fn check_angles(sample: &Sample) -> Result<(), String> {
-    match sample.angles() {
-        Some(a) if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&a.theta_p) => Err(format!(
-            "theta_p {} rad is not a distortion angle (it lies in [0, π/2])",
-            a.theta_p
-        )),
-        _ => Ok(()),
-    }
-}
-
 /// Reads one file in a worker thread, sending its samples in batches.
 fn read_one(
     file: usize,
@@ -563,7 +550,7 @@ fn read_one(
             stopped = true;
             return Err("stopped: another file failed".into());
         }
-        check_angles(sample)?;
+        sample.check_angles()?;
         batch.push(Rec::new(line, sample, bytes));
         if batch.len() == BATCH {
             let recs = std::mem::replace(&mut batch, Vec::with_capacity(BATCH));

@@ -13,11 +13,15 @@
 //! - **Reused only for the same job.** If the directory holds a `report.json` of another
 //!   job, or one that is not an mc-merge report, the merge is refused (exit 5) and nothing
 //!   in it is touched: give another `--out`, or remove the old report.
-//! - **Only our files removed.** mc-merge lists what it wrote in `.mc-merge.manifest`; a
-//!   rerun removes the files listed there that it does not write again (a renamed case's
-//!   plots, the plots of a run with plots when this one has `--no-plots`) after writing the
-//!   new ones. Every other file stays: a user's `theta_p-annotated.svg`, a diagnosis's
-//!   `theta_p-ecdf-before.svg`.
+//! - **Only our files removed or replaced.** mc-merge lists what it wrote in
+//!   `.mc-merge.manifest`, each file with its device, inode, size and SHA-256; a rerun
+//!   removes the files listed there that it does not write again (a renamed case's plots,
+//!   the plots of a run with plots when this one has `--no-plots`) after writing the new
+//!   ones, and only while each is still the file listed. A manifest that is not the user's
+//!   own (another user's, writable by others, edited) lists nothing. Every other file stays:
+//!   a user's `theta_p-annotated.svg`, a diagnosis's `theta_p-ecdf-before.svg`; a file that
+//!   mc-merge would write over and cannot prove it wrote (a case named `ecdf-before` would
+//!   write the diagnosis's plot) is refused (exit 5) before anything is written.
 
 use crate::errors::MergeError;
 use crate::report::REPORT_FORMAT;
@@ -35,12 +39,15 @@ pub const WRITER: &str = "mc-merge";
 pub const MAX_REPORT_BYTES: u64 = 256 << 20;
 
 /// Opens (creating if needed) and locks the report directory `dir`, refusing it if it
-/// holds another job's (or a foreign) report. A refused directory is left as it was: its
-/// report is checked before the lock file is created, and again under the lock.
-pub fn open(dir: &Path, job_id: &str) -> Result<OutputDir, MergeError> {
+/// holds another job's (or a foreign) report, or if any of the `names` to be written holds
+/// a file mc-merge cannot prove it wrote (crate `run-dir`). A refused directory is left as it
+/// was: its report is checked before the lock file is created, and again under the lock with
+/// every name, before anything is written.
+pub fn open(dir: &Path, job_id: &str, names: &[String]) -> Result<OutputDir, MergeError> {
     check_report(dir, job_id)?;
     let out = OutputDir::open(dir, WRITER)?;
     check_report(dir, job_id)?;
+    out.check_names(names)?;
     Ok(out)
 }
 

@@ -77,7 +77,9 @@ pub fn exit_code(e: &CommandError) -> u8 {
             RunDirError::Io { .. } => IO,
             RunDirError::Link { .. }
             | RunDirError::NotAFile { .. }
-            | RunDirError::Locked { .. } => IN_THE_WAY,
+            | RunDirError::Locked { .. }
+            | RunDirError::NotOurs { .. }
+            | RunDirError::HardLinked { .. } => IN_THE_WAY,
             RunDirError::NotRegular { .. } => INVALID_INPUT,
         },
         CommandError::Run(RunError::Shard(

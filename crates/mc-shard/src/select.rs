@@ -22,8 +22,14 @@
 //!   set `MC_SHARD_INDEX`/`MC_SHARD_COUNT` or give `--shard I/K` to say);
 //! - a count given twice that disagrees: `--shards K` or `MC_SHARD_COUNT` against the
 //!   scheduler's own count;
-//! - a value that is not a whole number, or an index not below its count.
+//! - a value that is not a whole number (or one beyond 2⁶⁴ − 1, called too large), an index
+//!   not below its count, or a count from the environment beyond 1 to
+//!   [`MAX_SHARDS`] (the bound of `--shards`);
+//! - `--shards K` with no index variable set (it would otherwise run the whole job);
+//! - a Slurm array that does not start at 0 (`SLURM_ARRAY_TASK_MIN` set and not 0: its task
+//!   ids are not the shard indices).
 
+use crate::cli::MAX_SHARDS;
 use crate::errors::RunError;
 use crate::job::Job;
 use shard_record::ShardRange;
@@ -70,6 +76,9 @@ pub const GENERIC_INDEX: &str = "MC_SHARD_INDEX";
 /// The generic count variable (also the count of a Kubernetes Indexed Job).
 pub const GENERIC_COUNT: &str = "MC_SHARD_COUNT";
 
+/// Slurm's first array index: 0 for an array whose task ids are shard indices.
+pub const SLURM_MIN: &str = "SLURM_ARRAY_TASK_MIN";
+
 /// A batch system's index variable and the variable of its count (`None`: it sets no count,
 /// and `MC_SHARD_COUNT` or `--shards` gives it).
 struct Scheduler {
@@ -103,9 +112,10 @@ const SCHEDULERS: [Scheduler; 4] = [
 ];
 
 /// Every environment variable [`select`] reads (for tests that must start from none).
-pub const VARIABLES: [&str; 9] = [
+pub const VARIABLES: [&str; 10] = [
     GENERIC_INDEX,
     GENERIC_COUNT,
+    SLURM_MIN,
     "SLURM_ARRAY_TASK_ID",
     "SLURM_ARRAY_TASK_COUNT",
     "AWS_BATCH_JOB_ARRAY_INDEX",
@@ -136,13 +146,27 @@ pub fn select(
         ));
     }
     let number = |name: &str| -> Result<Option<u64>, RunError> {
-        match env(name) {
-            None => Ok(None),
-            Some(v) => v.trim().parse().map(Some).map_err(|_| {
-                RunError::Usage(format!(
-                    "environment variable {name}={v:?} is not a whole number"
-                ))
-            }),
+        let Some(v) = env(name) else { return Ok(None) };
+        let digits = v.trim();
+        digits.parse().map(Some).map_err(|_| {
+            RunError::Usage(
+                if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
+                    format!(
+                        "environment variable {name}={v:?} is too large for a shard index or count"
+                    )
+                } else {
+                    format!("environment variable {name}={v:?} is not a whole number")
+                },
+            )
+        })
+    };
+    // A count from the environment, bounded as `--shards` is.
+    let count = |name: &str| -> Result<Option<u64>, RunError> {
+        match number(name)? {
+            Some(k) if !(1..=MAX_SHARDS).contains(&k) => Err(RunError::Usage(format!(
+                "environment variable {name}={k}: a shard count must be 1 to {MAX_SHARDS}"
+            ))),
+            k => Ok(k),
         }
     };
     let half = |set: &str, unset: &str| {
@@ -151,7 +175,7 @@ pub fn select(
         ))
     };
     // A count stated by the user: --shards K, else MC_SHARD_COUNT.
-    let generic_count = number(GENERIC_COUNT)?;
+    let generic_count = count(GENERIC_COUNT)?;
     let stated = match (shards, generic_count) {
         (Some(k), Some(c)) if k != c => {
             return Err(RunError::Usage(format!(
@@ -176,7 +200,7 @@ pub fn select(
     let mut found = Vec::new();
     for s in &SCHEDULERS {
         let index = number(s.index)?;
-        let count = s.count.map(number).transpose()?.flatten();
+        let count = s.count.map(count).transpose()?.flatten();
         match (index, count, s.count) {
             (Some(i), Some(k), _) => found.push((s, i, Some(k))),
             (Some(i), None, None) => found.push((s, i, None)),
@@ -185,10 +209,25 @@ pub fn select(
             (None, _, _) => {}
         }
     }
+    if let [(s, _, Some(_))] = found.as_slice()
+        && s.source == Source::Slurm
+        && let Some(min) = number(SLURM_MIN)?
+        && min != 0
+    {
+        return Err(RunError::Usage(format!(
+            "{SLURM_MIN}={min}: the array does not start at 0, so SLURM_ARRAY_TASK_ID is not \
+             the shard index: submit it as --array=0-(K-1) (or give --shard I/K)"
+        )));
+    }
     match found.as_slice() {
         [] if generic_count.is_some() => Err(RunError::Usage(format!(
             "{GENERIC_COUNT} is set but neither {GENERIC_INDEX} nor JOB_COMPLETION_INDEX is: \
              set one of them too, or unset {GENERIC_COUNT}"
+        ))),
+        [] if shards.is_some() => Err(RunError::Usage(format!(
+            "--shards {} is given but no shard index is set ({GENERIC_INDEX}, \
+             JOB_COMPLETION_INDEX, or a batch system's): set one, or give --shard I/K",
+            shards.unwrap_or_default()
         ))),
         [] => Ok((ShardRange::new(0, samples), Source::Whole)),
         [(s, i, Some(k))] => match &stated {
@@ -330,10 +369,8 @@ mod tests {
             from_env(&[], None),
             Ok((ShardRange::new(0, 100), Source::Whole))
         );
-        assert_eq!(
-            from_env(&[], Some(4)),
-            Ok((ShardRange::new(0, 100), Source::Whole))
-        );
+        // `--shards 4` alone names no shard: refused (ambiguous_environments_are_refused).
+        assert!(from_env(&[], Some(4)).is_err());
     }
 
     /// Half a pair, two schedulers, and disagreeing counts are refused, naming the variables.
@@ -425,6 +462,32 @@ mod tests {
                 &[("BATCH_TASK_INDEX", "3"), ("BATCH_TASK_COUNT", "3")],
                 None,
                 &["shard 3 of 3"],
+            ),
+            // A count without any index: not the whole job in silence.
+            (&[], Some(4), &["--shards 4", "MC_SHARD_INDEX"]),
+            // Counts from the environment are bounded as --shards is.
+            (
+                &[("MC_SHARD_INDEX", "1"), ("MC_SHARD_COUNT", "2000000")],
+                None,
+                &["MC_SHARD_COUNT=2000000", "1 to 1000000"],
+            ),
+            (
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "1"),
+                    ("SLURM_ARRAY_TASK_COUNT", "18446744073709551616"),
+                ],
+                None,
+                &["SLURM_ARRAY_TASK_COUNT", "too large"],
+            ),
+            // A 1-based Slurm array would run shard ID of COUNT one off.
+            (
+                &[
+                    ("SLURM_ARRAY_TASK_ID", "1"),
+                    ("SLURM_ARRAY_TASK_COUNT", "3"),
+                    ("SLURM_ARRAY_TASK_MIN", "1"),
+                ],
+                None,
+                &["SLURM_ARRAY_TASK_MIN=1", "--array=0-"],
             ),
         ] {
             let e = from_env(vars, shards).expect_err(&format!("{vars:?} is refused"));

@@ -19,6 +19,9 @@
 //!   again), and writing resumes at the next index: the finished file is byte-identical to
 //!   one written without interruption. A kept line that no longer matches its checkpoint is
 //!   an error ([`ShardError::Corrupt`]), never sealed under a fresh digest;
+//! - a file to be resumed or started afresh that has more than one name (a hard link, say
+//!   from a user's backup copy) is refused and left untouched
+//!   ([`run_dir::RunDirError::HardLinked`]): appending would grow the other name's file too;
 //! - an incomplete file of format version 1 (no checkpoints: its lines cannot be verified)
 //!   is not resumed ([`ShardError::OldFormat`]).
 //!
@@ -81,6 +84,7 @@ impl ShardWriter {
             Lock::Held { holder } => return Err(ShardError::Locked { path, holder }),
         }
         let fresh = |file: File| -> Result<Opened, ShardError> {
+            run_dir::input::check_single_name(&file, &path)?;
             file.set_len(0).map_err(io)?;
             let (encoder, header) = ShardEncoder::new(begin);
             let mut w = ShardWriter {
@@ -125,6 +129,8 @@ impl ShardWriter {
                 version: scan.begin.format_version,
             });
         }
+        // Never cut or grow a file that has another name too (a user's backup linked to it).
+        run_dir::input::check_single_name(&file, &path)?;
         // Keep the verified prefix: header, and sample lines up to the last checkpoint.
         file.set_len(scan.valid_len).map_err(io)?;
         Ok(Opened::Writer(ShardWriter {

@@ -35,6 +35,26 @@ pub enum RunDirError {
         /// The lock holder's pid, when this machine can see it.
         holder: Option<u32>,
     },
+    /// A regular file stands at a name to write, and the writer cannot prove it wrote it (its
+    /// manifest does not list it as it is now): replacing it could destroy someone's file.
+    #[error("{}: not replaced: {why}; it is left as it is (move it away, or use another directory)", path.display())]
+    NotOurs {
+        /// The file.
+        path: PathBuf,
+        /// The writer (`mc-merge`, …).
+        writer: String,
+        /// Why it is not provably the writer's, in words.
+        why: String,
+    },
+    /// A file to append to has more than one name (a hard link): appending would change the
+    /// other names' file too.
+    #[error("{}: has {links} hard links; appending would also change the file at its other names (copy it to a file of its own, or remove the other links)", path.display())]
+    HardLinked {
+        /// The file.
+        path: PathBuf,
+        /// Its number of links.
+        links: u64,
+    },
     /// A file a user named is not a regular file (a FIFO, a device, a directory).
     #[error("{}: not a regular file ({kind}); give the path of a file", path.display())]
     NotRegular {

@@ -61,6 +61,32 @@ pub fn open_own(path: &Path, options: &OpenOptions) -> Result<File, RunDirError>
     }
 }
 
+/// Opens our own file `path` to append to it, as [`open_own`] does, and refuses it when it
+/// has more than one name ([`RunDirError::HardLinked`]): appending through one name of a
+/// hard-linked file (a shard linked from a user's backup) would change it under every name.
+pub fn open_to_append(path: &Path, options: &OpenOptions) -> Result<File, RunDirError> {
+    let file = open_own(path, options)?;
+    check_single_name(&file, path)?;
+    Ok(file)
+}
+
+/// Refuses the open `file` (at `path`) when it has more than one name
+/// ([`RunDirError::HardLinked`]): to be called before it is appended to or truncated.
+pub fn check_single_name(file: &File, path: &Path) -> Result<(), RunDirError> {
+    use std::os::unix::fs::MetadataExt;
+    let links = file
+        .metadata()
+        .map_err(|e| RunDirError::io(path, e))?
+        .nlink();
+    if links > 1 {
+        return Err(RunDirError::HardLinked {
+            path: path.to_path_buf(),
+            links,
+        });
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -101,5 +127,12 @@ mod tests {
             RunDirError::NotAFile { .. }
         ));
         open_own(&file, &read).unwrap();
+        // A file with a second name is not appended to.
+        let append = OpenOptions::new().append(true).clone();
+        open_to_append(&file, &append).unwrap();
+        std::fs::hard_link(&file, dir.path().join("backup")).unwrap();
+        let e = open_to_append(&file, &append).unwrap_err();
+        assert!(matches!(e, RunDirError::HardLinked { links: 2, .. }), "{e}");
+        assert!(e.to_string().contains("2 hard links"), "{e}");
     }
 }

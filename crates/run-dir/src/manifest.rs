@@ -1,47 +1,60 @@
 //! A writer's output directory: locked while it writes, and a manifest of what it wrote, so
-//! that a rerun removes only its own earlier files.
+//! that a rerun removes or replaces only files it can prove it wrote.
 //!
 //! [`OutputDir::open`] creates the directory the user named (links are followed there: the
 //! user chose the path), takes the lock of `.truss-mc.lock` in it ([`LOCK_FILE`]: one writer
 //! at a time, every writer of the workspace alike; a second is refused with
 //! [`RunDirError::Locked`] rather than left to wait behind a run that may take long), and
-//! reads the writer's manifest `.WRITER.manifest`: a comment line, then the name of each file
-//! the writer wrote in the directory, one a line.
+//! reads the writer's manifest `.WRITER.manifest` ([`crate::record`]: trusted only when it is
+//! the writer's own, whole and unedited; each file listed with its device, inode, size and
+//! SHA-256).
 //!
-//! [`OutputDir::write`] lists a new name in the manifest *before* it writes the file (so a
-//! crash never leaves a file of ours unlisted), then writes it as [`crate::write_file`] does.
-//! [`OutputDir::finish`] removes the files of the earlier manifest that this run did not
-//! write again (a renamed case's plots, the plots of a run with plots when this one has
-//! none), and the temporary files a killed run of ours left, and writes the manifest of
-//! this run. Only regular files are removed: a link or a directory at a listed name is left
-//! as it is. A directory without a manifest (written before manifests existed) loses
-//! nothing: its files of the same names are replaced, and no other file is touched.
+//! **Replacing.** [`OutputDir::write`] writes a name only when nothing is there, or the file
+//! there is provably the writer's: its manifest lists it with the identity it still has, or
+//! claims the name (below), or this run wrote it. Any other file at the name (a user's, another
+//! writer's such as a diagnosis's `theta_p-ecdf-before.svg`, one edited since) is refused with
+//! [`RunDirError::NotOurs`], naming it and, when another writer's manifest lists it, that
+//! writer: the file is left as it is. [`OutputDir::check`] makes the same check for every name
+//! before any work, so a refusal never leaves a half-updated directory. A new name is listed
+//! as a `claim` *before* it is written, so a crash never leaves a file of ours unlisted.
+//!
+//! **Removing.** [`OutputDir::finish`] removes the files of the earlier manifest that this run
+//! did not write again (a renamed case's plots, the plots of a run with plots when this one
+//! has none), but only those that are still the very file listed; a listed file that changed,
+//! a name only claimed, the lock file and any manifest are kept, and each kept file is named
+//! in one line on stderr (`warning: …`; the run still succeeds). It removes the temporary
+//! files a killed run of ours left (`.NAME.tmp-` and exactly 16 hex digits, NAME one of our
+//! names, owned by this user), and writes the manifest of this run. An untrusted manifest
+//! (another user's, writable by others, edited, or of an older format) lists nothing: it is
+//! named in one line on stderr and replaced by this run's.
 
 use crate::errors::RunDirError;
 use crate::input::open_own;
 use crate::lock::{Lock, try_lock};
-use crate::output::{TEMP_INFIX, write_file};
-use std::collections::BTreeSet;
+use crate::output::OutputFile;
+pub use crate::record::is_plain_name;
+use crate::record::{self, Entry, Identity};
+use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
-use std::io::Read;
+use std::io::{Read, Write};
+use std::os::unix::fs::MetadataExt;
 use std::path::{Path, PathBuf};
 
 /// The lock file of an output directory.
 pub const LOCK_FILE: &str = ".truss-mc.lock";
-
-/// The longest manifest read \[bytes\]: a million plot names.
-pub const MAX_MANIFEST_BYTES: u64 = 64 << 20;
 
 /// The manifest file of `writer`.
 pub fn manifest_name(writer: &str) -> String {
     format!(".{writer}.manifest")
 }
 
-/// Whether `name` is a plain file name (no directory part, not `.` or `..`, no line break),
-/// the only kind a manifest lists.
-pub fn is_plain_name(name: &str) -> bool {
-    !name.is_empty() && name != "." && name != ".." && !name.contains(['/', '\n', '\r', '\0'])
+/// Whether `name` is never removed by a writer: the lock file, or a manifest.
+fn is_kept_always(name: &str) -> bool {
+    name == LOCK_FILE || (name.starts_with('.') && name.ends_with(".manifest"))
 }
+
+/// What a writer's earlier manifest gives it: the entries, or why it is not trusted.
+type Earlier = Result<BTreeMap<String, Entry>, String>;
 
 /// An output directory being written by one writer (see the module doc).
 #[derive(Debug)]
@@ -50,12 +63,14 @@ pub struct OutputDir {
     writer: String,
     /// Held until the writer is done.
     _lock: File,
-    /// What the previous run listed.
-    earlier: BTreeSet<String>,
+    /// What the previous run's trusted manifest listed, or why it is not trusted.
+    earlier: Earlier,
     /// What the manifest on disk lists now.
-    listed: BTreeSet<String>,
-    /// What this run wrote, in order.
-    written: Vec<String>,
+    listed: BTreeMap<String, Entry>,
+    /// What this run wrote.
+    written: BTreeMap<String, Identity>,
+    /// The warnings printed, one line each.
+    warnings: Vec<String>,
 }
 
 impl OutputDir {
@@ -76,23 +91,49 @@ impl OutputDir {
                 });
             }
         }
-        let earlier = read_manifest(&dir.join(manifest_name(writer)))?;
-        Ok(Self {
+        let manifest = dir.join(manifest_name(writer));
+        let earlier = record::read(&manifest)?;
+        let mut out = Self {
             dir: dir.to_path_buf(),
             writer: writer.to_string(),
             _lock: lock,
-            listed: earlier.clone(),
+            listed: earlier.clone().unwrap_or_default(),
             earlier,
-            written: Vec::new(),
-        })
+            written: BTreeMap::new(),
+            warnings: Vec::new(),
+        };
+        if let Err(why) = &out.earlier {
+            out.warn(format!(
+                "{}: not trusted ({why}); no file it lists is removed or replaced",
+                manifest.display()
+            ));
+        }
+        Ok(out)
     }
 
     /// Refuses, before any work and without creating anything, the names among `names` in
-    /// `dir` that could not be written: a link or a non-file stands there.
-    pub fn check(dir: &Path, names: &[&str]) -> Result<(), RunDirError> {
+    /// `dir` that `writer` could not write: a link or a non-file stands there, or a file
+    /// it cannot prove it wrote (see the module doc).
+    pub fn check(dir: &Path, writer: &str, names: &[&str]) -> Result<(), RunDirError> {
+        // A directory not made yet has no manifest: nothing there to prove.
+        let earlier = record::read(&dir.join(manifest_name(writer)))?;
         names
             .iter()
-            .try_for_each(|n| crate::output::check_final(&dir.join(n)))
+            .try_for_each(|n| provable(dir, writer, &earlier, &BTreeMap::new(), n))
+    }
+
+    /// Like [`OutputDir::check`], under the lock: refuses the first of `names` this writer
+    /// could not write.
+    pub fn check_names<S: AsRef<str>>(&self, names: &[S]) -> Result<(), RunDirError> {
+        names.iter().try_for_each(|n| {
+            provable(
+                &self.dir,
+                &self.writer,
+                &self.earlier,
+                &self.written,
+                n.as_ref(),
+            )
+        })
     }
 
     /// The directory.
@@ -100,157 +141,176 @@ impl OutputDir {
         &self.dir
     }
 
-    /// The files the writer's previous run wrote here, by name.
-    pub fn earlier(&self) -> &BTreeSet<String> {
-        &self.earlier
+    /// The files the writer's previous run wrote here, by name, as its trusted manifest
+    /// lists them (none when it is not trusted).
+    pub fn earlier(&self) -> BTreeMap<String, Entry> {
+        self.earlier.clone().unwrap_or_default()
     }
 
-    /// Writes the file `name` (a plain file name) in the directory: listed in the manifest
-    /// first, then written whole through a temporary file; refused at a link or a non-file.
-    /// Returns its path.
+    /// The warnings this writer printed so far, one line each.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Writes the file `name` (a plain file name) in the directory: refused at a link, a
+    /// non-file or a file not provably ours; listed in the manifest first, then written whole
+    /// through a temporary file. Returns its path.
     pub fn write(&mut self, name: &str, bytes: &[u8]) -> Result<PathBuf, RunDirError> {
         let path = self.dir.join(name);
-        if !is_plain_name(name) {
+        if !is_plain_name(name) || is_kept_always(name) {
             return Err(RunDirError::io(
                 path,
                 std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a plain file name"),
             ));
         }
-        if !self.listed.contains(name) {
-            self.listed.insert(name.to_string());
+        provable(&self.dir, &self.writer, &self.earlier, &self.written, name)?;
+        if !self.listed.contains_key(name) {
+            self.listed.insert(name.to_string(), Entry::Claim);
             self.save(&self.listed)?;
         }
-        write_file(&path, bytes)?;
-        self.written.push(name.to_string());
+        let mut out = OutputFile::create(&path)?;
+        out.write_all(bytes)
+            .map_err(|e| RunDirError::io(&path, e))?;
+        let id = out.commit_identity(bytes)?;
+        self.listed
+            .insert(name.to_string(), Entry::File(id.clone()));
+        self.written.insert(name.to_string(), id);
         Ok(path)
     }
 
-    /// Removes the earlier run's files this run did not write again and our stale
-    /// temporary files, and writes the manifest of this run.
-    pub fn finish(self) -> Result<(), RunDirError> {
-        let written: BTreeSet<String> = self.written.iter().cloned().collect();
-        for name in self.earlier.difference(&written) {
-            remove_regular(&self.dir.join(name))?;
+    /// Removes the earlier run's files this run did not write again, when each is still the
+    /// file listed (else it is kept and named on stderr), and our stale temporary files; writes
+    /// the manifest of this run. Returns the warnings printed.
+    pub fn finish(mut self) -> Result<Vec<String>, RunDirError> {
+        let earlier = self.earlier.clone().unwrap_or_default();
+        for (name, entry) in &earlier {
+            if self.written.contains_key(name) || is_kept_always(name) {
+                continue;
+            }
+            let path = self.dir.join(name);
+            let there = std::fs::symlink_metadata(&path).is_ok();
+            match entry {
+                Entry::File(id) if id.matches(&path)? => {
+                    std::fs::remove_file(&path).map_err(|e| RunDirError::io(&path, e))?;
+                }
+                Entry::File(_) if there => self.warn(format!(
+                    "{}: kept: it is not the file {} wrote here (changed or replaced since)",
+                    path.display(),
+                    self.writer
+                )),
+                Entry::Claim if there => self.warn(format!(
+                    "{}: kept: an earlier {} run was stopped before it could record this file",
+                    path.display(),
+                    self.writer
+                )),
+                Entry::File(_) | Entry::Claim => {}
+            }
         }
+        self.remove_stale_temporaries()?;
+        let mine: BTreeMap<String, Entry> = self
+            .written
+            .iter()
+            .map(|(n, id)| (n.clone(), Entry::File(id.clone())))
+            .collect();
+        self.save(&mine)?;
+        Ok(self.warnings)
+    }
+
+    /// Removes `.NAME.tmp-` + 16 hex digits where NAME is one of ours, owned by this user.
+    fn remove_stale_temporaries(&self) -> Result<(), RunDirError> {
+        let me = rustix::process::geteuid().as_raw();
         let entries = std::fs::read_dir(&self.dir).map_err(|e| RunDirError::io(&self.dir, e))?;
         for entry in entries {
             let entry = entry.map_err(|e| RunDirError::io(&self.dir, e))?;
             let name = entry.file_name();
             let Some(name) = name.to_str() else { continue };
-            let stale = name
-                .strip_prefix('.')
-                .and_then(|n| n.rsplit_once(TEMP_INFIX))
-                .is_some_and(|(base, _)| self.listed.contains(base));
-            if stale {
-                remove_regular(&entry.path())?;
+            let ours = crate::output::temporary_base(name)
+                .is_some_and(|base| self.listed.contains_key(base) && !is_kept_always(base));
+            if !ours {
+                continue;
+            }
+            let path = entry.path();
+            match std::fs::symlink_metadata(&path) {
+                Ok(m) if m.is_file() && m.uid() == me && m.nlink() == 1 => {
+                    std::fs::remove_file(&path).map_err(|e| RunDirError::io(&path, e))?;
+                }
+                _ => {}
             }
         }
-        self.save(&written)
+        Ok(())
     }
 
-    fn save(&self, names: &BTreeSet<String>) -> Result<(), RunDirError> {
-        let mut text = format!(
-            "# the files {} wrote in this directory; a rerun removes only these\n",
-            self.writer
-        );
-        for n in names {
-            text.push_str(n);
-            text.push('\n');
-        }
-        write_file(&self.dir.join(manifest_name(&self.writer)), text.as_bytes())
+    fn warn(&mut self, line: String) {
+        eprintln!("warning: {line}");
+        self.warnings.push(line);
+    }
+
+    fn save(&self, entries: &BTreeMap<String, Entry>) -> Result<(), RunDirError> {
+        let path = self.dir.join(manifest_name(&self.writer));
+        crate::write_file(&path, record::render(entries).as_bytes())
     }
 }
 
-/// Removes `path` if it is a regular file (never a link's target, never a directory).
-fn remove_regular(path: &Path) -> Result<(), RunDirError> {
-    match std::fs::symlink_metadata(path) {
-        Ok(m) if m.is_file() => std::fs::remove_file(path).map_err(|e| RunDirError::io(path, e)),
-        _ => Ok(()),
+/// Refuses `name` in `dir` unless `writer` may write it: nothing there, or a regular file
+/// this run wrote, or one its trusted earlier manifest lists with the identity it has (or
+/// claims). A link or a non-file is refused as [`crate::output::check_final`] does.
+fn provable(
+    dir: &Path,
+    writer: &str,
+    earlier: &Earlier,
+    written: &BTreeMap<String, Identity>,
+    name: &str,
+) -> Result<(), RunDirError> {
+    let path = dir.join(name);
+    crate::output::check_final(&path)?;
+    if std::fs::symlink_metadata(&path).is_err() {
+        return Ok(());
     }
-}
-
-/// The names a manifest lists (none if it does not exist); lines that are not plain names
-/// are ignored.
-fn read_manifest(path: &Path) -> Result<BTreeSet<String>, RunDirError> {
-    let file = match open_own(path, OpenOptions::new().read(true)) {
-        Ok(f) => f,
-        Err(RunDirError::Io { source, .. }) if source.kind() == std::io::ErrorKind::NotFound => {
-            return Ok(BTreeSet::new());
-        }
-        Err(e) => return Err(e),
+    let listed = match earlier {
+        Ok(entries) => entries.get(name),
+        Err(_) => None,
     };
-    let mut bytes = Vec::new();
-    file.take(MAX_MANIFEST_BYTES)
-        .read_to_end(&mut bytes)
-        .map_err(|e| RunDirError::io(path, e))?;
-    Ok(String::from_utf8_lossy(&bytes)
-        .lines()
-        .filter(|l| !l.starts_with('#') && is_plain_name(l))
-        .map(String::from)
-        .collect())
+    let ours = match (written.get(name), listed) {
+        (Some(id), _) => id.matches(&path)?,
+        (None, Some(Entry::Claim)) => true,
+        (None, Some(Entry::File(id))) => id.matches(&path)?,
+        (None, None) => false,
+    };
+    if ours {
+        return Ok(());
+    }
+    let why = match (earlier, listed) {
+        (Err(why), _) => format!("{writer}'s manifest is not trusted: {why}"),
+        (Ok(_), Some(_)) => format!("it changed since {writer} wrote it"),
+        (Ok(_), None) => match other_writer(dir, writer, name) {
+            Some(other) => format!("it is listed by {other}, another writer in this directory"),
+            None => format!("{writer}'s manifest does not list it"),
+        },
+    };
+    Err(RunDirError::NotOurs {
+        path,
+        writer: writer.to_string(),
+        why,
+    })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn names(dir: &Path) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().into_string().unwrap())
-            .filter(|n| !n.starts_with('.'))
-            .collect();
-        v.sort();
-        v
-    }
-
-    /// A rerun removes its own files it does not write again, and nothing else; a second
-    /// writer on a locked directory is refused.
-    #[test]
-    fn reruns_remove_only_their_own_files() {
-        let dir = tempfile::tempdir().unwrap();
-        let mut out = OutputDir::open(dir.path(), "w").unwrap();
-        out.write("a.svg", b"a").unwrap();
-        out.write("b.svg", b"b").unwrap();
-        let e = OutputDir::open(dir.path(), "w").unwrap_err();
-        assert!(matches!(e, RunDirError::Locked { .. }), "{e}");
-        assert!(e.to_string().contains("wait for it or stop it"), "{e}");
-        out.finish().unwrap();
-        std::fs::write(dir.path().join("mine.svg"), "mine").unwrap();
-        std::fs::write(dir.path().join(".b.svg.tmp-0123456789abcdef"), "stale").unwrap();
-        let mut out = OutputDir::open(dir.path(), "w").unwrap();
-        assert_eq!(out.earlier().len(), 2);
-        out.write("a.svg", b"a2").unwrap();
-        out.finish().unwrap();
-        assert_eq!(names(dir.path()), ["a.svg", "mine.svg"]);
-        assert!(!dir.path().join(".b.svg.tmp-0123456789abcdef").exists());
-        // Another writer's manifest is its own.
-        let other = OutputDir::open(dir.path(), "v").unwrap();
-        assert!(other.earlier().is_empty());
-        other.finish().unwrap();
-        assert_eq!(names(dir.path()), ["a.svg", "mine.svg"]);
-    }
-
-    /// A planted link at a listed name is left alone (not followed, not removed) and
-    /// writing that name again is refused.
-    #[test]
-    fn listed_links_are_neither_followed_nor_removed() {
-        let dir = tempfile::tempdir().unwrap();
-        let elsewhere = tempfile::tempdir().unwrap();
-        let target = elsewhere.path().join("precious");
-        std::fs::write(&target, "precious").unwrap();
-        let mut out = OutputDir::open(dir.path(), "w").unwrap();
-        out.write("p.png", b"p").unwrap();
-        out.finish().unwrap();
-        std::fs::remove_file(dir.path().join("p.png")).unwrap();
-        std::os::unix::fs::symlink(&target, dir.path().join("p.png")).unwrap();
-        let mut out = OutputDir::open(dir.path(), "w").unwrap();
-        assert!(matches!(
-            out.write("p.png", b"x").unwrap_err(),
-            RunDirError::Link { .. }
-        ));
-        out.finish().unwrap();
-        assert_eq!(std::fs::read_to_string(&target).unwrap(), "precious");
-        assert!(dir.path().join("p.png").is_symlink());
-    }
+/// Another writer whose manifest in `dir` (trusted or not: this only names it) lists `name`.
+fn other_writer(dir: &Path, writer: &str, name: &str) -> Option<String> {
+    let mine = manifest_name(writer);
+    std::fs::read_dir(dir).ok()?.find_map(|entry| {
+        let file_name = entry.ok()?.file_name().into_string().ok()?;
+        let other = file_name.strip_prefix('.')?.strip_suffix(".manifest")?;
+        if file_name == mine {
+            return None;
+        }
+        let file = open_own(&dir.join(&file_name), OpenOptions::new().read(true)).ok()?;
+        let mut text = String::new();
+        file.take(record::MAX_MANIFEST_BYTES)
+            .read_to_string(&mut text)
+            .ok()?;
+        let suffix = format!(" {name}");
+        text.lines()
+            .any(|l| l == name || l.ends_with(&suffix))
+            .then(|| other.to_string())
+    })
 }

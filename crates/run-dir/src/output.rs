@@ -21,6 +21,17 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// The infix of temporary files: `.NAME.tmp-` then 16 hex digits.
 pub const TEMP_INFIX: &str = ".tmp-";
 
+/// The NAME of a temporary file name `.NAME.tmp-` + exactly 16 lower-case hex digits (as
+/// [`OutputFile::create`] makes them), or `None` for any other name.
+pub fn temporary_base(file_name: &str) -> Option<&str> {
+    let (base, suffix) = file_name.strip_prefix('.')?.rsplit_once(TEMP_INFIX)?;
+    let hex = suffix.len() == 16
+        && suffix
+            .bytes()
+            .all(|b| matches!(b, b'0'..=b'9' | b'a'..=b'f'));
+    (hex && !base.is_empty()).then_some(base)
+}
+
 /// Checks what is at an output's final name, without following it: nothing, or a regular
 /// file, may be replaced; a link or anything else is refused.
 pub fn check_final(path: &Path) -> Result<(), RunDirError> {
@@ -126,23 +137,42 @@ impl OutputFile {
         &self.path
     }
 
-    /// Flushes and syncs the temporary file; returns it closed.
-    fn seal(&mut self) -> Result<(), RunDirError> {
+    /// Flushes and syncs the temporary file; returns it, still open.
+    fn seal(&mut self) -> Result<File, RunDirError> {
         let writer = self.file.take().expect("an output is sealed once");
         let file = writer
             .into_inner()
             .map_err(|e| RunDirError::io(&self.path, e.into_error()))?;
         file.sync_all()
             .map_err(|e| RunDirError::io(&self.path, e))?;
-        Ok(())
+        Ok(file)
     }
 
     /// Syncs the file to disk and renames it over the final name (refused if a link or a
     /// non-file has appeared there).
-    pub fn commit(mut self) -> Result<(), RunDirError> {
-        let done = self.seal().and_then(|()| check_final(&self.path));
-        let done = done.and_then(|()| {
-            std::fs::rename(&self.temp, &self.path).map_err(|e| RunDirError::io(&self.path, e))
+    pub fn commit(self) -> Result<(), RunDirError> {
+        self.commit_then(|_| Ok(()))
+    }
+
+    /// Like [`OutputFile::commit`], and returns the identity of the file committed, whose
+    /// content was `bytes` (the device and inode are read from the open file before the
+    /// rename, so a file swapped in afterwards is not mistaken for it).
+    pub fn commit_identity(self, bytes: &[u8]) -> Result<crate::record::Identity, RunDirError> {
+        let path = self.path.clone();
+        self.commit_then(|file| {
+            crate::record::Identity::of_written(file, bytes).map_err(|e| RunDirError::io(&path, e))
+        })
+    }
+
+    fn commit_then<T>(
+        mut self,
+        before: impl FnOnce(&File) -> Result<T, RunDirError>,
+    ) -> Result<T, RunDirError> {
+        let done = self.seal().and_then(|file| {
+            let value = before(&file)?;
+            check_final(&self.path)?;
+            std::fs::rename(&self.temp, &self.path).map_err(|e| RunDirError::io(&self.path, e))?;
+            Ok(value)
         });
         if done.is_err() {
             let _ = std::fs::remove_file(&self.temp);
@@ -156,7 +186,7 @@ impl OutputFile {
     pub fn commit_new(mut self) -> Result<bool, RunDirError> {
         let done = self
             .seal()
-            .and_then(|()| match std::fs::hard_link(&self.temp, &self.path) {
+            .and_then(|_| match std::fs::hard_link(&self.temp, &self.path) {
                 Ok(()) => Ok(true),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(false),
                 Err(e) => Err(RunDirError::io(&self.path, e)),

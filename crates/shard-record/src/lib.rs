@@ -329,6 +329,21 @@ impl Sample {
         }
     }
 
+    /// Refuses a converged sample whose θ_P is not an angle between the surfaces, in
+    /// \[0, π/2\] rad (the tangents are finite: [`Sample::angles`]). Its digests may well
+    /// verify (a line rewritten with fresh ones): a θ_P of 1e308 would otherwise wreck every
+    /// statistic. Every reader that verifies shards applies it (the merge, the Python
+    /// package).
+    pub fn check_angles(&self) -> Result<(), String> {
+        match self.angles() {
+            Some(a) if !(0.0..=std::f64::consts::FRAC_PI_2).contains(&a.theta_p) => Err(format!(
+                "theta_p {} rad is not a distortion angle (it lies in [0, π/2])",
+                a.theta_p
+            )),
+            _ => Ok(()),
+        }
+    }
+
     /// Checks that the fields present agree with `status`: a converged sample carries three
     /// finite angles with θ_P ≥ 0, and a holding force, where it has one, finite and ≥ 0; a
     /// failed one carries a reason.

@@ -65,7 +65,9 @@ pub fn exit_code(e: &anyhow::Error) -> u8 {
             RunDirError::Io { .. } => IO,
             RunDirError::Link { .. }
             | RunDirError::NotAFile { .. }
-            | RunDirError::Locked { .. } => IN_THE_WAY,
+            | RunDirError::Locked { .. }
+            | RunDirError::NotOurs { .. }
+            | RunDirError::HardLinked { .. } => IN_THE_WAY,
             RunDirError::NotRegular { .. } => INVALID_INPUT,
         },
         CliError::Model(_)

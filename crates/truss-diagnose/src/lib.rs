@@ -89,7 +89,8 @@
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
 //! plots of [`report::plot`], each written through a temporary file and never through a link (a
-//! link or a non-file at any of [`OUTPUTS`] is refused before the work), with the directory
+//! link, a non-file or a file this writer cannot prove it wrote (crate `run-dir`: another
+//! writer's, a user's) at any of [`OUTPUTS`] is refused before the work), with the directory
 //! locked while they are written and listed in `.truss-diagnose.manifest` (crate
 //! `run-dir`). The measured files are read only if they are regular files of at most
 //! 64 MiB (`/dev/zero` or a FIFO is refused at once). Progress goes to stderr.
@@ -190,7 +191,8 @@ pub const MAX_SAMPLES: usize = 10_000;
 
 /// Runs the diagnosis and writes `diagnosis.json`, `diagnosis.md`, `updated-job.json` and
 /// the plots into the output directory: each through a temporary file, never through a
-/// link (a link or a non-file at any of [`OUTPUTS`] is refused before the work), with the
+/// link (a link, a non-file or a file this writer cannot prove it wrote, at any of
+/// [`OUTPUTS`], is refused before the work and again before the first write), with the
 /// directory locked while they are written and a manifest of them kept ([`WRITER`]). What was left out of the data (outliers, unknown
 /// nodes and members) is reported on stderr (even with `quiet`) and in `diagnosis.json`.
 pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
@@ -216,7 +218,7 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
         )));
     }
     // Before any work: no output may go through a link.
-    run_dir::OutputDir::check(&options.out, &OUTPUTS)?;
+    run_dir::OutputDir::check(&options.out, WRITER, &OUTPUTS)?;
     let progress = settings::Progress::new(s.quiet);
     let base = comparison::baseline::Baseline::read(&options.job, &options.case)?;
     let data = comparison::measured::read(
@@ -229,6 +231,7 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     let d = selection::diagnose(&base, &data, s, &progress)?;
     let dir = &options.out;
     let mut out = run_dir::OutputDir::open(dir, WRITER)?;
+    out.check_names(&OUTPUTS)?;
     let mut plots = Vec::new();
     if options.plots {
         plots.extend(report::plot::draw(

@@ -1,7 +1,9 @@
 //! Reading shard files back as columns: every file verified as the merge verifies it
 //! (`shard_record::read_shard`: each line's form and place, every checkpoint, the end
-//! line's digests), one job across the files, and an index present in two files only if its
-//! lines are identical; the samples in index order, each field of the sample lines a column
+//! line's digests; a converged θ_P in \[0, π/2\], `shard_record::Sample::check_angles`), one
+//! job across the files, and an index present in two files only if its lines are identical;
+//! each file checked to be a regular file (links followed) *before* it is opened, so a FIFO
+//! or a device is refused at once (`InvalidInputError`, exit code 3), as the merge refuses it; the samples in index order, each field of the sample lines a column
 //! ([`crate::columns`]). With `partial`, an incomplete file (a run still going, or stopped)
 //! gives the lines its last checkpoint verifies.
 
@@ -45,6 +47,14 @@ fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
     if files.is_empty() {
         return Err(Failure::new(Kind::Usage, "no shard files given"));
     }
+    for f in files {
+        run_dir::input::check_regular(f).map_err(|e| match e {
+            run_dir::RunDirError::NotRegular { .. } => {
+                Failure::new(Kind::InvalidInput, e.to_string())
+            }
+            e => Failure::new(Kind::Io, e.to_string()),
+        })?;
+    }
     let mut order: Vec<(u64, &PathBuf)> = files
         .iter()
         .map(|f| (header(f).map_or(0, |b| b.range.start), f))
@@ -56,6 +66,7 @@ fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
     let mut first: Option<(Begin, &PathBuf)> = None;
     for (n, (_, path)) in order.iter().enumerate() {
         let visit = |_line_number: u64, sample: &shard_record::Sample, line: &[u8]| {
+            sample.check_angles()?;
             let index = sample.index;
             let fp = fingerprint(line);
             if let Some(&(last, _, _)) = taken.last()
@@ -132,4 +143,76 @@ pub fn read_shard_files<'py>(
     )?;
     out.set_item("columns", read.table.to_python(py)?)?;
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shard_record::{CaseInfo, Sample, SampleDigest, ShardRange, Status, to_line};
+
+    /// A complete shard of one sample whose θ_P is `theta_p`, its digests computed after.
+    fn shard(dir: &Path, theta_p: f64) -> PathBuf {
+        let range = ShardRange { start: 0, end: 1 };
+        let case = CaseInfo {
+            name: "a".into(),
+            start: 0,
+            samples: 1,
+            parameters: Default::default(),
+        };
+        let begin = Begin::new("mc-shard", "0.1.0", &"0".repeat(64), range, 1, vec![case]);
+        let sample = Sample {
+            index: 0,
+            case: "a".into(),
+            sample: 0,
+            status: Status::Converged,
+            iterations: 3,
+            theta_p: Some(theta_p),
+            tan_theta_x: Some(0.0),
+            tan_theta_y: Some(0.0),
+            residual: Some(1e-11),
+            slack_cables: Some(0),
+            loose_joints: None,
+            floating: None,
+            reason: None,
+        };
+        let line = sample.to_line();
+        let mut digest = SampleDigest::new();
+        digest.add_line(line.as_bytes(), false);
+        let text = to_line(&Record::Begin(begin)) + &line + &to_line(&Record::End(digest.end()));
+        let path = dir.join(range.file_name());
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    /// θ_P = 2 rad verifies its digests but is no angle between the surfaces: refused as
+    /// the merge refuses it, naming the file and line; 0.5 rad reads.
+    #[test]
+    fn angles_beyond_a_right_angle_do_not_verify() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = shard(dir.path(), 2.0);
+        let e = read(std::slice::from_ref(&path), false).err().unwrap();
+        assert_eq!(e.kind, Kind::Verification);
+        assert!(
+            e.message.contains("not a distortion angle"),
+            "{}",
+            e.message
+        );
+        let path = shard(dir.path(), 0.5);
+        read(&[path], false).unwrap();
+    }
+
+    /// A FIFO is refused before it is opened (an open would wait for a writer forever).
+    #[test]
+    fn a_fifo_is_refused_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let fifo = dir.path().join("shard.jsonl");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap();
+        assert!(made.success());
+        let e = read(&[fifo], false).err().unwrap();
+        assert_eq!(e.kind, Kind::InvalidInput);
+        assert!(e.message.contains("not a regular file"), "{}", e.message);
+    }
 }

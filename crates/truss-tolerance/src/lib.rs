@@ -77,8 +77,8 @@
 //! `allocated-job.json` (the input job, the case's σ replaced by the allocation),
 //! `tolerance.json` ([`report`] documents its fields), `tolerance.md`, and the SVG plots
 //! `shares-groups.svg` and `shares-members.svg` ([`plot`]): each written through a temporary
-//! file and never through a link (a link or a non-file at any of these names is refused
-//! before the study runs), the directory locked while they are written, and listed in
+//! file and never through a link (a link, a non-file or a file this writer cannot prove it
+//! wrote, crate `run-dir`, at any of these names is refused before the study runs), the directory locked while they are written, and listed in
 //! `.truss-tolerance.manifest` (crate `run-dir`). `--cost` and `--fix` name each group once.
 
 pub mod allocate;

@@ -262,7 +262,26 @@ impl Study {
 
     /// A job of this one case with σ values `sigmas` (group order) and `samples` samples:
     /// sample `k` of it draws the same `z` as sample `k` of the input case.
+    /// A σ the study computed that is no number (its input σ and `--cost` values so extreme
+    /// that a ratio overflowed) is refused naming the group ([`ToleranceError::NotScalable`]),
+    /// never reported as the job's own "not a finite number".
     pub fn job_with(&self, sigmas: &[f64], samples: u64) -> Result<Job, ToleranceError> {
+        for (g, &s) in self.groups.iter().zip(sigmas) {
+            let scaled = g.distribution.with_sigma(s).ok();
+            let finite = s.is_finite() && scaled.is_none_or(|d| d.std_dev().is_finite());
+            if !finite {
+                return Err(ToleranceError::NotScalable {
+                    case: self.case().name.clone(),
+                    group: g.name.clone(),
+                    reason: format!(
+                        "the σ the study computed for it is {s} mm, not a number: its input σ \
+                         ({} mm) or its --cost is too extreme beside the other groups' \
+                         (keep them within some hundred orders of magnitude)",
+                        truss_core::readable(g.sigma)
+                    ),
+                });
+            }
+        }
         let spec = JobSpec {
             model: self.spec.model.clone(),
             seed: self.spec.seed,

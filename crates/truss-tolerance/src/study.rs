@@ -65,12 +65,13 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
     o.check()?;
     // Before any work: no output may go through a link.
     let outputs: Vec<&str> = report::FILES.iter().chain(&plot::PLOTS).copied().collect();
-    run_dir::OutputDir::check(&o.out, &outputs)?;
+    run_dir::OutputDir::check(&o.out, WRITER, &outputs)?;
     let study = Study::read(&o.job, &o.case, &o.costs, &o.fixes)?;
     let mut result = analyse(o, &study)?;
     let last = result.verified_run().1;
     let target = result.target_rad;
     let mut out = run_dir::OutputDir::open(&o.out, WRITER)?;
+    out.check_names(&outputs)?;
     result.files = report::write_all(&study, &result, &mut out, o.plots)?;
     out.finish()?;
     if !result.verified {

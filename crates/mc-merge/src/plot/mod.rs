@@ -127,6 +127,26 @@ impl Writer {
     }
 }
 
+/// Every file name [`draw_all`] may write for `report` (also a plot it turns out not to draw,
+/// such as a sweep of a job without one), to check before anything is written.
+pub fn file_names(report: &Report) -> Vec<String> {
+    let names: Vec<&str> = report.cases.iter().map(|c| c.name.as_str()).collect();
+    let mut stems: Vec<String> = file_stems(&names)
+        .iter()
+        .flat_map(|stem| CASE_PLOTS.iter().map(move |kind| format!("{kind}-{stem}")))
+        .collect();
+    stems.extend(JOB_PLOTS.iter().map(|s| s.to_string()));
+    let extensions = if cfg!(feature = "png") {
+        &EXTENSIONS[..]
+    } else {
+        &EXTENSIONS[..1]
+    };
+    stems
+        .iter()
+        .flat_map(|s| extensions.iter().map(move |e| format!("{s}.{e}")))
+        .collect()
+}
+
 /// Draws every plot into the report directory `out`; returns the files written.
 pub fn draw_all(
     out: &mut OutputDir,
@@ -136,27 +156,20 @@ pub fn draw_all(
     let mut w = Writer::new(out.path())?;
     let names: Vec<&str> = report.cases.iter().map(|c| c.name.as_str()).collect();
     for ((case, rep), stem) in cases.iter().zip(&report.cases).zip(file_stems(&names)) {
-        let name = |prefix: &str| format!("{prefix}-{stem}");
+        let [theta, tan, qq, exceedance, running] = CASE_PLOTS.map(|k| format!("{k}-{stem}"));
+        w.write(out, &theta, distribution::theta(case, rep, report))?;
+        w.write(out, &tan, distribution::tan(case, rep))?;
+        w.write(out, &qq, distribution::qq(case, rep, report))?;
         w.write(
             out,
-            &name("theta_p"),
-            distribution::theta(case, rep, report),
-        )?;
-        w.write(out, &name("tan"), distribution::tan(case, rep))?;
-        w.write(out, &name("qq"), distribution::qq(case, rep, report))?;
-        w.write(
-            out,
-            &name("exceedance"),
+            &exceedance,
             distribution::exceedance(case, rep, report),
         )?;
-        w.write(
-            out,
-            &name("running"),
-            distribution::running(case, rep, report),
-        )?;
+        w.write(out, &running, distribution::running(case, rep, report))?;
     }
-    w.write(out, "sigma-sweep", series::sigma(report))?;
-    w.write(out, "stages-sweep", series::stages(report))?;
+    let [sigma, stages] = JOB_PLOTS;
+    w.write(out, sigma, series::sigma(report))?;
+    w.write(out, stages, series::stages(report))?;
     Ok(w.written)
 }
 

@@ -3,6 +3,28 @@
 //! HTML writers render the same document, so `report.md` and `report.html` say the same
 //! things in the same order. Text is plain: each writer escapes it for its own format.
 
+/// The code point of a character that would act on the reader's display instead of
+/// showing as itself, `U+XXXX`, for the writers to show in its place: a control character
+/// (ESC from a forged shard header would colour or move a terminal's text; line breaks and
+/// tabs excepted, which each writer handles), a bidirectional embedding, override, isolate or
+/// mark (a case name could read backwards), a zero-width space, joiner or word joiner, a soft
+/// hyphen or a byte-order mark (two names would look the same). `None` for any other
+/// character.
+pub fn hidden_code_point(c: char) -> Option<String> {
+    let control = c.is_control() && !matches!(c, '\n' | '\r' | '\t');
+    let format = matches!(
+        c,
+        '\u{00AD}'
+            | '\u{061C}'
+            | '\u{200B}'..='\u{200F}'
+            | '\u{202A}'..='\u{202E}'
+            | '\u{2060}'..='\u{2064}'
+            | '\u{2066}'..='\u{2069}'
+            | '\u{FEFF}'
+    );
+    (control || format).then(|| format!("U+{:04X}", c as u32))
+}
+
 /// A piece of running text.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Span {

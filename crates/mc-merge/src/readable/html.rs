@@ -19,7 +19,7 @@
 //! `<script>alert(1)</script>` is shown as written; in running text, headers and captions
 //! θ_P, θ_x, θ_y and σ_t are set with subscripts, as in the plots.
 
-use super::document::{Block, Document, Line, Plot, Span, Table};
+use super::document::{Block, Document, Line, Plot, Span, Table, hidden_code_point};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 
@@ -177,10 +177,16 @@ pub fn content(s: &str) -> String {
     out
 }
 
-/// Text escaped for HTML content and attribute values.
+/// Text escaped for HTML content and attribute values; a character that would act on the
+/// display (ESC, a bidirectional override, a zero-width space: [`hidden_code_point`]) is
+/// shown as `[U+XXXX]`.
 pub fn escape(s: &str) -> String {
     let mut out = String::with_capacity(s.len());
     for c in s.chars() {
+        if let Some(code_point) = hidden_code_point(c) {
+            let _ = write!(out, "[{code_point}]");
+            continue;
+        }
         match c {
             '&' => out.push_str("&amp;"),
             '<' => out.push_str("&lt;"),
@@ -236,6 +242,10 @@ mod tests {
         assert_eq!(
             escape("<script>alert('x')</script> & \"y\""),
             "&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt; &amp; &quot;y&quot;"
+        );
+        assert_eq!(
+            escape("a\u{1b}b\u{202e}c\u{2066}d\u{feff}"),
+            "a[U+001B]b[U+202E]c[U+2066]d[U+FEFF]"
         );
         let svg = "<svg width=\"960\" height=\"780\" xmlns=\"http://www.w3.org/2000/svg\"><text>θ #1 50% a'b &amp;</text></svg>\n";
         let uri = data_uri(svg.as_bytes());

@@ -4,7 +4,7 @@
 //! file reads with its plots wherever the directory is viewed (a repository, a wiki, an
 //! editor's preview).
 
-use super::document::{Block, Document, Line, Plot, Span, Table};
+use super::document::{Block, Document, Line, Plot, Span, Table, hidden_code_point};
 
 /// The document as Markdown.
 pub fn markdown(doc: &Document) -> String {
@@ -74,8 +74,11 @@ fn plot(m: &mut String, p: &Plot) {
 
 /// Plain text escaped for Markdown: every character that could start markup is
 /// backslash-escaped (an underscore only where it could, not inside a word such as `θ_P`; a
-/// closing bracket only where a link could follow, so `[rad]` stays as it is), and a line
-/// break becomes a space.
+/// closing bracket only where a link could follow, so `[rad]` stays as it is), a line
+/// break becomes a space, a bare URL (`https://…`, `www.…`) is kept from being linked, and
+/// a character that would act on the display (ESC, a
+/// bidirectional override, a zero-width space: [`hidden_code_point`]) is shown as
+/// `[U+XXXX]`.
 pub fn escape(s: &str) -> String {
     escape_with(s, false)
 }
@@ -94,6 +97,10 @@ fn escape_with(s: &str, brackets: bool) -> String {
             j.and_then(|j| chars.get(j))
                 .is_some_and(|c| c.is_alphanumeric())
         };
+        if let Some(code_point) = hidden_code_point(c) {
+            out.push_str(&format!("\\[{code_point}\\]"));
+            continue;
+        }
         match c {
             '\\' | '`' | '*' | '<' | '>' | '|' | '#' | '&' | '~' | '$' => {
                 out.push('\\');
@@ -107,6 +114,16 @@ fn escape_with(s: &str, brackets: bool) -> String {
             ']' if chars.get(k + 1).is_some_and(|n| "([:".contains(*n)) => out.push_str("\\]"),
             '_' if !(word(k.checked_sub(1)) && word(Some(k + 1))) => out.push_str("\\_"),
             '\n' | '\r' => out.push(' '),
+            // GitHub links a bare `scheme://…` or `www.…` by itself: escaped, neither is.
+            ':' if chars.get(k + 1..k + 3) == Some(&['/', '/']) => out.push_str("\\:"),
+            '.' if k >= 3
+                && chars[k - 3..k]
+                    .iter()
+                    .collect::<String>()
+                    .eq_ignore_ascii_case("www") =>
+            {
+                out.push_str("\\.")
+            }
             _ => out.push(c),
         }
     }
@@ -115,7 +132,14 @@ fn escape_with(s: &str, brackets: bool) -> String {
 
 /// A code span that holds `s` whatever backticks it contains.
 fn code(s: &str) -> String {
-    let s = s.replace(['\n', '\r'], " ");
+    let s: String = s
+        .chars()
+        .map(|c| match hidden_code_point(c) {
+            Some(code_point) => format!("[{code_point}]"),
+            None if matches!(c, '\n' | '\r') => " ".into(),
+            None => c.into(),
+        })
+        .collect();
     let longest = s.split(|c| c != '`').map(str::len).max().unwrap_or(0);
     let fence = "`".repeat(longest + 1);
     let pad = if s.starts_with('`') || s.ends_with('`') || s.starts_with(' ') {
@@ -168,6 +192,13 @@ mod tests {
             "a\\*b\\|c \\<σ\\> \\_x\\_ \\#1 \\& \\~"
         );
         assert_eq!(escape("two\nlines"), "two lines");
+        assert_eq!(
+            escape("a\u{1b}[31mb\u{202e}c\u{200b}d"),
+            "a\\[U+001B\\][31mb\\[U+202E\\]c\\[U+200B\\]d"
+        );
+        assert_eq!(code("x\u{1b}y"), "`x[U+001B]y`");
+        assert_eq!(escape("https://x.org"), "https\\://x.org");
+        assert_eq!(escape("WWW.x.org a.b"), "WWW\\.x.org a.b");
         assert_eq!(escape_label("a ] b [c]"), "a \\] b \\[c\\]");
         assert_eq!(code("a`b"), "``a`b``");
         assert_eq!(code("`x"), "`` `x ``");

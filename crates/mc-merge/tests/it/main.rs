@@ -1,6 +1,7 @@
 //! mc-merge's integration tests, one binary: statistics, sweeps, the command line, plots, the
 //! readable reports and the report directory.
 
+mod authorship;
 mod cli;
 mod common;
 mod export;

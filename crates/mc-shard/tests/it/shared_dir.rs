@@ -1,7 +1,8 @@
 //! A shared run directory (crate `run-dir`): a shard's name, the quarantine and claims
 //! directories and every file written never go through a planted link; a file at a shard's
 //! name that is not a shard is refused, not truncated; `inputs -o` is written whole or not at
-//! all; `audit` reads only regular files; a shard locked by a live process names it.
+//! all; `audit` reads only regular files; a shard locked by a live process names it; a
+//! shard with a second hard link is never resumed through it.
 
 use crate::binary::mc_shard;
 use crate::common::*;
@@ -66,6 +67,31 @@ fn a_file_that_is_not_a_shard_is_refused_not_truncated() {
     let (status, stderr) = code(&run_range(&job, &out, "0..20"));
     assert_eq!(status, Some(0), "{stderr}");
     assert_eq!(sample_lines(&out).len(), 20);
+}
+
+/// A partial shard that is also a hard link of the user's backup copy is not resumed
+/// through it (the backup would be cut and grown too): refused (exit 5) naming the file,
+/// and the backup keeps its bytes.
+#[test]
+fn a_hard_linked_shard_is_not_resumed() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = write(dir.path(), "job.json", &small_job(10));
+    let out = dir.path().join("runs");
+    let (status, stderr) = code(&run_range(&job, &out, "0..20"));
+    assert_eq!(status, Some(0), "{stderr}");
+    let path = out.join(shard_record::ShardRange::new(0, 20).file_name());
+    let whole = std::fs::read_to_string(&path).unwrap();
+    let partial: String = whole.split_inclusive('\n').take(6).collect();
+    std::fs::write(&path, &partial).unwrap();
+    let backup = dir.path().join("backup.jsonl");
+    std::fs::hard_link(&path, &backup).unwrap();
+    let (status, stderr) = code(&run_range(&job, &out, "0..20"));
+    assert_eq!(status, Some(5), "{stderr}");
+    assert!(
+        stderr.contains(&path.display().to_string()) && stderr.contains("hard links"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_to_string(&backup).unwrap(), partial);
 }
 
 /// Shard 1 of 2 damaged, and `quarantine/` (or `claims/`) a link to another directory: the

@@ -175,6 +175,72 @@ fn tolerance_never_writes_through_a_link_nor_reads_a_fifo() {
     assert!(stderr.contains("not a regular file"), "{stderr}");
 }
 
+/// A manifest planted in the output directory (`.truss-diagnose.manifest`,
+/// `.truss-tolerance.manifest`) listing the merge's `report.json` deletes nothing: it is not
+/// the writer's own (an older format, unchecked); the run succeeds and names it on stderr.
+#[test]
+fn planted_manifests_delete_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = measured(dir.path());
+    let job = crate::one_stage_job(dir.path());
+    let plant = |out: &Path, writer: &str| {
+        std::fs::create_dir(out).unwrap();
+        std::fs::write(out.join("report.json"), "the merge's report").unwrap();
+        std::fs::write(
+            out.join(format!(".{writer}.manifest")),
+            "# the files wrote\nreport.json\n",
+        )
+        .unwrap();
+    };
+    let d = dir.path().join("d");
+    plant(&d, "truss-diagnose");
+    let o = truss(&[
+        "diagnose",
+        "--job",
+        job_path(),
+        "--case",
+        "as-built",
+        "--measured",
+        m.to_str().unwrap(),
+        "--measurement-sigma",
+        "0.001",
+        "--samples",
+        "100",
+        "--no-plots",
+        "--quiet",
+        "--out",
+        d.to_str().unwrap(),
+    ]);
+    let t = dir.path().join("t");
+    plant(&t, "truss-tolerance");
+    let o2 = truss(&[
+        "tolerance",
+        "--job",
+        job.to_str().unwrap(),
+        "--case",
+        "c",
+        "--target-arcsec",
+        "20",
+        "--samples",
+        "1000",
+        "--sensitivity-samples",
+        "1000",
+        "--no-plots",
+        "--out",
+        t.to_str().unwrap(),
+    ]);
+    for (o, out, writer) in [(o, d, "truss-diagnose"), (o2, t, "truss-tolerance")] {
+        let (status, stderr) = code(&o);
+        assert!(matches!(status, Some(0 | 6)), "{writer}: {stderr}");
+        assert!(
+            stderr.contains(&format!(".{writer}.manifest: not trusted")),
+            "{writer}: {stderr}"
+        );
+        let report = std::fs::read_to_string(out.join("report.json")).unwrap();
+        assert_eq!(report, "the merge's report", "{writer}");
+    }
+}
+
 /// Output that cannot be written (`/dev/full`) is an I/O error (exit 4) for a result and
 /// for a completion script alike (clap's generator used to panic, 101, in the other
 /// binaries: see their tests).

@@ -7,9 +7,10 @@
 //! case, surrounding spaces ignored; other columns ignored), one row per measured node per
 //! specimen, positions in mm in the model's frame with the bottom surface at nominal. Quoted
 //! fields, CRLF line ends and a UTF-8 byte-order mark are accepted; node order does not
-//! matter. A row with a missing or non-numeric field, more fields than the header (a decimal
-//! comma shifts the columns), or a second row for the same specimen and node, is an error
-//! naming its line.
+//! matter. A row with a missing or non-numeric field, a coordinate beyond the model's range
+//! (|x| ≤ 10⁷ mm, `truss_core::model::MAX_COORDINATE`), more fields than the header (a
+//! decimal comma shifts the columns), or a second row for the same specimen and node, is an
+//! error naming its line.
 //!
 //! **Outliers.** A specimen with a coordinate more than [`OUTLIER_Z`] robust standard
 //! deviations (1.4826 × the median absolute deviation over the specimens, at least
@@ -310,6 +311,25 @@ fn number(path: &Path, line: u64, column: &str, text: &str) -> Result<f64, Diagn
         })
 }
 
+/// A measured coordinate: a finite number within the model's own coordinate range
+/// (`truss_core::model::MAX_COORDINATE`, 10⁷ mm). A value beyond it (z = 1e300 in every
+/// specimen, which the outlier screen cannot see) is no measurement of this truss.
+fn coordinate(path: &Path, line: u64, column: &str, text: &str) -> Result<f64, DiagnoseError> {
+    let v = number(path, line, column, text)?;
+    let max = truss_core::model::MAX_COORDINATE;
+    if v.abs() > max {
+        return Err(DiagnoseError::BadRow {
+            path: path.to_path_buf(),
+            line,
+            message: format!(
+                "{column} = {text} mm is beyond the coordinates a model may have (|{column}| ≤ {} mm)",
+                truss_core::readable(max)
+            ),
+        });
+    }
+    Ok(v)
+}
+
 /// Reads the node file (and the member file, if given) against `model`; `min_specimens` is
 /// the fewest usable specimens accepted.
 pub fn read(
@@ -330,9 +350,9 @@ pub fn read(
     let mut unknown: BTreeMap<String, ()> = BTreeMap::new();
     for (line, f) in &rows {
         let xyz = [
-            number(nodes_path, *line, "x", &f[2])?,
-            number(nodes_path, *line, "y", &f[3])?,
-            number(nodes_path, *line, "z", &f[4])?,
+            coordinate(nodes_path, *line, "x", &f[2])?,
+            coordinate(nodes_path, *line, "y", &f[3])?,
+            coordinate(nodes_path, *line, "z", &f[4])?,
         ];
         let entry = by_specimen.entry(f[0].clone()).or_insert_with(|| {
             order.push(f[0].clone());
@@ -765,5 +785,21 @@ mod tests {
         assert_eq!((o[0].node.as_str(), o[0].axis), ("n1.0", "z"));
         // s13: dz = 0.001·(91 mod 5 − 2) = −0.001 mm.
         assert!((o[0].displacement - 3419.999).abs() < 1e-6);
+    }
+
+    /// z = 1e300 mm in every specimen moves no specimen from the others (the outlier screen
+    /// cannot see it) and is no measurement: refused naming its line and the range.
+    #[test]
+    fn coordinates_beyond_the_models_range_are_refused() {
+        let model = PrismOptions::with_stages(1).model().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let h = 380.0 * 3f64.sqrt() / 2.0;
+        let mut text = String::from("specimen,node,x,y,z\n");
+        for s in 0..6 {
+            text += &format!("s{s},n1.0,0,0,1e300\ns{s},n1.1,380,0,380\ns{s},n1.2,190,{h},380\n");
+        }
+        let p = write(dir.path(), "far.csv", &text);
+        let e = read(&model, &p, None, 1).err().unwrap().to_string();
+        assert!(e.contains("far.csv:2: z = 1e300 mm is beyond"), "{e}");
     }
 }

@@ -77,6 +77,14 @@ impl Kind for TruncatedNormal {
                 self.limit
             ));
         }
+        if !self.limit_in_sigmas().is_finite() {
+            return Err(format!(
+                "sigma {} mm is too small beside limit {} mm: limit/sigma is beyond the \
+                 largest number (give a larger sigma; beyond 40 σ the cut changes nothing)",
+                truss_core::readable(self.sigma),
+                truss_core::readable(self.limit)
+            ));
+        }
         Ok(())
     }
 
@@ -100,9 +108,17 @@ impl Kind for TruncatedNormal {
         self.mean
     }
 
-    /// `σ·√(1 − 2a·φ(a)/erf(a/√2))` (module doc).
+    /// `σ·√(1 − 2a·φ(a)/erf(a/√2))` (module doc); for a limit so far inside σ that `a²`
+    /// underflows (σ = 1e200 mm, limit 0.01 mm), `t·√(Σ c_k/(2k + 3) / Σ c_k/(2k + 1))`, the
+    /// same series without its factor `a²` (→ t/√3, the uniform's), never 0.
     fn std_dev(&self) -> f64 {
-        self.sigma * truncated_variance(self.limit_in_sigmas()).sqrt()
+        let a = self.limit_in_sigmas();
+        let variance = truncated_variance(a);
+        if variance >= f64::MIN_POSITIVE {
+            self.sigma * variance.sqrt()
+        } else {
+            self.limit * series_ratio(a).sqrt()
+        }
     }
 
     fn lowest(&self) -> f64 {
@@ -174,15 +190,7 @@ impl Kind for TruncatedNormal {
 /// below `a = 1` (module doc).
 pub(crate) fn truncated_variance(a: f64) -> f64 {
     if a < 1.0 {
-        let c = -0.5 * a * a;
-        let (mut term, mut inner, mut outer) = (1.0, 0.0, 0.0);
-        for k in 0..30 {
-            let k = k as f64;
-            inner += term / (2.0 * k + 1.0);
-            outer += term / (2.0 * k + 3.0);
-            term *= c / (k + 1.0);
-        }
-        a * a * outer / inner
+        a * a * series_ratio(a)
     } else if a > 40.0 {
         // a·φ(a) < 10⁻³⁴⁰: nothing of the normal is cut off.
         1.0
@@ -190,6 +198,20 @@ pub(crate) fn truncated_variance(a: f64) -> f64 {
         let density = libm::exp(-0.5 * a * a) / (2.0 * std::f64::consts::PI).sqrt();
         1.0 - 2.0 * a * density / libm::erf(a * std::f64::consts::FRAC_1_SQRT_2)
     }
+}
+
+/// `Σ c_k/(2k + 3) / Σ c_k/(2k + 1)`, `c_k = (−a²/2)^k/k!`, for `a < 1`: the truncated
+/// variance over `a²` (module doc).
+fn series_ratio(a: f64) -> f64 {
+    let c = -0.5 * a * a;
+    let (mut term, mut inner, mut outer) = (1.0, 0.0, 0.0);
+    for k in 0..30 {
+        let k = k as f64;
+        inner += term / (2.0 * k + 1.0);
+        outer += term / (2.0 * k + 3.0);
+        term *= c / (k + 1.0);
+    }
+    outer / inner
 }
 
 /// `x = Φ⁻¹(½ + h) ≥ 0` given both `h` and `tail = ½ − h` (each exact in its own range):
@@ -470,9 +492,46 @@ mod tests {
                 },
                 "sigma is not a finite",
             ),
+            (
+                TruncatedNormal {
+                    sigma: 5e-324,
+                    ..ok
+                },
+                "sigma 5e-324 mm is too small",
+            ),
         ] {
             let m = bad.check().unwrap_err();
             assert!(m.starts_with(field), "{bad:?}: {m}");
         }
+    }
+
+    /// σ = 1e200 mm cut at 0.01 mm is a uniform of ±0.01 mm in all but name: its standard
+    /// deviation is t/√3, not 0 (the variance formula's a² underflows); a limit that is not
+    /// tiny keeps the formula's own bits.
+    #[test]
+    fn a_huge_sigma_keeps_its_spread() {
+        let d = TruncatedNormal {
+            mean: 0.0,
+            sigma: 1e200,
+            limit: 0.01,
+        };
+        d.check().unwrap();
+        let uniform = 0.01 / 3f64.sqrt();
+        assert!(
+            (d.std_dev() / uniform - 1.0).abs() < 1e-15,
+            "{}",
+            d.std_dev()
+        );
+        let d = TruncatedNormal { sigma: 1e300, ..d };
+        assert!(
+            (d.std_dev() / uniform - 1.0).abs() < 1e-15,
+            "{}",
+            d.std_dev()
+        );
+        let d = TruncatedNormal { sigma: 0.02, ..d };
+        assert_eq!(
+            d.std_dev(),
+            0.02 * truncated_variance(d.limit_in_sigmas()).sqrt()
+        );
     }
 }

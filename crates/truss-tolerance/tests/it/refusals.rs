@@ -144,3 +144,32 @@ fn cases_with_effects_are_refused() {
     let e = error(&options(path, "g", &dir));
     assert!(matches!(e, ToleranceError::Unsupported { .. }), "{e}");
 }
+
+/// Finite but extreme inputs (σ = 1e-300 mm, `--cost batten=1e300`) make the study's own σ
+/// overflow: refused naming the group, not as the job's "sigma is not a finite number".
+#[test]
+fn extreme_sigmas_and_costs_are_refused_naming_the_group() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "tiny",
+            r#"{"batten": {"normal": {"sigma": 1e-300}}, "longeron": {"normal": {"sigma": 0.01}}}"#,
+        ),
+        (
+            "plain",
+            r#"{"batten": {"normal": {"sigma": 0.01}}, "longeron": {"normal": {"sigma": 0.01}}}"#,
+        ),
+    ];
+    let path = job(&dir, 1, &cases);
+    let mut costly = options(path.clone(), "plain", &dir);
+    costly.costs = vec!["batten=1e300".into()];
+    for o in [options(path, "tiny", &dir), costly] {
+        let e = error(&o);
+        assert!(matches!(e, ToleranceError::NotScalable { .. }), "{e}");
+        let text = e.to_string();
+        assert!(
+            text.contains("group \"batten\"") && text.contains("not a number"),
+            "{text}"
+        );
+    }
+}

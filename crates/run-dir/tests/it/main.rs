@@ -1,0 +1,3 @@
+//! run-dir's integration tests, one binary.
+
+mod manifest;
