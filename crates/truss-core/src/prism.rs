@@ -212,19 +212,7 @@ impl PrismOptions {
                 format!("must be in [0, 1), got {}", self.compression_ratio),
             ));
         }
-        if let Some(d) = self.diagonal_length {
-            within("diagonal_length", d, MAX_COORDINATE, "mm")?;
-            let face = self.side.hypot(self.height);
-            // Each stage has six joints (a hole at each end of its three longerons).
-            let play = self
-                .backlash
-                .as_ref()
-                .map_or(0.0, |b| 6.0 * self.stages as f64 * b.clearance);
-            let what = "the face diagonal √(side² + height²)";
-            if let Some(fault) = crate::model::initial_strain_fault(d, face, play, what) {
-                return Err(("diagonal_length", fault));
-            }
-        }
+        // The clearance first: the diagonals' check below reads it.
         if let Some(b) = &self.backlash {
             let max = MAX_CLEARANCE_FRACTION * self.side.min(self.height);
             if !(b.clearance.is_finite() && (0.0..=max).contains(&b.clearance)) {
@@ -246,6 +234,19 @@ impl PrismOptions {
                         b.compression_ratio
                     ),
                 ));
+            }
+        }
+        if let Some(d) = self.diagonal_length {
+            within("diagonal_length", d, MAX_COORDINATE, "mm")?;
+            let face = self.side.hypot(self.height);
+            // Each stage has six joints (a hole at each end of its three longerons).
+            let play = self
+                .backlash
+                .as_ref()
+                .map_or(0.0, |b| 6.0 * self.stages as f64 * b.clearance);
+            let what = "the face diagonal √(side² + height²)";
+            if let Some(fault) = crate::model::initial_strain_fault(d, face, play, what) {
+                return Err(("diagonal_length", fault));
             }
         }
         Ok(())
@@ -462,6 +463,19 @@ mod tests {
             ..t()
         };
         assert_eq!(field(loose), "backlash.clearance");
+        // A negative or NaN clearance is named as itself, not as the diagonals' length
+        // that the clearance's play enters.
+        for bad in [-0.01, f64::NAN] {
+            let o = PrismOptions {
+                diagonal_length: Some(428.1),
+                backlash: Some(BacklashOptions {
+                    clearance: bad,
+                    ..BacklashOptions::default()
+                }),
+                ..t()
+            };
+            assert_eq!(field(o), "backlash.clearance", "{bad}");
+        }
         let exaggerated = PrismOptions {
             backlash: Some(BacklashOptions {
                 clearance: 30.0,
