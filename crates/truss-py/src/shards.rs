@@ -173,6 +173,7 @@ mod tests {
             slack_cables: Some(0),
             loose_joints: None,
             floating: None,
+            holding_force: None,
             reason: None,
         };
         let line = sample.to_line();
