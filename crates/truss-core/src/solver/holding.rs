@@ -34,9 +34,11 @@
 //! stiffness, the assembly's history), and a touch, a draught or gravity in a test moves
 //! it.
 //!
-//! It is `0` where `K(u)` is not positive definite at the equilibrium (the state is not
-//! stable against some small load) or a bearing member carries nothing, and it is not
-//! computed where the model's bars frame the tilt (the prism without pin joints, as for
+//! A member that bears less than the solve resolves (`σ·N` within a thousand times the
+//! force floor) sits at its kink, as slack as it is taut, and is not counted: it lets go
+//! under any load, and that changes nothing. The holding force is `0` where `K(u)` is not
+//! positive definite at the equilibrium (the state is not stable against some small load),
+//! and it is not computed where the model's bars frame the tilt (the prism without pin joints, as for
 //! [`crate::SolveReport::floating`]), without a top surface, or where a top node is a
 //! joint's hole node (its position is its joint's, not an unknown to load).
 
