@@ -55,10 +55,15 @@ use std::sync::Arc;
 const GRAZING_FACTOR: f64 = 1e3;
 
 impl Solver {
-    /// The holding force of the converged point (module doc); `None` where it is not
-    /// computed. Changes only scratch state (the solve is over): the factorisation, its
-    /// slack set, the pinned cables and the scratch vectors.
-    pub(super) async fn compute_holding(&mut self, kernels: Kernels<'_>) -> Option<Holding> {
+    /// The holding force of the converged point (module doc), whose force test's floor is
+    /// `force_floor` \[N\]; `None` where it is not computed. Changes only scratch state (the
+    /// solve is over): the factorisation, its slack set, the pinned cables and the scratch
+    /// vectors.
+    pub(super) async fn compute_holding(
+        &mut self,
+        force_floor: f64,
+        kernels: Kernels<'_>,
+    ) -> Option<Holding> {
         let s = Arc::clone(&self.structure);
         if s.tilt_framed {
             return None;
@@ -102,7 +107,7 @@ impl Solver {
             });
         }
         let n = s.free;
-        let grazing = GRAZING_FACTOR * self.options.residual_floor * self.force_resolution_scale();
+        let grazing = GRAZING_FACTOR * force_floor;
         let mut best: Option<Holding> = None;
         for &node in &top.nodes {
             let mut tilt = [0.0; 3];
@@ -179,15 +184,5 @@ impl Solver {
             }
         }
         best
-    }
-
-    /// The force scale of the converged point \[N\]: the largest member force, or the
-    /// sample's force scale if larger (as the force test of the solve uses).
-    fn force_resolution_scale(&self) -> f64 {
-        self.work
-            .states
-            .iter()
-            .map(|st| st.force.abs())
-            .fold(self.sample.force_ref, f64::max)
     }
 }

@@ -167,7 +167,8 @@ impl Solver {
             }
         }
         let floating = self.floating();
-        self.holding = self.compute_holding(kernels).await;
+        let floor = self.force_floor(&p.eval);
+        self.holding = self.compute_holding(floor, kernels).await;
         Ok(SolveReport {
             iterations: p.iterations,
             factorisations: p.factorisations,
