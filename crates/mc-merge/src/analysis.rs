@@ -28,22 +28,17 @@ pub struct CaseAnalysis {
 /// The holding forces of a case's converged samples (see [`HoldingForces`]); `target` is
 /// the empirical target percentile of θ_P \[rad\], if any, whose tail is summarised apart.
 pub fn holding_forces(case: &CaseData, target: Option<f64>, conf: f64) -> HoldingForces {
-    let mut forces: Vec<f64> = case
-        .points()
-        .map(|p| p.holding)
-        .filter(|h| !h.is_nan())
-        .collect();
+    let (mut forces, mut loose, mut tail_recorded, mut tail_loose) = (Vec::new(), 0, 0, 0);
+    for p in case.points().filter(|p| !p.holding.is_nan()) {
+        let is_loose = u64::from(p.holding < LOOSE_HOLDING_FORCE);
+        forces.push(p.holding);
+        loose += is_loose;
+        if target.is_some_and(|t| p.theta > t) {
+            tail_recorded += 1;
+            tail_loose += is_loose;
+        }
+    }
     forces.sort_by(f64::total_cmp);
-    let loose = forces.iter().filter(|&&f| f < LOOSE_HOLDING_FORCE).count() as u64;
-    let (tail_recorded, tail_loose) = match target {
-        Some(t) => case
-            .points()
-            .filter(|p| p.theta > t && !p.holding.is_nan())
-            .fold((0u64, 0u64), |(n, k), p| {
-                (n + 1, k + u64::from(p.holding < LOOSE_HOLDING_FORCE))
-            }),
-        None => (0, 0),
-    };
     let recorded = forces.len() as u64;
     HoldingForces {
         recorded,
