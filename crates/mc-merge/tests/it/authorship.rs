@@ -4,27 +4,9 @@
 //! written; the sweep of stale temporary files takes only the writers' own names; the lock
 //! file is never removed.
 
-use crate::common::{SynthCase, SynthJob};
 use crate::hostile::code;
+use crate::report_dir::{job, merge};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn job(seed: u64, name: &str) -> SynthJob {
-    SynthJob::new(
-        seed,
-        vec![SynthCase::rayleigh(name, 200, 3e-5, &[("stages", 5.0)])],
-    )
-}
-
-fn merge_into(shards: &Path, out: &Path, extra: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_mc-merge"))
-        .arg(shards)
-        .args(["--replicates", "50", "--gof-replicates", "19", "--out"])
-        .arg(out)
-        .args(extra)
-        .output()
-        .unwrap()
-}
 
 fn read(dir: &Path, name: &str) -> String {
     std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
@@ -36,7 +18,7 @@ fn read(dir: &Path, name: &str) -> String {
 fn a_planted_manifest_deletes_nothing() {
     let shards = tempfile::tempdir().unwrap();
     let out = tempfile::tempdir().unwrap();
-    job(11, "a").write_split(shards.path(), 1);
+    job(11, &["a"]).write_split(shards.path(), 1);
     std::fs::write(out.path().join("notes.txt"), "notes").unwrap();
     std::fs::write(out.path().join("data.csv"), "1,2").unwrap();
     std::fs::write(
@@ -44,7 +26,7 @@ fn a_planted_manifest_deletes_nothing() {
         "# the files mc-merge wrote\nnotes.txt\ndata.csv\n.truss-mc.lock\n",
     )
     .unwrap();
-    let (status, stderr) = code(&merge_into(shards.path(), out.path(), &[]));
+    let (status, stderr) = code(&merge(shards.path(), out.path(), &[]));
     assert_eq!(status, Some(0), "{stderr}");
     assert!(
         stderr.contains(".mc-merge.manifest: not trusted"),
@@ -63,8 +45,8 @@ fn an_appended_line_deletes_nothing() {
     use std::os::unix::fs::MetadataExt;
     let shards = tempfile::tempdir().unwrap();
     let out = tempfile::tempdir().unwrap();
-    job(12, "a").write_split(shards.path(), 1);
-    assert_eq!(code(&merge_into(shards.path(), out.path(), &[])).0, Some(0));
+    job(12, &["a"]).write_split(shards.path(), 1);
+    assert_eq!(code(&merge(shards.path(), out.path(), &[])).0, Some(0));
     std::fs::write(out.path().join("notes.txt"), "notes").unwrap();
     let manifest = out.path().join(".mc-merge.manifest");
     let mut text = read(out.path(), ".mc-merge.manifest");
@@ -73,7 +55,7 @@ fn an_appended_line_deletes_nothing() {
     let inode = std::fs::metadata(out.path().join("report.json"))
         .unwrap()
         .ino();
-    let (status, stderr) = code(&merge_into(shards.path(), out.path(), &["--no-plots"]));
+    let (status, stderr) = code(&merge(shards.path(), out.path(), &["--no-plots"]));
     assert_eq!(status, Some(5), "{stderr}");
     assert!(stderr.contains("not trusted"), "{stderr}");
     assert!(stderr.contains("report.json: not replaced"), "{stderr}");
@@ -91,13 +73,13 @@ fn an_appended_line_deletes_nothing() {
 fn another_writers_file_is_not_replaced() {
     let shards = tempfile::tempdir().unwrap();
     let out = tempfile::tempdir().unwrap();
-    job(13, "ecdf-before").write_split(shards.path(), 1);
+    job(13, &["ecdf-before"]).write_split(shards.path(), 1);
     std::fs::write(
         out.path().join("theta_p-ecdf-before.svg"),
         "the diagnosis's",
     )
     .unwrap();
-    let (status, stderr) = code(&merge_into(shards.path(), out.path(), &[]));
+    let (status, stderr) = code(&merge(shards.path(), out.path(), &[]));
     assert_eq!(status, Some(5), "{stderr}");
     assert!(stderr.contains("theta_p-ecdf-before.svg"), "{stderr}");
     assert_eq!(
@@ -112,11 +94,11 @@ fn another_writers_file_is_not_replaced() {
 fn the_sweep_leaves_names_not_ours() {
     let shards = tempfile::tempdir().unwrap();
     let out = tempfile::tempdir().unwrap();
-    job(14, "a").write_split(shards.path(), 1);
-    assert_eq!(code(&merge_into(shards.path(), out.path(), &[])).0, Some(0));
+    job(14, &["a"]).write_split(shards.path(), 1);
+    assert_eq!(code(&merge(shards.path(), out.path(), &[])).0, Some(0));
     std::fs::write(out.path().join(".report.md.tmp-mynotes"), "mine").unwrap();
     std::fs::write(out.path().join(".report.md.tmp-0123456789abcdef"), "stale").unwrap();
-    let (status, stderr) = code(&merge_into(shards.path(), out.path(), &[]));
+    let (status, stderr) = code(&merge(shards.path(), out.path(), &[]));
     assert_eq!(status, Some(0), "{stderr}");
     assert_eq!(read(out.path(), ".report.md.tmp-mynotes"), "mine");
     assert!(!out.path().join(".report.md.tmp-0123456789abcdef").exists());
@@ -127,14 +109,14 @@ fn the_sweep_leaves_names_not_ours() {
 fn a_name_in_the_way_leaves_the_report_whole() {
     let shards = tempfile::tempdir().unwrap();
     let out = tempfile::tempdir().unwrap();
-    job(15, "a").write_split(shards.path(), 1);
-    assert_eq!(code(&merge_into(shards.path(), out.path(), &[])).0, Some(0));
+    job(15, &["a"]).write_split(shards.path(), 1);
+    assert_eq!(code(&merge(shards.path(), out.path(), &[])).0, Some(0));
     use std::os::unix::fs::MetadataExt;
     let inode = |p: &Path| std::fs::metadata(p.join("report.json")).unwrap().ino();
     let before = inode(out.path());
     std::fs::remove_file(out.path().join("report.html")).unwrap();
     std::fs::create_dir(out.path().join("report.html")).unwrap();
-    let (status, stderr) = code(&merge_into(shards.path(), out.path(), &[]));
+    let (status, stderr) = code(&merge(shards.path(), out.path(), &[]));
     assert_eq!(status, Some(5), "{stderr}");
     assert!(stderr.contains("report.html"), "{stderr}");
     assert_eq!(inode(out.path()), before, "report.json was replaced");

@@ -509,6 +509,21 @@ fn completions_and_man_page() {
     );
 }
 
+/// `job` written in `shards` shards and merged into their directory's `report/` (exit 0):
+/// the directory (kept while it lives), the report directory, the run and `report.json`.
+fn merged(job: &SynthJob, shards: u64) -> (tempfile::TempDir, PathBuf, Out, Value) {
+    let dir = tempfile::tempdir().unwrap();
+    job.write_split(dir.path(), shards);
+    let out = dir.path().join("report");
+    let run = mc_merge(
+        &["--out", out.to_str().unwrap()],
+        &[dir.path().to_path_buf()],
+    );
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let v: Value = serde_json::from_str(&report(&out)).unwrap();
+    (dir, out, run, v)
+}
+
 /// The holding forces of a case, against the same figures computed here from the samples:
 /// the 5th, 50th and 95th percentiles (definition 1: the `⌈p·n⌉`-th smallest), the samples
 /// held by less than 1 µN among all and among those above θ_P95, and a caveat naming the
@@ -519,15 +534,7 @@ fn holding_forces_are_summarised_and_a_loosely_held_tail_is_named() {
     loose.floating_every = Some(4);
     let framed = SynthCase::rayleigh("framed", 400, 2e-5, &[("sigma", 0.05)]);
     let job = SynthJob::new(11, vec![loose, framed]);
-    let dir = tempfile::tempdir().unwrap();
-    job.write_split(dir.path(), 3);
-    let out = dir.path().join("report");
-    let run = mc_merge(
-        &["--out", out.to_str().unwrap()],
-        &[dir.path().to_path_buf()],
-    );
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    let v: Value = serde_json::from_str(&report(&out)).unwrap();
+    let (_dir, out, _, v) = merged(&job, 3);
     let h = &v["cases"][0]["holding_force"];
     let samples: Vec<_> = (0..400).map(|i| job.sample(i)).collect();
     let mut forces: Vec<f64> = samples.iter().map(|s| s.holding_force.unwrap()).collect();
@@ -594,15 +601,7 @@ fn floating_stages_are_counted_and_a_heavy_tail_is_named() {
     light.floating_every = Some(50);
     let framed = SynthCase::rayleigh("framed", 400, 2e-5, &[("sigma", 0.05)]);
     let job = SynthJob::new(9, vec![heavy, light, framed]);
-    let dir = tempfile::tempdir().unwrap();
-    job.write_split(dir.path(), 2);
-    let out = dir.path().join("report");
-    let run = mc_merge(
-        &["--out", out.to_str().unwrap()],
-        &[dir.path().to_path_buf()],
-    );
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    let v: Value = serde_json::from_str(&report(&out)).unwrap();
+    let (_dir, _, run, v) = merged(&job, 2);
     let case = |i: usize| &v["cases"][i];
     assert_eq!(case(0)["floating"]["recorded"], 400);
     assert_eq!(case(0)["floating"]["floating"], 40);

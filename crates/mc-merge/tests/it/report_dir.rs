@@ -8,7 +8,8 @@ use crate::common::{SynthCase, SynthJob};
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn job(seed: u64, names: &[&str]) -> SynthJob {
+/// A job of one 200-sample Rayleigh case per name (also the authorship tests').
+pub(crate) fn job(seed: u64, names: &[&str]) -> SynthJob {
     SynthJob::new(
         seed,
         names
@@ -18,7 +19,9 @@ fn job(seed: u64, names: &[&str]) -> SynthJob {
     )
 }
 
-fn merge(shards: &Path, out: &Path, extra: &[&str]) -> Output {
+/// mc-merge of `shards` into `out` with few replicates, and `extra` (also the authorship
+/// tests').
+pub(crate) fn merge(shards: &Path, out: &Path, extra: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mc-merge"))
         .arg(shards)
         .args(["--replicates", "50", "--gof-replicates", "19", "--out"])
