@@ -80,6 +80,7 @@ mod linearised;
 pub mod measure;
 pub mod model;
 pub mod model_file;
+mod model_read;
 mod ordering;
 pub mod output;
 pub mod prism;

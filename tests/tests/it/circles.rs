@@ -1,6 +1,8 @@
 //! No two files of a crate import each other, directly or around a circle (STYLE.md, habit
 //! 17): shared types sink into a leaf module. This test reads every workspace crate's sources
-//! and fails on a circle of imports between its files.
+//! and fails on a circle of imports between its files, and on a circle between the crate
+//! root's modules taken whole (a module with the files below it), which a re-export can hide
+//! from the file view.
 //!
 //! ## What counts as an import
 //!
@@ -22,7 +24,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// Circles that are being removed: skipped while a re-shaping is under way, by crate and the
-/// files of the circle (under `src/`). None today; delete an entry when its circle is gone.
+/// files of the circle (under `src/`) or its modules (names under the crate root). None today; delete an entry when its circle is gone.
 const KNOWN: &[(&str, &[&str])] = &[];
 
 #[test]
@@ -46,6 +48,14 @@ fn no_file_imports_a_file_that_imports_it_back() {
                 if !known {
                     let shown: Vec<String> = circle.iter().map(|f| relative(f, &dir)).collect();
                     circles.push(format!("{name}: {}", shown.join(" → ")));
+                }
+            }
+            for circle in graph.module_circles() {
+                let known = KNOWN.iter().any(|(c, known)| {
+                    *c == name && circle.iter().all(|m| known.contains(&m.as_str()))
+                });
+                if !known {
+                    circles.push(format!("{name}: modules {}", circle.join(" → ")));
                 }
             }
         }
@@ -112,6 +122,53 @@ fn the_reader_finds_a_circle_and_follows_re_exports() {
         .map(|c| c.iter().map(name).collect())
         .collect();
     assert_eq!(circles, [["a.rs", "b/inner.rs", "c.rs"]]);
+    assert_eq!(graph.module_circles(), [["a", "b", "c"]]);
+}
+
+/// A module named inside a `use crate::{…}` tree and then used through its path is an
+/// import; and two modules whose files import each other only through a re-export (here
+/// `limit.rs` takes `Structure` through `structure/mod.rs`, which defines none of it) are a
+/// circle of modules, though no two files import each other. This is the form that
+/// `truss-core`'s `structure/mod.rs` and `limit.rs` had.
+#[test]
+fn a_circle_through_a_re_export_is_a_circle_of_modules() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = dir.path().join("src");
+    std::fs::create_dir_all(src.join("structure")).unwrap();
+    let write = |p: &str, s: &str| std::fs::write(src.join(p), s).unwrap();
+    write(
+        "lib.rs",
+        "mod structure;\npub mod limit;\npub struct ModelError;\n",
+    );
+    write(
+        "structure/mod.rs",
+        "mod compiled;\npub use compiled::Structure;\nuse crate::{ModelError, limit};\n\
+         fn new() -> Result<Structure, ModelError> { limit::framed(); todo!() }\n",
+    );
+    write("structure/compiled.rs", "pub struct Structure;\n");
+    write(
+        "limit.rs",
+        "use crate::structure::Structure;\npub fn framed(s: &Structure) {}\n",
+    );
+    let graph = Crate::read(&src.join("lib.rs"));
+    let name = |p: &PathBuf| relative(p, &src);
+    let edges: BTreeSet<(String, String)> = graph
+        .edges
+        .iter()
+        .flat_map(|(a, bs)| bs.iter().map(move |b| (name(a), name(b))))
+        .collect();
+    let expect: BTreeSet<(String, String)> = [
+        ("limit.rs", "structure/compiled.rs"),
+        ("structure/mod.rs", "limit.rs"),
+        ("structure/mod.rs", "lib.rs"),
+        ("structure/mod.rs", "structure/compiled.rs"),
+    ]
+    .iter()
+    .map(|(a, b)| (a.to_string(), b.to_string()))
+    .collect();
+    assert_eq!(edges, expect);
+    assert!(graph.circles().is_empty());
+    assert_eq!(graph.module_circles(), [["limit", "structure"]]);
 }
 
 /// `crates/*` and the workspace's own test crate.
@@ -456,53 +513,81 @@ impl Crate {
     /// The circles between files: each strongly connected set of more than one file, in
     /// name order (Tarjan's algorithm).
     fn circles(&self) -> Vec<Vec<PathBuf>> {
-        let files: Vec<&PathBuf> = self
+        let files: BTreeSet<PathBuf> = self.modules.values().map(|m| m.file.clone()).collect();
+        strongly_connected(&files, &self.edges)
+    }
+
+    /// The circles between the crate root's modules, each taken whole with the files below
+    /// it (`structure/` with `structure/compiled.rs`): a file of module `a` that imports a
+    /// file of module `b`, while a file of `b` imports one of `a`, is a circle between `a`
+    /// and `b` even where no two files import each other (a name taken through `b`'s
+    /// re-export from one of its children). The root's own file belongs to none.
+    fn module_circles(&self) -> Vec<Vec<String>> {
+        let top: BTreeMap<&PathBuf, String> = self
             .modules
-            .values()
-            .map(|m| &m.file)
-            .collect::<BTreeSet<_>>()
-            .into_iter()
-            .collect();
-        let index: BTreeMap<&PathBuf, usize> =
-            files.iter().enumerate().map(|(i, f)| (*f, i)).collect();
-        let next: Vec<Vec<usize>> = files
             .iter()
-            .map(|f| {
-                self.edges
-                    .get(*f)
-                    .into_iter()
-                    .flatten()
-                    .filter_map(|t| index.get(t).copied())
-                    .collect()
-            })
+            .filter_map(|(path, m)| path.first().map(|t| (&m.file, t.clone())))
             .collect();
-        let mut tarjan = Tarjan {
-            next: &next,
-            index: vec![None; files.len()],
-            low: vec![0; files.len()],
-            on_stack: vec![false; files.len()],
-            stack: Vec::new(),
-            counter: 0,
-            found: Vec::new(),
-        };
-        for v in 0..files.len() {
-            if tarjan.index[v].is_none() {
-                tarjan.visit(v);
+        let mut edges: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
+        for (from, tos) in &self.edges {
+            for to in tos {
+                if let (Some(a), Some(b)) = (top.get(from), top.get(to))
+                    && a != b
+                {
+                    edges.entry(a.clone()).or_default().insert(b.clone());
+                }
             }
         }
-        let mut circles: Vec<Vec<PathBuf>> = tarjan
-            .found
-            .into_iter()
-            .filter(|c| c.len() > 1)
-            .map(|c| {
-                let mut c: Vec<PathBuf> = c.into_iter().map(|v| files[v].clone()).collect();
-                c.sort();
-                c
-            })
-            .collect();
-        circles.sort();
-        circles
+        let names: BTreeSet<String> = top.values().cloned().collect();
+        strongly_connected(&names, &edges)
     }
+}
+
+/// Each strongly connected set of more than one of `nodes` under `edges`, sorted, in order
+/// (Tarjan's algorithm).
+fn strongly_connected<T: Ord + Clone>(
+    nodes: &BTreeSet<T>,
+    edges: &BTreeMap<T, BTreeSet<T>>,
+) -> Vec<Vec<T>> {
+    let nodes: Vec<&T> = nodes.iter().collect();
+    let index: BTreeMap<&T, usize> = nodes.iter().enumerate().map(|(i, f)| (*f, i)).collect();
+    let next: Vec<Vec<usize>> = nodes
+        .iter()
+        .map(|f| {
+            edges
+                .get(*f)
+                .into_iter()
+                .flatten()
+                .filter_map(|t| index.get(t).copied())
+                .collect()
+        })
+        .collect();
+    let mut tarjan = Tarjan {
+        next: &next,
+        index: vec![None; nodes.len()],
+        low: vec![0; nodes.len()],
+        on_stack: vec![false; nodes.len()],
+        stack: Vec::new(),
+        counter: 0,
+        found: Vec::new(),
+    };
+    for v in 0..nodes.len() {
+        if tarjan.index[v].is_none() {
+            tarjan.visit(v);
+        }
+    }
+    let mut circles: Vec<Vec<T>> = tarjan
+        .found
+        .into_iter()
+        .filter(|c| c.len() > 1)
+        .map(|c| {
+            let mut c: Vec<T> = c.into_iter().map(|v| nodes[v].clone()).collect();
+            c.sort();
+            c
+        })
+        .collect();
+    circles.sort();
+    circles
 }
 
 struct Tarjan<'a> {

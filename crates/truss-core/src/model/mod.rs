@@ -24,8 +24,6 @@ use crate::{DEFAULT_COMPRESSION_RATIO, MAX_LENGTH_ERROR_FRACTION, ModelError};
 pub const MAX_CLEARANCE_FRACTION: f64 = 0.1;
 use std::collections::HashMap;
 
-mod read;
-
 /// A node.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Node {
@@ -127,7 +125,7 @@ pub struct Model {
 impl Model {
     /// Validates everything but the mechanism check (which needs the solver's structure;
     /// [`Model::new`] does both).
-    pub(super) fn check(file: ModelFile) -> Result<Self, ModelError> {
+    pub(crate) fn check(file: ModelFile) -> Result<Self, ModelError> {
         if file.nodes.is_empty() {
             return Err(ModelError::Empty { what: "nodes" });
         }

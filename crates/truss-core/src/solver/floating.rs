@@ -2,7 +2,7 @@
 //! regularisation alone, not by the members that bear (see [`crate::limit`]).
 
 use super::Solver;
-use crate::limit::tilt_loads;
+use crate::structure::tilt_loads;
 
 /// A sample floats when the members that bear take less than this share of the work of a
 /// tilting load.
@@ -10,7 +10,7 @@ const BEARING_SHARE: f64 = 0.5;
 
 impl Solver {
     /// Whether the converged point floats. For each tilting load `g` (see
-    /// [`crate::limit::tilt_loads`]), `x = K_S⁻¹·g` with the linearised stiffness of the
+    /// [`crate::structure::tilt_loads`]), `x = K_S⁻¹·g` with the linearised stiffness of the
     /// current slack set (the material stiffness of the members that bear, and the slack
     /// members' `r·k`: the geometric stiffness of the pretension is left out, so what it
     /// holds counts as not held by members), and the work `gᵀx = Σ_m k_e,m·(b_mᵀx)²` is

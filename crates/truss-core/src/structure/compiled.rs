@@ -40,7 +40,7 @@ pub struct Structure {
     pub(crate) basis: Option<CableBasis>,
     pub(crate) top_surface: Option<TopSurface>,
     /// Whether the model's bars frame the top surface's tilt by themselves (see
-    /// [`crate::limit::tilt_framed_by_bars`]): then no sample floats.
+    /// [`crate::limit`]): then no sample floats.
     pub(crate) tilt_framed: bool,
 }
 

@@ -18,9 +18,9 @@
 //!    the model's members;
 //! 3. **sparsity** (`sparsity.rs`): which member first writes each block of the band, and
 //!    which blocks none reaches;
-//! 4. **factorisation** (`factorisation.rs`): `K₀` assembled and factorised; then the working
-//!    compression ratio of the cables of ratio 0, from whether the bars frame the top
-//!    surface's tilt ([`crate::limit`]);
+//! 4. **factorisation** (`factorisation.rs`): `K₀` assembled and factorised; then
+//!    (`framing.rs`) the working compression ratio of the cables of ratio 0, from whether the
+//!    bars frame the top surface's tilt (what the ratios stand for: [`crate::limit`]);
 //! 5. **low-rank basis** (`basis.rs`): the Woodbury data over the cables.
 //!
 //! The compiled pieces (`parts.rs`) and the [`Structure`] type (`compiled.rs`) sit below the
@@ -29,6 +29,7 @@
 mod basis;
 mod compiled;
 mod factorisation;
+mod framing;
 mod joints;
 mod numbering;
 mod parts;
@@ -36,10 +37,12 @@ mod sparsity;
 
 pub(crate) use basis::CableBasis;
 pub use compiled::Structure;
+pub(crate) use framing::tilt_loads;
+pub use framing::{FRAMED_RATIO, LIMIT_RATIO};
 pub(crate) use parts::{FIXED, Link};
 
+use crate::ModelError;
 use crate::model::Model;
-use crate::{ModelError, limit};
 
 impl Structure {
     /// Compiles `model` and factorises `K₀`; fails if the model is a mechanism.
@@ -71,12 +74,8 @@ impl Structure {
         };
         factorisation::factorise_nominal(&structure, &mut k)?;
         structure.nominal = k;
-        structure.tilt_framed = limit::tilt_framed_by_bars(&structure);
-        let working = if structure.tilt_framed {
-            limit::FRAMED_RATIO
-        } else {
-            limit::LIMIT_RATIO
-        };
+        let (tilt_framed, working) = framing::working_ratio(&structure);
+        structure.tilt_framed = tilt_framed;
         for c in structure.members.iter_mut().filter(|c| c.limit) {
             c.compression_ratio = working;
         }

@@ -23,7 +23,7 @@
 //! median and 95th percentile of θ_P within a factor [`TOL_RATIO`] of the prediction.
 
 use crate::comparison::measured::{Coordinate, Measured};
-use crate::comparison::simulate::Simulation;
+use crate::comparison::simulate::{RESOLUTION, Simulation};
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
 use truss_stats::bootstrap::{BootstrapConfig, SortedSample, bootstrap_quantiles};
@@ -656,7 +656,7 @@ pub fn compare(
         threads,
     ));
     stats.push(ks_statistic(&measured.theta_p, &sim.theta_p));
-    let floor = (sigma_m * sigma_m + crate::likelihood::gaussian::RESOLUTION.powi(2)).sqrt();
+    let floor = (sigma_m * sigma_m + RESOLUTION.powi(2)).sqrt();
     let scale: Vec<f64> = (0..d)
         .map(|j| moments(&columns[j].1).sd.max(floor))
         .collect();

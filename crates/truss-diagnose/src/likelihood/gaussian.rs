@@ -34,10 +34,9 @@ use crate::comparison::simulate::Simulation;
 use crate::errors::DiagnoseError;
 use nalgebra::{DMatrix, DVector};
 
-/// The floor τ of the predicted standard deviation of every coordinate \[mm\]: 0.1 µm, below
-/// any instrument's resolution for trusses of this size, and large against the solver's
-/// error (1e-12 relative).
-pub const RESOLUTION: f64 = 1e-4;
+/// The floor τ of the predicted standard deviation (defined with the simulation it floors,
+/// which the comparison's statistics read too).
+pub use crate::comparison::simulate::RESOLUTION;
 
 /// The specimens' mean and covariance.
 #[derive(Debug, Clone)]

@@ -1,8 +1,9 @@
 //! Reading and validating a model file into a [`Model`]: every item checked
 //! ([`Model::check`]'s rules), then the mechanism check, which compiles the model's
-//! [`Structure`] and factorises its stiffness.
+//! [`Structure`] and factorises its stiffness. Beside `model` rather than inside it: the
+//! compiler reads the model, and this reads the compiler.
 
-use super::Model;
+use crate::model::Model;
 use crate::model_file::ModelFile;
 use crate::{ModelError, Structure};
 use std::path::Path;
