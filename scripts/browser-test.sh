@@ -25,10 +25,13 @@
 #
 # Usage: scripts/browser-test.sh [REPORT_DIR]
 #        (needs chromium and python3; without REPORT_DIR, target/release/mc-shard and
-#        mc-merge; CHROMIUM=/path/to/chromium to use another build)
+#        mc-merge, or the binaries MC_SHARD and MC_MERGE name; CHROMIUM=/path/to/chromium to
+#        use another build)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 CHROMIUM="${CHROMIUM:-chromium}"
+MC_SHARD="${MC_SHARD:-$REPO/target/release/mc-shard}"
+MC_MERGE="${MC_MERGE:-$REPO/target/release/mc-merge}"
 WORK="$(mktemp -d /tmp/truss-mc-browser.XXXXXX)"
 trap 'rm -rf "$WORK"' EXIT
 fail() { echo "browser-test: $*" >&2; exit 1; }
@@ -52,9 +55,9 @@ else
   ]
 }
 JOB
-    "$REPO/target/release/mc-shard" run --job "$WORK/job.json" --out "$WORK/run" --quiet > "$WORK/run.log" 2>&1 \
+    "$MC_SHARD" run --job "$WORK/job.json" --out "$WORK/run" --quiet > "$WORK/run.log" 2>&1 \
         || { cat "$WORK/run.log" >&2; fail "mc-shard run failed"; }
-    "$REPO/target/release/mc-merge" "$WORK/run" --out "$WORK/report" --quiet
+    "$MC_MERGE" "$WORK/run" --out "$WORK/report" --quiet
     REPORT="$WORK/report"
 fi
 [[ -s "$REPORT/report.html" ]] || fail "no report.html in $REPORT"

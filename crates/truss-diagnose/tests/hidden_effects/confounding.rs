@@ -133,7 +133,7 @@ fn an_absorbed_length_bias_is_said_fast() {
 /// gradient: here only the ridge probe finds it (`along_ridge`), and without the probe
 /// nothing was listed. Both named passes too.
 #[test]
-#[ignore = "slow statistical check (tens of seconds): scripts/test.sh runs it in release"]
+#[ignore = "slow statistical check (a few seconds): scripts/test.sh runs it"]
 fn a_batten_bias_on_a_flat_ridge_is_said() {
     let dir = tempfile::tempdir().unwrap();
     let v = hidden(
