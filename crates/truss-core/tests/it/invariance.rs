@@ -300,7 +300,7 @@ fn theta_statistics_do_not_depend_on_the_compression_ratio() {
 /// ratios 1e-5 … 1e-2, and for 1e-3 and 1e-2 at σ = 66.7 µm (the paper's largest) and at
 /// 300 stages (smaller ratios take hundreds of factorisations per solve there).
 #[test]
-#[ignore = "slow: 300-stage solves, run in release by scripts/test.sh"]
+#[ignore = "slow: 300-stage solves, run optimised by scripts/test.sh"]
 fn theta_statistics_of_long_trusses_do_not_depend_on_the_compression_ratio() {
     let w30 = assert_ratio_does_not_matter(30, SIGMA, 1000, &[1e-5, 1e-3, 1e-2]);
     let w30_large = assert_ratio_does_not_matter(30, 0.0667, 500, &[1e-3, 1e-2]);

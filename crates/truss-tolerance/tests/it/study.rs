@@ -154,7 +154,7 @@ fn truncated_normals_are_scaled_with_their_limit() {
 /// small (the paper: battens alone give about 4 % of θ_P95, so about 0.2 % of the variance),
 /// and the battens get the wider tolerance.
 #[test]
-#[ignore = "slow: 64,000 solves of the 5-stage truss (run in release by scripts/test.sh)"]
+#[ignore = "slow: 64,000 solves of the 5-stage truss (run optimised by scripts/test.sh)"]
 fn the_paper_case_allocation_verifies() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let dir = tempfile::tempdir().unwrap();
