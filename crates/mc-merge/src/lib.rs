@@ -291,18 +291,33 @@ pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError>
         }
         names.extend([readable::MARKDOWN_FILE, readable::HTML_FILE].map(String::from));
         let mut files = report_dir::open(dir, &merge.report.job_id, &names)?;
-        let path = files.write(report_dir::REPORT_FILE, json.as_bytes())?;
-        text.push_str(&format!("\nwrote {}\n", path.display()));
+        files.write(report_dir::REPORT_FILE, json.as_bytes())?;
+        text.push('\n');
         let plots = if options.plots {
             plot::draw_all(&mut files, &merge.dataset.cases, &merge.report)?
         } else {
             vec![]
         };
         let readable = readable::write(&mut files, &merge.report, &merge.dataset.writers, &plots)?;
-        for p in plots.iter().chain(&readable) {
-            text.push_str(&format!("wrote {}\n", p.display()));
-        }
         files.finish()?;
+        // One line for the files (a report has dozens of plots), then the answer, then where
+        // to read the rest: the last lines on the screen are what the user came for.
+        text.push_str(&format!(
+            "wrote {} files to {}: {}, {} plots, {}, {}\n",
+            1 + plots.len() + readable.len(),
+            dir.display(),
+            report_dir::REPORT_FILE,
+            plots.len(),
+            readable::MARKDOWN_FILE,
+            readable::HTML_FILE
+        ));
+        text.push_str(&table::answer(&merge.report));
+        text.push_str(&format!(
+            "\nreport: {}\n",
+            dir.join(readable::HTML_FILE).display()
+        ));
+    } else {
+        text.push_str(&table::answer(&merge.report));
     }
     out.write_all(text.as_bytes())
         .map_err(|source| MergeError::Io {

@@ -93,7 +93,9 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
             };
             let exe = std::env::current_exe().map_err(CommandError::from)?;
             let started = Instant::now();
-            run_all(&exe, &job, &options, out)?;
+            // The merge's table comes last: its last lines are the answer and the report.
+            let mut table = Vec::new();
+            run_all(&exe, &job, &options, &mut table)?;
             writeln!(
                 out,
                 "run-all: {} samples in {} shards on {} workers, {:.2} s{}",
@@ -101,13 +103,10 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> Result<(), Error> {
                 options.shards,
                 workers,
                 started.elapsed().as_secs_f64(),
-                if a.no_merge {
-                    String::new()
-                } else {
-                    format!("; report in {}", a.out.join("report").display())
-                }
+                if a.no_merge { "" } else { "; the merge:" }
             )
             .map_err(CommandError::from)?;
+            out.write_all(&table).map_err(CommandError::from)?;
             Ok(())
         }
     }

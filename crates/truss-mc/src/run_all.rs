@@ -242,6 +242,12 @@ async fn run_and_merge(
     }
     let mut table = Vec::new();
     if options.audit_samples > 0 {
+        if !options.quiet {
+            eprintln!(
+                "run-all: auditing: re-solving {} sampled lines and comparing them byte for byte…",
+                options.audit_samples
+            );
+        }
         let audit_options = mc_shard::audit::AuditOptions {
             samples: options.audit_samples,
             seed: 0,
@@ -271,6 +277,11 @@ async fn run_and_merge(
             ..mc_merge::Settings::default()
         },
     };
+    if !options.quiet {
+        eprintln!(
+            "run-all: merging: verifying every shard, bootstrapping the intervals, drawing the plots…"
+        );
+    }
     let merging =
         tokio::task::spawn_blocking(move || mc_merge::run(&merge, &mut table).map(|_| table));
     tokio::select! {
@@ -329,6 +340,18 @@ async fn run_children(
     let mut kept = 0;
     for (r, (offset, lines)) in ranges.iter().zip(counted.iter_mut()) {
         kept += count_new_lines(&options.out.join(r.file_name()), offset, lines, r.len());
+    }
+    if kept > 0 && !options.quiet {
+        let complete = ranges
+            .iter()
+            .zip(&counted)
+            .filter(|(r, (_, lines))| *lines == r.len())
+            .count();
+        let resumed = counted.iter().filter(|(_, lines)| *lines > 0).count() - complete;
+        eprintln!(
+            "run-all: reusing {kept} samples already in {}: {complete} of {k} shards complete, {resumed} resumed where they stopped",
+            options.out.display()
+        );
     }
     let limit = Arc::new(tokio::sync::Semaphore::new(options.workers.max(1)));
     let (cancel_tx, cancel_rx) = tokio::sync::watch::channel(false);

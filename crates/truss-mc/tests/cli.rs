@@ -73,6 +73,44 @@ fn run_all_runs_every_shard_then_merges() {
     assert_eq!(sample_lines(&all), sample_lines(&single));
     assert!(all.join("report/report.json").exists());
     assert!(all.join("report/theta_p-normal.svg").exists());
+    // Without --quiet: the audit and the merge say when they start, a rerun says what it
+    // reused, and the last line names report.html.
+    let again = truss_mc(
+        &[
+            "run-all",
+            "--job",
+            job.to_str().unwrap(),
+            "--out",
+            all.to_str().unwrap(),
+            "--shards",
+            "5",
+            "--workers",
+            "3",
+        ],
+        &[],
+    );
+    assert!(
+        again.status.success(),
+        "{}",
+        String::from_utf8_lossy(&again.stderr)
+    );
+    let stderr = String::from_utf8_lossy(&again.stderr);
+    for said in [
+        format!(
+            "run-all: reusing 120 samples already in {}: 5 of 5 shards complete, 0 resumed",
+            all.display()
+        ),
+        "run-all: auditing: re-solving".to_string(),
+        "run-all: merging: verifying every shard".to_string(),
+    ] {
+        assert!(stderr.contains(&said), "{said:?} not in {stderr}");
+    }
+    let stdout = String::from_utf8_lossy(&again.stdout);
+    assert_eq!(
+        stdout.lines().last(),
+        Some(format!("report: {}", all.join("report/report.html").display()).as_str()),
+        "{stdout}"
+    );
 }
 
 /// Exit codes of `run-all`: an invalid job is refused with mc-shard's code 3 before anything

@@ -105,6 +105,7 @@ fn complete_job_reports_and_plots() {
             .contains("Hyndman")
     );
     crate::plots::check_every_plot(out.path(), &["s1", "s2", "s3"], true, true);
+    check_answer_last(&o.stdout, &v, out.path());
 }
 
 /// The report does not depend on how the job was split, on the order of the files, on the
@@ -633,4 +634,70 @@ fn floating_stages_are_counted_and_a_heavy_tail_is_named() {
     assert_eq!(case(2)["floating"]["recorded"], 0);
     assert!(case(2)["floating"]["fraction"]["value"].is_null());
     assert!(!caveat(2));
+}
+
+/// The merge's last lines are the answer, then the report's path: the files in one line,
+/// every case placed against the target by its θ_P95 in report.json, the allowable σ with
+/// its interval and conservative end as report.json has them, the Rayleigh rejections
+/// counted against what chance gives, and `report.html` last.
+fn check_answer_last(stdout: &str, v: &Value, dir: &Path) {
+    let lines: Vec<&str> = stdout.lines().collect();
+    let html = dir.join("report.html");
+    assert_eq!(
+        lines.last().copied(),
+        Some(format!("report: {}", html.display()).as_str())
+    );
+    assert_eq!(
+        stdout.matches("wrote ").count(),
+        1,
+        "the files are summarised in one line: {stdout}"
+    );
+    let start = lines
+        .iter()
+        .position(|l| l.starts_with("answer: θ_P95 against the target "))
+        .unwrap_or_else(|| panic!("no answer: {stdout}"));
+    let answer = lines[start..].join("\n");
+    let target = v["settings"]["target_angle"].as_f64().unwrap();
+    for case in v["cases"].as_array().unwrap() {
+        let name = case["name"].as_str().unwrap();
+        let p95 = case["percentiles"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["percentile"] == 95.0)
+            .unwrap()["value"]
+            .as_f64()
+            .unwrap();
+        let side = if p95 > target {
+            "  above the target: "
+        } else {
+            "  at or below it: "
+        };
+        let line = lines[start..].iter().find(|l| l.starts_with(side)).unwrap();
+        assert!(
+            line.contains(&format!("{name} (")),
+            "{name} not in {line:?}"
+        );
+    }
+    let a = &v["sweep"]["sigma_series"][0]["allowable_sigma"]["through_origin"];
+    let lower = a["lower"].as_f64().unwrap();
+    assert!(
+        answer.contains(&format!(
+            "{:.3e} [{lower:.3e}, ",
+            a["value"].as_f64().unwrap()
+        )) && answer.contains(&format!("conservative σ ≤ {lower:.3e} mm")),
+        "{answer}\n{a}"
+    );
+    let rejected = v["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["gof"]["verdict"] == "rejected")
+        .count();
+    assert!(
+        answer.contains(&format!(
+            "Rayleigh law rejected in {rejected} of 3 cases at α = 0.05"
+        )),
+        "{answer}"
+    );
 }
