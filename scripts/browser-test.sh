@@ -9,6 +9,8 @@
 #   image has alternative text, one image per SVG that mc-merge's manifest lists;
 # - nothing is fetched (no resource entry: no file, no network) and there is no script;
 # - one h1, and every table has a caption;
+# - the answer's allowable σ is on the first screen: in a 1280 x 900 frame, not scrolled, the
+#   list item that starts "Allowable σ" ends at most 900 px down;
 # - a screenshot (1280 x 2400 px) is not blank: the standard deviation of its luminance is
 #   at least 20 (of 255) and at least 1 % of its pixels are ink (luminance below 200); a
 #   blank page gives about 7 and 0.2 %;
@@ -88,7 +90,7 @@ pages="$(grep -ac '/Type /Page\($\|[^s]\)' "$WORK/report.pdf" || true)"
 <body>
 <pre id="images">not loaded</pre>
 <pre id="pixels">not loaded</pre>
-<iframe id="page" src="$URL" width="1280" height="800"></iframe>
+<iframe id="page" src="$URL" width="1280" height="900"></iframe>
 <img id="shot" alt="screenshot" src="data:image/png;base64,
 HTML
     base64 -w0 "$WORK/shot.png"
@@ -101,6 +103,11 @@ document.getElementById('page').addEventListener('load', function () {
   if (!d) { out.textContent = 'IMAGES no access to the page'; return; }
   var imgs = Array.prototype.slice.call(d.images);
   var count = function (f) { return imgs.filter(f).length; };
+  // The answer's allowable σ, where the page opens (1280 × 900, not scrolled): its bottom edge.
+  var allowable = Array.prototype.slice.call(d.querySelectorAll('li')).filter(function (li) {
+    return li.textContent.indexOf('Allowable σ') === 0;
+  })[0];
+  var answerBottom = allowable ? Math.round(allowable.getBoundingClientRect().bottom) : 99999;
   out.textContent = 'IMAGES images=' + imgs.length +
     ' loaded=' + count(function (i) { return i.complete && i.naturalWidth > 0; }) +
     ' noalt=' + count(function (i) { return !i.alt; }) +
@@ -108,7 +115,8 @@ document.getElementById('page').addEventListener('load', function () {
     ' resources=' + d.defaultView.performance.getEntriesByType('resource').length +
     ' h1=' + d.querySelectorAll('h1').length +
     ' tables=' + d.querySelectorAll('table').length +
-    ' captions=' + d.querySelectorAll('table > caption').length + ' end';
+    ' captions=' + d.querySelectorAll('table > caption').length +
+    ' answer_bottom=' + answerBottom + ' end';
 });
 window.addEventListener('load', function () {
   var img = document.getElementById('shot');
@@ -150,8 +158,11 @@ n="$(value images "$images")"
 (($(value h1 "$images") == 1)) || fail "not one h1 ($images)"
 tables="$(value tables "$images")"
 ((tables > 0 && $(value captions "$images") == tables)) || fail "a table without a caption ($images)"
+answer_bottom="$(value answer_bottom "$images")"
+((answer_bottom > 0 && answer_bottom <= 900)) \
+    || fail "the allowable σ is not on the first screen at 1280 × 900 (its bottom at ${answer_bottom} px; $images)"
 [[ "$pixels" == *"width=1280 height=2400"* ]] || fail "screenshot of the wrong size ($pixels)"
 sd="$(value sd "$pixels")"
 ink="$(value ink_permille "$pixels")"
 ((${sd%.*} >= 20 && ink >= 10)) || fail "the screenshot is blank ($pixels)"
-echo "browser-test: report.html in $("$CHROMIUM" --version 2>/dev/null | head -1): $n of $n images loaded, $tables tables, nothing fetched, no script; screenshot sd $sd, ink ${ink} ‰; printed $pages pages" >&2
+echo "browser-test: report.html in $("$CHROMIUM" --version 2>/dev/null | head -1): $n of $n images loaded, $tables tables, nothing fetched, no script; the allowable σ ends $answer_bottom px down the first screen (900); screenshot sd $sd, ink ${ink} ‰; printed $pages pages" >&2

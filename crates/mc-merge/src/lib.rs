@@ -151,6 +151,7 @@
 //! 560 MiB peak RSS (58 bytes per sample).
 
 pub mod analysis;
+pub mod answer;
 pub mod cli;
 pub mod definitions;
 pub mod errors;

@@ -237,95 +237,73 @@ pub fn render(report: &Report, files: usize) -> String {
     s
 }
 
-/// The answer, printed last: each case's θ_P at the target percentile against the target
-/// angle (above it, or at or below it), each σ-series' allowable σ with its interval and its
-/// conservative end, and how many Rayleigh-law rejections chance alone would give.
+/// The answer ([`crate::answer::Answer`]), printed last: each case's θ_P at the target
+/// percentile against the target angle (above it, or at or below it), each σ-series'
+/// allowable σ with its interval and its conservative end, and how many Rayleigh-law
+/// rejections chance alone would give.
 pub fn answer(report: &Report) -> String {
+    let a = crate::answer::Answer::of(report);
     let mut s = String::new();
-    let set = &report.settings;
-    let pct = set.target_percentile;
-    let target = set.target_angle;
     let _ = writeln!(
         s,
         "\nanswer: θ_P{} against the target {} rad ({:.2}\"):",
-        short(pct),
-        rad(target),
-        target * ARCSEC_PER_RAD
+        short(a.percentile),
+        rad(a.target),
+        a.target * ARCSEC_PER_RAD
     );
-    let (mut above, mut below, mut undefined) = (Vec::new(), Vec::new(), Vec::new());
-    for case in &report.cases {
-        let value = case
-            .percentiles
-            .iter()
-            .find(|p| p.percentile.0 == pct)
-            .and_then(|p| p.value);
-        match value {
-            Some(v) if v.0 > target => {
-                above.push(format!("{} ({:.2}\")", case.name, v.0 * ARCSEC_PER_RAD))
-            }
-            Some(v) => below.push(format!("{} ({:.2}\")", case.name, v.0 * ARCSEC_PER_RAD)),
-            None => undefined.push(case.name.clone()),
-        }
-    }
-    let list = |v: &[String]| {
+    let list = |v: &[crate::answer::Placed]| {
         if v.is_empty() {
             "none".to_string()
         } else {
-            v.join(", ")
+            v.iter()
+                .map(|p| format!("{} ({:.2}\")", p.name, p.theta * ARCSEC_PER_RAD))
+                .collect::<Vec<_>>()
+                .join(", ")
         }
     };
-    let _ = writeln!(s, "  above the target: {}", list(&above));
-    let _ = writeln!(s, "  at or below it: {}", list(&below));
-    if !undefined.is_empty() {
-        let _ = writeln!(s, "  no θ_P{}: {}", short(pct), undefined.join(", "));
+    let _ = writeln!(s, "  above the target: {}", list(&a.above));
+    let _ = writeln!(s, "  at or below it: {}", list(&a.within));
+    if !a.undefined.is_empty() {
+        let _ = writeln!(
+            s,
+            "  no θ_P{}: {}",
+            short(a.percentile),
+            a.undefined.join(", ")
+        );
     }
-    for ser in &report.sweep.sigma_series {
-        let a = &ser.allowable_sigma;
-        let conservative = a
+    for (name, sigma) in &a.allowable {
+        let conservative = sigma
             .through_origin
             .interval()
             .map(|(lo, _)| {
                 format!(
                     "; conservative σ ≤ {lo:.3e} mm (lower {:.0} % bound)",
-                    set.confidence * 100.0
+                    report.settings.confidence * 100.0
                 )
             })
             .unwrap_or_default();
         let _ = writeln!(
             s,
-            "  allowable σ [{}]: {} mm{}{}",
-            ser.name,
-            plain(&a.through_origin, 3),
-            conservative,
-            if a.extrapolated {
+            "  allowable σ [{name}]: {} mm{conservative}{}",
+            plain(&sigma.through_origin, 3),
+            if sigma.extrapolated {
                 " [extrapolated beyond the σ range]"
             } else {
                 ""
             }
         );
     }
-    let tested: Vec<_> = report
-        .cases
-        .iter()
-        .filter_map(|c| c.gof.verdict.map(|v| (c.name.as_str(), v, c.gof.level.0)))
-        .collect();
-    if let Some(&(_, _, level)) = tested.first() {
-        let rejected: Vec<&str> = tested
-            .iter()
-            .filter(|(_, v, _)| *v == "rejected")
-            .map(|(name, _, _)| *name)
-            .collect();
+    if let (Some(level), Some(chance)) = (a.level, a.expected_by_chance()) {
         let _ = writeln!(
             s,
-            "  Rayleigh law rejected in {} of {} cases at α = {level}{} ({:.1} expected by chance alone if it held in all)",
-            rejected.len(),
-            tested.len(),
-            if rejected.is_empty() {
+            "  Rayleigh law rejected in {} of {} cases at α = {level}{} ({chance:.1} expected by chance alone if it held in all)",
+            a.rejected.len(),
+            a.tested,
+            if a.rejected.is_empty() {
                 String::new()
             } else {
-                format!(": {}", rejected.join(", "))
+                format!(": {}", a.rejected.join(", "))
             },
-            tested.len() as f64 * level
         );
     }
     s

@@ -11,7 +11,10 @@ use super::percentiles::{percentiles_section, summary_section, target};
 use super::plots;
 use super::rayleigh::rayleigh_section;
 use super::sweeps;
-use super::words::{NONE, arcsec, figure_interval, figure_value, parameters, plain, rad, verdict};
+use super::words::{
+    NONE, arcsec, figure_interval, figure_value, parameters, plain, rad, sci, verdict,
+};
+use crate::answer::Answer;
 use crate::load::ShardWriter;
 use crate::report::Report;
 use std::collections::BTreeSet;
@@ -31,6 +34,7 @@ pub fn compose(report: &Report, writers: &[ShardWriter], files: &BTreeSet<String
     doc.text(
         "Percentiles of the distortion angle θ_P between the truss's top and bottom surfaces with their confidence intervals, the paper's Rayleigh law, the floating stages, the sweeps over σ and the allowable σ for the pointing target, from the verified shards of one job. Every number is also in report.json beside this file, at full precision; this report is written from the same results.",
     );
+    answer_section(&mut doc, report);
     run_section(&mut doc, report, writers);
     let contents_at = doc.blocks.len();
     summary_section(&mut doc, report);
@@ -70,6 +74,81 @@ fn contents(doc: &Document) -> Vec<Line> {
             _ => None,
         })
         .collect()
+}
+
+/// The answer first, in three lines ([`crate::answer::Answer`]): the allowable σ for the
+/// target with its interval, the cases above and below the target, and what the Rayleigh
+/// verdicts mean given how many were tested.
+fn answer_section(doc: &mut Document, report: &Report) {
+    let a = Answer::of(report);
+    let pct = plain(a.percentile);
+    let target = format!(
+        "θ_P{pct} ≤ {} rad ({} arcsec)",
+        rad(a.target),
+        arcsec(a.target)
+    );
+    doc.heading(2, "The answer", "answer");
+    let mut items: Vec<Line> = vec![];
+    if a.allowable.is_empty() {
+        items.push(vec![text(format!(
+            "Allowable σ: none here, since no cases of this job differ only in σ (a σ-series); the cases are compared with the target {target} one by one below."
+        ))]);
+    }
+    for (name, sigma) in &a.allowable {
+        let mut line = vec![
+            text(format!("Allowable σ for {target}, series {name}: ")),
+            strong(format!("{} mm", figure_value(&sigma.through_origin, sci))),
+            text(format!(
+                ", {} % interval {} mm",
+                plain(100.0 * report.settings.confidence),
+                figure_interval(&sigma.through_origin, sci)
+            )),
+        ];
+        if let Some((lo, _)) = sigma.through_origin.interval() {
+            line.push(text("; the conservative choice is "));
+            line.push(strong(format!("σ ≤ {} mm", sci(lo))));
+            line.push(text(" (the interval's lower end)"));
+        }
+        if sigma.extrapolated {
+            line.push(text(", extrapolated beyond the σ range of the series"));
+        }
+        line.push(text("."));
+        items.push(line);
+    }
+    let list = |v: &[crate::answer::Placed]| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.iter()
+                .map(|p| format!("{} ({} arcsec)", p.name, arcsec(p.theta)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
+    };
+    let mut cases = format!(
+        "θ_P{pct} above the target: {}; at or below it: {}",
+        list(&a.above),
+        list(&a.within)
+    );
+    if !a.undefined.is_empty() {
+        cases += &format!("; too few samples for θ_P{pct}: {}", a.undefined.join(", "));
+    }
+    items.push(vec![text(cases + ".")]);
+    if let (Some(level), Some(chance)) = (a.level, a.expected_by_chance()) {
+        let rejected = if a.rejected.is_empty() {
+            "in none".to_string()
+        } else {
+            format!("in {} ({})", a.rejected.len(), a.rejected.join(", "))
+        };
+        items.push(vec![text(format!(
+            "The paper's Rayleigh law is rejected {rejected} of {} cases at level {}: with {} tests, {:.2} rejections are expected by chance alone where it holds. The θ_P{pct} above are the empirical percentiles, whatever the verdict; the Rayleigh figure is a cross-check (section The Rayleigh law gives the difference).",
+            a.tested,
+            plain(level),
+            a.tested,
+            chance
+        ))]);
+    }
+    doc.list(items);
 }
 
 fn run_section(doc: &mut Document, report: &Report, writers: &[ShardWriter]) {

@@ -4,6 +4,9 @@
 //! from the [`Report`] that `report.json` is serialised from ([`compose()`]: nothing is
 //! computed again):
 //!
+//! 0. **The answer**, first, in three lines ([`crate::answer`]): the allowable σ for the
+//!    target with its interval and conservative end, the cases above and below the target,
+//!    and the Rayleigh verdicts with how many chance alone gives;
 //! 1. **The run**: the job id, the samples present and expected, the failed samples, the
 //!    cases, the programs and versions that wrote the shards (as their begin lines name
 //!    them; the numerics version is not in the shards, it is part of the job id), the

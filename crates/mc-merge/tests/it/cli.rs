@@ -688,6 +688,16 @@ fn check_answer_last(stdout: &str, v: &Value, dir: &Path) {
         )) && answer.contains(&format!("conservative σ ≤ {lower:.3e} mm")),
         "{answer}\n{a}"
     );
+    // The readable report opens with the same answer, before the run's details.
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    let first = md.split("\n## ").nth(1).unwrap_or_default();
+    assert!(
+        first.starts_with("The answer\n")
+            && first.contains(&format!(
+                "the conservative choice is **σ ≤ {lower:.3e} mm**"
+            )),
+        "{first}"
+    );
     let rejected = v["cases"]
         .as_array()
         .unwrap()
