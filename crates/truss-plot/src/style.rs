@@ -110,10 +110,12 @@ pub fn tick(v: &f64) -> String {
     number((v * scale).round() / scale)
 }
 
-/// An angle in µrad with its arcsec in brackets, e.g. "96.9 µrad (20.0″)".
+/// An angle in µrad with its arcsec in brackets, e.g. "96.9 µrad (19.99″)": arcsec to two
+/// decimals, as the console and the readable report write them, so that the default target
+/// (9.69e-5 rad) reads 19.99″ everywhere and not 20.0″ in the plots.
 pub fn angle(microrad: f64) -> String {
     format!(
-        "{} µrad ({:.1}″)",
+        "{} µrad ({:.2}″)",
         number(round_sig(microrad, 4)),
         microrad * ARCSEC_PER_MICRORAD
     )

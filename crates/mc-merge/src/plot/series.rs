@@ -195,6 +195,13 @@ pub fn sigma(report: &Report) -> Drawn {
             DOTTED,
             BLACK.stroke_width(1),
         ))?;
+        // The target marked on the θ axis, where its line starts.
+        let (px, py) = chart.backend_coord(&(xlo, target));
+        root.draw(&Text::new(
+            format!("target {}", angle(target)),
+            (px + 6, py - 4),
+            label_style(HPos::Left, VPos::Bottom),
+        ))?;
         for (k, s) in series.iter().enumerate() {
             let color = palette(k);
             if let Some(b) = slopes[k] {
@@ -214,6 +221,19 @@ pub fn sigma(report: &Report) -> Drawn {
                         7,
                         color.stroke_width(3),
                     )))?;
+                    // The allowable σ marked on the σ axis: dropped from the target line
+                    // and written where it meets the axis.
+                    chart.draw_series(pattern_series(
+                        vec![(a, ylo), (a, target)],
+                        DOTTED,
+                        color.stroke_width(1),
+                    ))?;
+                    let (px, py) = chart.backend_coord(&(a, ylo));
+                    root.draw(&Text::new(
+                        format!("σ = {} mm", number(round_sig(a, 3))),
+                        (px + 4, py - 4),
+                        label_style(HPos::Left, VPos::Bottom),
+                    ))?;
                 }
             }
             for &(x, v, lo, hi) in &points[k] {

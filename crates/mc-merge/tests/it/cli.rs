@@ -688,6 +688,21 @@ fn check_answer_last(stdout: &str, v: &Value, dir: &Path) {
         )) && answer.contains(&format!("conservative σ ≤ {lower:.3e} mm")),
         "{answer}\n{a}"
     );
+    // The σ-sweep marks the target on both axes: the target written where its line meets
+    // the θ axis (besides the legend's entry), the allowable σ written where it meets the σ
+    // axis (the legend's entry starts "allowable").
+    let sweep = std::fs::read_to_string(dir.join("sigma-sweep.svg")).unwrap();
+    let texts: Vec<&str> = sweep.lines().collect();
+    assert!(
+        texts.iter().filter(|l| l.starts_with("target ")).count() >= 2,
+        "no target at the θ axis"
+    );
+    assert!(
+        texts
+            .iter()
+            .any(|l| l.starts_with("σ = ") && l.ends_with(" mm")),
+        "no allowable σ at the σ axis"
+    );
     // The readable report opens with the same answer, before the run's details.
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     let first = md.split("\n## ").nth(1).unwrap_or_default();
