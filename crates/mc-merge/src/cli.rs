@@ -158,7 +158,7 @@ impl Helper {
                 clap_complete::generate(*shell, &mut command, "mc-merge", &mut script);
                 out.write_all(&script).map_err(stdout)
             }
-            Helper::Man => clap_mangen::Man::new(command).render(out).map_err(stdout),
+            Helper::Man => truss_man::pages(command, out).map_err(stdout),
         }
     }
 }

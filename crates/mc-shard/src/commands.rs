@@ -135,14 +135,10 @@ pub fn completions(
     Ok(())
 }
 
-/// Writes `cmd`'s man page (roff), with a section per subcommand, to `out`.
+/// Writes `cmd`'s man pages (roff), one per command and subcommand, to `out`
+/// ([`truss_man::pages`]).
 pub fn man_page(cmd: clap::Command, out: &mut dyn Write) -> Result<(), CommandError> {
-    let cmd = cmd.after_help(truss_exit::SUMMARY);
-    clap_mangen::Man::new(cmd.clone()).render(out)?;
-    for sub in cmd.get_subcommands() {
-        let name = format!("{}-{}", cmd.get_name(), sub.get_name());
-        clap_mangen::Man::new(sub.clone()).title(name).render(out)?;
-    }
+    truss_man::pages(cmd.after_help(truss_exit::SUMMARY), out)?;
     Ok(())
 }
 

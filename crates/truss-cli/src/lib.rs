@@ -227,8 +227,7 @@ pub fn run(cli: Cli, out: &mut dyn Write) -> anyhow::Result<()> {
         }
         Command::Man => {
             let mut page = Vec::new();
-            clap_mangen::Man::new(<Cli as clap::CommandFactory>::command())
-                .render(&mut page)
+            truss_man::pages(<Cli as clap::CommandFactory>::command(), &mut page)
                 .map_err(CliError::from)?;
             out.write_all(&page).map_err(CliError::from)?;
         }
