@@ -26,7 +26,7 @@
 # Needs what scripts/setup.sh installs (run first when something is missing: Debian's Slurm,
 # munge, librsvg2-bin, fonts-dejavu-core and chromium through apt-get, and a Python virtual
 # environment with maturin, pytest and numpy from PyPI).
-# Takes about 12 minutes from a clean clone on 2 cores (the build about 7 of them), about
+# Takes about 11 minutes from a clean clone on 2 cores (the build about 6 of them), about
 # 4 once built.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
