@@ -70,10 +70,12 @@ pub fn run(args: &ToleranceArgs, out: &mut dyn Write) -> Result<(), CliError> {
     for g in &t.groups {
         writeln!(
             out,
-            "{}: sigma {:.4e} mm (share {:.4}{})",
+            "{}: sigma {:.4e} mm (variance share {:.4} [{:.4}, {:.4}]{})",
             g.name,
             g.sigma,
             g.share.0,
+            g.share.1.0,
+            g.share.1.1,
             if g.fixed { ", fixed" } else { "" }
         )?;
     }

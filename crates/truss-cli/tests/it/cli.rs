@@ -248,3 +248,49 @@ fn diagnose_reports_a_bad_row_with_its_line() {
         "{err}"
     );
 }
+
+/// `truss tolerance` prints each group's variance share with its bootstrap interval, as
+/// `tolerance.json` holds them (the console gave the share alone, 1.0019, where the
+/// interval [0.970, 1.034] says it is 1 within its noise).
+#[test]
+fn tolerance_prints_each_share_with_its_interval() {
+    let dir = tempfile::tempdir().unwrap();
+    let job = crate::one_stage_job(dir.path());
+    let out = dir.path().join("t");
+    let o = truss(&[
+        "tolerance",
+        "--job",
+        job.to_str().unwrap(),
+        "--case",
+        "c",
+        "--target-arcsec",
+        "20",
+        "--samples",
+        "1000",
+        "--sensitivity-samples",
+        "1000",
+        "--no-plots",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let t: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("tolerance.json")).unwrap())
+            .unwrap();
+    let groups = t["groups"].as_object().unwrap();
+    assert!(!groups.is_empty());
+    for (name, g) in groups {
+        let f = |v: &serde_json::Value| v.as_f64().unwrap();
+        let i = g["share_interval"].as_array().unwrap();
+        let want = format!(
+            "{name}: sigma {:.4e} mm (variance share {:.4} [{:.4}, {:.4}]",
+            f(&g["sigma"]),
+            f(&g["share"]),
+            f(&i[0]),
+            f(&i[1])
+        );
+        assert!(stdout.contains(&want), "{want:?} not in {stdout}");
+    }
+}
