@@ -30,7 +30,7 @@ pub struct Answer<'a> {
     pub undefined: Vec<String>,
     /// Each σ-series' name and allowable σ.
     pub allowable: Vec<(&'a str, &'a AllowableSigma)>,
-    /// The cases whose Rayleigh law was tested, and those where it was rejected.
+    /// How many cases had their Rayleigh law tested.
     pub tested: usize,
     /// The cases where the Rayleigh law was rejected, by name.
     pub rejected: Vec<String>,

@@ -312,13 +312,13 @@ pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError>
             readable::MARKDOWN_FILE,
             readable::HTML_FILE
         ));
-        text.push_str(&table::answer(&merge.report));
+    }
+    text.push_str(&table::answer(&merge.report));
+    if let Some(dir) = &options.out {
         text.push_str(&format!(
             "\nreport: {}\n",
             dir.join(readable::HTML_FILE).display()
         ));
-    } else {
-        text.push_str(&table::answer(&merge.report));
     }
     out.write_all(text.as_bytes())
         .map_err(|source| MergeError::Io {

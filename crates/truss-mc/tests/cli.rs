@@ -49,8 +49,8 @@ fn run_all_runs_every_shard_then_merges() {
     let job = write(dir.path(), "job.json", &small_job(60));
     let single = single_run(dir.path(), &job);
     let all = dir.path().join("all");
-    let r = truss_mc(
-        &[
+    let run_all = |extra: &[&str]| {
+        let mut args = vec![
             "run-all",
             "--job",
             job.to_str().unwrap(),
@@ -60,10 +60,11 @@ fn run_all_runs_every_shard_then_merges() {
             "5",
             "--workers",
             "3",
-            "--quiet",
-        ],
-        &[],
-    );
+        ];
+        args.extend(extra);
+        truss_mc(&args, &[])
+    };
+    let r = run_all(&["--quiet"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let stdout = String::from_utf8_lossy(&r.stdout);
     assert!(
@@ -75,20 +76,7 @@ fn run_all_runs_every_shard_then_merges() {
     assert!(all.join("report/theta_p-normal.svg").exists());
     // Without --quiet: the audit and the merge say when they start, a rerun says what it
     // reused, and the last line names report.html.
-    let again = truss_mc(
-        &[
-            "run-all",
-            "--job",
-            job.to_str().unwrap(),
-            "--out",
-            all.to_str().unwrap(),
-            "--shards",
-            "5",
-            "--workers",
-            "3",
-        ],
-        &[],
-    );
+    let again = run_all(&[]);
     assert!(
         again.status.success(),
         "{}",

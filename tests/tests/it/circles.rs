@@ -100,22 +100,17 @@ fn the_reader_finds_a_circle_and_follows_re_exports() {
     );
     let graph = Crate::read(&src.join("lib.rs"));
     let name = |p: &PathBuf| relative(p, &src);
-    let edges: BTreeSet<(String, String)> = graph
-        .edges
-        .iter()
-        .flat_map(|(a, bs)| bs.iter().map(move |b| (name(a), name(b))))
-        .collect();
-    let expect: BTreeSet<(String, String)> = [
-        ("a.rs", "b/inner.rs"),
-        ("b/inner.rs", "c.rs"),
-        ("c.rs", "a.rs"),
-        ("c.rs", "lib.rs"),
-        ("elsewhere/d.rs", "c.rs"),
-    ]
-    .iter()
-    .map(|(a, b)| (a.to_string(), b.to_string()))
-    .collect();
-    assert_eq!(edges, expect);
+    assert_edges(
+        &graph,
+        &src,
+        &[
+            ("a.rs", "b/inner.rs"),
+            ("b/inner.rs", "c.rs"),
+            ("c.rs", "a.rs"),
+            ("c.rs", "lib.rs"),
+            ("elsewhere/d.rs", "c.rs"),
+        ],
+    );
     let circles: Vec<Vec<String>> = graph
         .circles()
         .iter()
@@ -151,24 +146,33 @@ fn a_circle_through_a_re_export_is_a_circle_of_modules() {
         "use crate::structure::Structure;\npub fn framed(s: &Structure) {}\n",
     );
     let graph = Crate::read(&src.join("lib.rs"));
-    let name = |p: &PathBuf| relative(p, &src);
+    assert_edges(
+        &graph,
+        &src,
+        &[
+            ("limit.rs", "structure/compiled.rs"),
+            ("structure/mod.rs", "limit.rs"),
+            ("structure/mod.rs", "lib.rs"),
+            ("structure/mod.rs", "structure/compiled.rs"),
+        ],
+    );
+    assert!(graph.circles().is_empty());
+    assert_eq!(graph.module_circles(), [["limit", "structure"]]);
+}
+
+/// The graph's edges between files, named under `src`, are exactly `expect`.
+fn assert_edges(graph: &Crate, src: &Path, expect: &[(&str, &str)]) {
+    let name = |p: &PathBuf| relative(p, src);
     let edges: BTreeSet<(String, String)> = graph
         .edges
         .iter()
         .flat_map(|(a, bs)| bs.iter().map(move |b| (name(a), name(b))))
         .collect();
-    let expect: BTreeSet<(String, String)> = [
-        ("limit.rs", "structure/compiled.rs"),
-        ("structure/mod.rs", "limit.rs"),
-        ("structure/mod.rs", "lib.rs"),
-        ("structure/mod.rs", "structure/compiled.rs"),
-    ]
-    .iter()
-    .map(|(a, b)| (a.to_string(), b.to_string()))
-    .collect();
+    let expect: BTreeSet<(String, String)> = expect
+        .iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
     assert_eq!(edges, expect);
-    assert!(graph.circles().is_empty());
-    assert_eq!(graph.module_circles(), [["limit", "structure"]]);
 }
 
 /// `crates/*` and the workspace's own test crate.

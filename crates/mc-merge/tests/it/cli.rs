@@ -660,14 +660,7 @@ fn check_answer_last(stdout: &str, v: &Value, dir: &Path) {
     let target = v["settings"]["target_angle"].as_f64().unwrap();
     for case in v["cases"].as_array().unwrap() {
         let name = case["name"].as_str().unwrap();
-        let p95 = case["percentiles"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .find(|p| p["percentile"] == 95.0)
-            .unwrap()["value"]
-            .as_f64()
-            .unwrap();
+        let p95 = crate::readable::p95(case);
         let side = if p95 > target {
             "  above the target: "
         } else {

@@ -101,16 +101,20 @@ fn p95s(report: &serde_json::Value) -> Vec<String> {
         .as_array()
         .unwrap()
         .iter()
-        .map(|c| {
-            let p = c["percentiles"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .find(|p| p["percentile"] == 95.0)
-                .unwrap();
-            format!("{:.3e}", p["value"].as_f64().unwrap())
-        })
+        .map(|c| format!("{:.3e}", p95(c)))
         .collect()
+}
+
+/// A case's θ_P95 in `report.json` (rad).
+pub(crate) fn p95(case: &serde_json::Value) -> f64 {
+    case["percentiles"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["percentile"] == 95.0)
+        .unwrap()["value"]
+        .as_f64()
+        .unwrap()
 }
 
 /// The destinations of the Markdown's links and images.

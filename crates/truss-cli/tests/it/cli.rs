@@ -257,23 +257,7 @@ fn tolerance_prints_each_share_with_its_interval() {
     let dir = tempfile::tempdir().unwrap();
     let job = crate::one_stage_job(dir.path());
     let out = dir.path().join("t");
-    let o = truss(&[
-        "tolerance",
-        "--job",
-        job.to_str().unwrap(),
-        "--case",
-        "c",
-        "--target-arcsec",
-        "20",
-        "--samples",
-        "1000",
-        "--sensitivity-samples",
-        "1000",
-        "--no-plots",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = crate::small_tolerance(&job, &out, &["--quiet"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let stdout = String::from_utf8_lossy(&o.stdout);
     let t: serde_json::Value =

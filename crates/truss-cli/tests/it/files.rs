@@ -213,22 +213,7 @@ fn planted_manifests_delete_nothing() {
     ]);
     let t = dir.path().join("t");
     plant(&t, "truss-tolerance");
-    let o2 = truss(&[
-        "tolerance",
-        "--job",
-        job.to_str().unwrap(),
-        "--case",
-        "c",
-        "--target-arcsec",
-        "20",
-        "--samples",
-        "1000",
-        "--sensitivity-samples",
-        "1000",
-        "--no-plots",
-        "--out",
-        t.to_str().unwrap(),
-    ]);
+    let o2 = crate::small_tolerance(&job, &t, &[]);
     for (o, out, writer) in [(o, d, "truss-diagnose"), (o2, t, "truss-tolerance")] {
         let (status, stderr) = code(&o);
         assert!(matches!(status, Some(0 | 6)), "{writer}: {stderr}");

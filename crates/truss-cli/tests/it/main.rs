@@ -35,3 +35,31 @@ pub fn one_stage_job(dir: &std::path::Path) -> std::path::PathBuf {
     .unwrap();
     job
 }
+
+/// `truss tolerance` on case `c` of `job` ([`one_stage_job`]) for a 20″ target, small
+/// (1000 samples for the sensitivity and for the verification), no plots, into `out`, with
+/// `extra` arguments.
+pub fn small_tolerance(
+    job: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> std::process::Output {
+    let mut args = vec![
+        "tolerance",
+        "--job",
+        job.to_str().unwrap(),
+        "--case",
+        "c",
+        "--target-arcsec",
+        "20",
+        "--samples",
+        "1000",
+        "--sensitivity-samples",
+        "1000",
+        "--no-plots",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    truss(&args)
+}
