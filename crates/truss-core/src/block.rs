@@ -44,6 +44,9 @@ pub struct BlockBandMatrix {
     diag: Vec<[f64; 3]>,
     inv_diag: Vec<[f64; 3]>,
     factored: bool,
+    /// A pivot at most this fraction of its row's diagonal fails (default
+    /// [`PIVOT_TOLERANCE`]).
+    tolerance: f64,
     /// Which matrix this is, and how many times its numbers changed: a batched solve's
     /// copy of the factor is reused while both match (see `solver::lanes`).
     id: u64,
@@ -67,6 +70,7 @@ impl Clone for BlockBandMatrix {
             diag: self.diag.clone(),
             inv_diag: self.inv_diag.clone(),
             factored: self.factored,
+            tolerance: self.tolerance,
             id: next_id(),
             version: 0,
         }
@@ -85,9 +89,20 @@ impl BlockBandMatrix {
             diag: vec![[0.0; 3]; nb],
             inv_diag: vec![[0.0; 3]; nb],
             factored: false,
+            tolerance: PIVOT_TOLERANCE,
             id: next_id(),
             version: 0,
         }
+    }
+
+    /// Sets the fraction of its row's diagonal at or below which a pivot fails.
+    pub(crate) fn set_pivot_tolerance(&mut self, tolerance: f64) {
+        self.tolerance = tolerance;
+    }
+
+    /// The fraction of its row's diagonal at or below which a pivot fails.
+    pub(crate) fn pivot_tolerance(&self) -> f64 {
+        self.tolerance
     }
 
     /// The numbers changed: not factorised, and a new version.
@@ -108,15 +123,17 @@ impl BlockBandMatrix {
     }
 
     /// Installs a factor computed elsewhere (the batched factorisation, bit for bit
-    /// [`BlockBandMatrix::factor`]'s): `fill` writes the blocks, each row's original diagonal
-    /// and the inverse pivots; the matrix is then factorised.
+    /// [`BlockBandMatrix::factor_collecting`]'s): `fill` writes the blocks, each row's
+    /// original diagonal and the inverse pivots; the matrix is then factorised unless some
+    /// pivot failed (`failed`), as `factor_collecting` leaves it.
     pub(crate) fn install_factor(
         &mut self,
+        failed: bool,
         fill: impl FnOnce(&mut [Block], &mut [[f64; 3]], &mut [[f64; 3]]),
     ) {
         fill(&mut self.a, &mut self.diag, &mut self.inv_diag);
         self.touched();
-        self.factored = true;
+        self.factored = !failed;
     }
 
     /// Number of block rows.
@@ -251,7 +268,15 @@ impl BlockBandMatrix {
                     off_diagonal(next, q - (i + 1 - j1), j - j1, row_j, inv, q);
                 }
             }
-            let (stop, inv) = diagonal(row, q - (i - j0), i, self.diag[i], failures, max);
+            let (stop, inv) = diagonal(
+                row,
+                q - (i - j0),
+                i,
+                self.diag[i],
+                self.tolerance,
+                failures,
+                max,
+            );
             self.inv_diag[i] = inv;
             if stop {
                 return;
@@ -261,7 +286,15 @@ impl BlockBandMatrix {
                 if i >= j1 {
                     off_diagonal(next, first, i - j1, row, &self.inv_diag[i], q);
                 }
-                let (stop, inv) = diagonal(next, first, i + 1, self.diag[i + 1], failures, max);
+                let (stop, inv) = diagonal(
+                    next,
+                    first,
+                    i + 1,
+                    self.diag[i + 1],
+                    self.tolerance,
+                    failures,
+                    max,
+                );
                 self.inv_diag[i + 1] = inv;
                 if stop {
                     return;
@@ -270,6 +303,13 @@ impl BlockBandMatrix {
             i += 2;
         }
         self.factored = failures.is_empty();
+    }
+
+    /// After [`BlockBandMatrix::factor_collecting`] with failures: the factor is that of the
+    /// matrix with each failed pivot's diagonal raised to its row's original diagonal (a
+    /// spring on that row); marks it usable for solves.
+    pub(crate) fn force_factored(&mut self) {
+        self.factored = true;
     }
 
     /// Solves `A·x = b` in place with the factor: `L·y = b`, then `Lᵀ·x = y`.
@@ -411,6 +451,7 @@ fn diagonal(
     first: usize,
     i: usize,
     diag: [f64; 3],
+    tolerance: f64,
     failures: &mut Vec<PivotFailure>,
     max: usize,
 ) -> (bool, [f64; 3]) {
@@ -421,7 +462,7 @@ fn diagonal(
         sub_mul_t_lower(&mut s, l);
     }
     let mut pivot = |k: usize, p: f64| -> f64 {
-        if p > PIVOT_TOLERANCE * diag[k] {
+        if p > tolerance * diag[k] {
             p
         } else {
             failures.push(PivotFailure {
@@ -547,7 +588,7 @@ mod tests {
             {
                 off_diagonal(row, q - (i - j0), n, row_j, inv, q);
             }
-            let (stop, inv) = diagonal(row, q - (i - j0), i, d, failures, max);
+            let (stop, inv) = diagonal(row, q - (i - j0), i, d, PIVOT_TOLERANCE, failures, max);
             m.inv_diag[i] = inv;
             if stop {
                 return;

@@ -98,10 +98,10 @@ pub use structure::Structure;
 /// Default compression stiffness ratio of a cable: 0, the paper's (Table 1: a diagonal
 /// carries nothing in compression).
 ///
-/// A cable of ratio 0 is solved as the limit `r → 0`: at a small working ratio chosen per
-/// model by what holds the top surface's tilt, where the answer is the limit's (see
-/// [`limit`], which says how and what is tested). Where some stage's tilt is held by
-/// pretension alone in that limit, the sample is reported *floating*
+/// A cable of ratio 0 is solved as the limit `r → 0`: at a small working ratio where the
+/// model's bars frame the top surface's tilt, and otherwise at `r = 0` itself, by
+/// continuation (see [`limit`], which says how and what is tested). Where some stage is
+/// held by nothing in that limit, the sample is reported *floating*
 /// ([`SolveReport::floating`]). A ratio above 0 in a model file or job is a model choice and
 /// is used as it is.
 pub const DEFAULT_COMPRESSION_RATIO: f64 = 0.0;

@@ -89,11 +89,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "eff1ebfec9e37a41ac7d6f085613e96c8dda168b569ac5e37aac842a050c7d87",
+        "f42f9eb60f0b73e789dcdc6fd84eff8f115869362d739aefd12639d0363108b8",
         "250ebc35d731f68192faca6b4669b8f390d78b9f27cebefb5b7b50bee177ec38",
-        "098aa180429d0cc97595bed509b793c37bb7f0b0d30d29c5cf63ec6347cd8528",
+        "c5753b56848e65975611ccfe35ae9fd31ffa92e67afa1de9c27593684b0ae7c6",
         "7f95eed1a842b547589bf84637c37505cc0c2cfdc91b76242878045a89080f26",
-        "95691c3b1c3819a508808f3facd918ce6a7864e2a042b0a408d51c5eef8d582d",
+        "9197a3d03247601b08e5f5ac29ef635f513e605a28ca464335274e7d9eca327c",
     ];
     for (what, (g, w)) in [
         "job id",

@@ -10,6 +10,7 @@ mod determinism;
 mod hostile;
 mod interrupt;
 mod job;
+mod limit_reference;
 mod pool;
 mod sampling;
 mod schedulers;

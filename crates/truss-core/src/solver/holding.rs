@@ -3,8 +3,9 @@
 //! one-sided member let go.
 //!
 //! At the equilibrium `u` with tangent stiffness `K(u)` \[N/mm\] (the true tangent: the
-//! members that bear, the slack members at their working ratio, and the geometric stiffness
-//! of the member forces), a small load `F·t` on top node `j` (`t` a unit vector, `F` in N)
+//! members that bear, the slack members at their working ratio (at the limit `r → 0`: none,
+//! and a one-sided member at its kink counts as slack), and the geometric stiffness of the
+//! member forces), a small load `F·t` on top node `j` (`t` a unit vector, `F` in N)
 //! moves the nodes by `Δu = F·K⁻¹·e_{j,t}`, and with it
 //!
 //! ```text
@@ -28,8 +29,8 @@
 //! a joint on its hole's edge) lets go, after which what holds the top is what is left.
 //!
 //! A sample whose top is framed by bearing members has a holding force of millinewtons to
-//! newtons; a stage held only by a pretension of a few millinewtons, or by the slack
-//! members' working ratio (a floating stage), of micronewtons to nanonewtons: there θ_P
+//! newtons; a stage held only by a pretension of a few millinewtons, of micronewtons; a
+//! stage held by nothing at the limit (a floating stage), 0: there θ_P
 //! rests on effects the model leaves out (friction in the joints, the diagonals' bending
 //! stiffness, the assembly's history), and a touch, a draught or gravity in a test moves
 //! it.
@@ -85,8 +86,18 @@ impl Solver {
                 }
             }
         }
-        // The true tangent at the equilibrium: no cable switched or pinned, no shift.
-        self.factor.factor_slack.copy_from_slice(&self.work.slack);
+        // The true tangent at the equilibrium: no cable switched or pinned, no shift; at the
+        // limit, a one-sided member with nothing on its slack side that carries no more than
+        // the solve resolves sits at its kink and resists nothing a load compresses it by: it
+        // counts as slack (a floating stage's cables).
+        let grazing = GRAZING_FACTOR * force_floor;
+        for (m, c) in s.members.iter().enumerate() {
+            let st = &self.work.states[m];
+            self.factor.factor_slack[m] = st.slack
+                || (c.is_cable
+                    && self.sample.members[m].compression_ratio == 0.0
+                    && c.sense * st.force <= grazing);
+        }
         self.step.pinned.fill(false);
         self.assemble_model();
         kernels
@@ -107,7 +118,6 @@ impl Solver {
             });
         }
         let n = s.free;
-        let grazing = GRAZING_FACTOR * force_floor;
         let mut best: Option<Holding> = None;
         for &node in &top.nodes {
             let mut tilt = [0.0; 3];

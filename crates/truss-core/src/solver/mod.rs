@@ -92,6 +92,7 @@ mod floating;
 mod held;
 mod holding;
 pub mod lanes;
+mod limit;
 mod line_search;
 mod newton;
 mod step;
@@ -169,9 +170,11 @@ pub struct SolveReport {
     /// Newton iterations). 0 where the start was not solved by the capacitance matrix (a
     /// model with more than 96 cables, or a large slack set).
     pub soft_directions: u32,
-    /// Whether some stage's tilt is held by pretension or regularisation alone, not by
-    /// the members that bear (a *floating* stage; see [`crate::limit`]): the answer then
-    /// rests on effects the model leaves out. Never where the model's bars frame the tilt.
+    /// Whether some stage is held by nothing at the limit: the tangent of the members that
+    /// bear (and the geometric stiffness of their forces) is not positive definite, so a
+    /// stage moves under an arbitrarily small load (a *floating* stage; see
+    /// [`crate::limit`]): the answer then rests on effects the model leaves out. Never where
+    /// the model's bars frame the tilt.
     pub floating: bool,
     /// The holding force \[N\]: the largest force on one node of the top surface that, to
     /// first order, moves θ_P by at most 1 % and makes no bearing one-sided member let go
@@ -252,6 +255,8 @@ pub struct Solver {
     last: Option<SolveReport>,
     /// The last converged sample's holding force and the load that reaches it.
     holding: Option<Holding>,
+    /// The buffers of the solver for cables at their limit (see [`limit`]).
+    limit: limit::work::LimitWork,
     evaluations: u32,
     /// The last chord step's secant minimiser along its line, relative to that step
     /// (NaN when the last step was not a chord step, or switched a one-sided member):
@@ -395,6 +400,7 @@ impl Solver {
             log: Vec::new(),
             last: None,
             holding: None,
+            limit: limit::work::LimitWork::new(n),
             evaluations: 0,
             chord_secant: f64::NAN,
             sample_key: (SOLVERS.fetch_add(1, Ordering::Relaxed) as usize, 0),
@@ -439,7 +445,11 @@ impl Solver {
         self.evaluations = 0;
         self.sample_key.1 += 1;
         self.set_sample(p)?;
-        let report = self.newton(kernels).await?;
+        let report = if self.structure.near_the_limit() {
+            self.solve_limit(kernels).await?
+        } else {
+            self.newton(kernels).await?
+        };
         self.last = Some(report);
         Ok(report)
     }

@@ -116,7 +116,59 @@ impl Solver {
     /// [`Solver::choose_step`], taken by the line search) until the force test
     /// ([`Solver::force_converged`]) or the step test ([`Solver::step_converged`]) holds.
     pub(super) async fn newton(&mut self, kernels: Kernels<'_>) -> Result<SolveReport, SolveError> {
-        let mut p = self.start(kernels).await;
+        let p = self.start(kernels).await;
+        self.iterate(p, true, kernels).await
+    }
+
+    /// Steps 2–5 of the module doc from the current point (a warm start): `u` as it is,
+    /// evaluated, and model steps from there.
+    pub(super) async fn newton_warm(
+        &mut self,
+        kernels: Kernels<'_>,
+    ) -> Result<SolveReport, SolveError> {
+        let structure = Arc::clone(&self.structure);
+        let eval = kernels
+            .evaluate(Evaluate {
+                structure: &structure,
+                key: self.sample_key,
+                members: &mut self.sample.members,
+                tension: &mut self.sample.tension,
+                loads: &mut self.sample.loads,
+                u: &mut self.work.u,
+                r: &mut self.work.r,
+                states: &mut self.work.states,
+            })
+            .await;
+        self.update_slack();
+        self.chord_secant = f64::NAN;
+        self.step.damping = 0.0;
+        self.step.plain_step = false;
+        self.step.pinned.fill(false);
+        let p = Progress {
+            iterations: 0,
+            factorisations: 0,
+            mode: Mode::Tangent,
+            eval,
+            k_valid: false,
+            prev_step: f64::INFINITY,
+            step: 0.0,
+            poor: false,
+            stalled: 0,
+            lowest: f64::INFINITY,
+            u_max: max_abs(&self.work.u[..structure.free]),
+            soft_directions: 0,
+        };
+        self.iterate(p, false, kernels).await
+    }
+
+    /// The iteration of [`Solver::newton`] from `p`; with `assess`, the converged point's
+    /// floating flag and holding force (else left out: a stage of the limit solver).
+    async fn iterate(
+        &mut self,
+        mut p: Progress,
+        assess: bool,
+        kernels: Kernels<'_>,
+    ) -> Result<SolveReport, SolveError> {
         loop {
             if let Next::Done = self.force_converged(&mut p)? {
                 break;
@@ -166,9 +218,12 @@ impl Solver {
                 break;
             }
         }
-        let floating = self.floating();
-        let floor = self.force_floor(&p.eval);
-        self.holding = self.compute_holding(floor, kernels).await;
+        let mut floating = false;
+        if assess {
+            floating = self.floating();
+            let floor = self.force_floor(&p.eval);
+            self.holding = self.compute_holding(floor, kernels).await;
+        }
         Ok(SolveReport {
             iterations: p.iterations,
             factorisations: p.factorisations,
@@ -267,7 +322,7 @@ impl Solver {
 
     /// The force test's floor \[N\]: `residual_floor` times the largest member force (or
     /// the sample's force scale, if larger).
-    fn force_floor(&self, eval: &Evaluation) -> f64 {
+    pub(super) fn force_floor(&self, eval: &Evaluation) -> f64 {
         self.options.residual_floor * eval.force_scale.max(self.sample.force_ref)
     }
 

@@ -28,6 +28,9 @@ use super::evaluate::{dot_n, max_abs};
 use super::lanes::Kernels;
 use crate::SolveError;
 
+/// Most negative pivots of one factorisation whose directions engage a cable each.
+const ENGAGE_AT_ONCE: usize = 32;
+
 /// Most slack sets tried for one model step; the last step is used if none settles.
 const MAX_MODEL_PIECES: u32 = 8;
 
@@ -100,7 +103,23 @@ impl Solver {
         kernels: Kernels<'_>,
     ) -> Result<Step, SolveError> {
         let n = self.structure.free;
-        self.factor.factor_slack.copy_from_slice(&self.work.slack);
+        // The model's slack set: the current one; in a stage of the limit solver (see
+        // `limit`), a one-sided member within the rounding noise of its kink bears (a
+        // floating stage's cables sit at their kinks), except in a plain step, which switches
+        // nothing. Elsewhere the kink band is empty and one cable engages per factorisation.
+        let at_limit = self.structure.near_the_limit();
+        let kink = if at_limit {
+            super::limit::work::KINK * self.sample.scale
+        } else {
+            -1.0
+        };
+        let at_once = if at_limit { ENGAGE_AT_ONCE } else { 1 };
+        let plain = self.step.damping > 0.0 || self.step.plain_step;
+        for (m, c) in self.structure.members.iter().enumerate() {
+            let se = c.sense * self.work.states[m].elongation;
+            self.factor.factor_slack[m] =
+                self.work.slack[m] && (plain || !c.is_cable || se.abs() > kink);
+        }
         self.factor.locked.fill(false);
         let mut pieces = 0;
         let mut engagements = 0;
@@ -116,7 +135,7 @@ impl Solver {
                     self.sample_key,
                     &mut self.factor.k,
                     &mut self.work.failures,
-                    1,
+                    at_once,
                 )
                 .await;
             let mut shift = self.step.damping;
@@ -125,13 +144,47 @@ impl Solver {
             let damped = self.step.damping > 0.0 || self.step.plain_step;
             if let Some(&first) = self.work.failures.first() {
                 if !damped && first.pivot < 0.0 && engagements < self.structure.members.len() {
+                    // The first negative pivot's direction engages its first cable, and so
+                    // does each later one that lies more than twice the band's reach from
+                    // every pivot engaged before it (another part of the truss: its
+                    // direction is its own).
+                    let reach = 6 * (self.structure.bandwidth() + 1);
+                    let mut engaged_at: [usize; ENGAGE_AT_ONCE] = [0; ENGAGE_AT_ONCE];
+                    let mut count = 0;
+                    for f in 0..self.work.failures.len() {
+                        let failure = self.work.failures[f];
+                        if failure.pivot >= 0.0
+                            || engaged_at[..count]
+                                .iter()
+                                .any(|&j| failure.index < j + reach)
+                        {
+                            if f == 0 {
+                                break;
+                            }
+                            continue;
+                        }
+                        self.factor
+                            .k
+                            .failed_pivot_direction(failure.index, &mut self.work.scratch);
+                        let curvature = if at_limit {
+                            failure.pivot
+                        } else {
+                            f64::INFINITY
+                        };
+                        if self.engage_first_cable(curvature) {
+                            engagements += 1;
+                            engaged_at[count] = failure.index;
+                            count += 1;
+                        } else if f == 0 {
+                            break;
+                        }
+                    }
+                    if count > 0 {
+                        continue;
+                    }
                     self.factor
                         .k
                         .failed_pivot_direction(first.index, &mut self.work.scratch);
-                    if self.engage_first_cable() {
-                        engagements += 1;
-                        continue;
-                    }
                     self.work.d.copy_from_slice(&self.work.scratch);
                     self.work.d[n] = 0.0;
                     if self.negative_curvature() {
@@ -194,6 +247,11 @@ impl Solver {
                     + st.direction[2] * dv[2];
                 let slack =
                     c.sense * e < 0.0 && c.compression_ratio < 1.0 && !self.factor.locked[m];
+                // A member predicted within the noise of its kink keeps its state: a floating
+                // stage's cables sit at their kinks, and would flip at every piece.
+                if (c.sense * e).abs() <= kink {
+                    continue;
+                }
                 if slack != self.factor.factor_slack[m] {
                     settled = false;
                     self.factor.factor_slack[m] = slack;
@@ -265,8 +323,10 @@ impl Solver {
     /// With `self.work.scratch` a direction of negative curvature `v` of `K(S)`, finds the slack
     /// cable of `S` that engages first along `±v` (the sign that lowers the energy first,
     /// else the other), makes it taut and locked in `S`, and returns true; false if no slack
-    /// cable engages.
-    fn engage_first_cable(&mut self) -> bool {
+    /// cable engages. Only a cable whose stiffness once taut outweighs the direction's
+    /// negative curvature (`k·rate² > −curvature`, N/mm per unit of `v`) counts: pass
+    /// infinity to count every cable.
+    fn engage_first_cable(&mut self, curvature: f64) -> bool {
         let n = self.structure.free;
         let v = &self.work.scratch;
         let descent = if dot_n(&self.work.r[..n], &v[..n]) > 0.0 {
@@ -289,7 +349,10 @@ impl Solver {
                 let rate = sign
                     * c.sense
                     * (st.direction[0] * dv[0] + st.direction[1] * dv[1] + st.direction[2] * dv[2]);
-                if rate > 0.0 {
+                // Only a member whose stiffness, once it bears, outweighs the direction's
+                // negative curvature holds it.
+                let k = self.sample.tension[m] * (1.0 - self.sample.members[m].compression_ratio);
+                if rate > 0.0 && k * rate * rate > -curvature {
                     let at = (-c.sense * st.elongation).max(0.0) / rate;
                     if first.is_none_or(|(best, _)| at < best) {
                         first = Some((at, m));
@@ -325,7 +388,7 @@ impl Solver {
     /// at its kink ([`PIN_FACTOR`] times its tension stiffness), or switched in `S`; `None`
     /// otherwise.
     #[inline]
-    fn model_stiffness(&self, m: usize) -> Option<f64> {
+    pub(super) fn model_stiffness(&self, m: usize) -> Option<f64> {
         let c = &self.structure.members[m];
         if !c.is_cable {
             return None;
@@ -335,7 +398,7 @@ impl Solver {
             Some(PIN_FACTOR * k)
         } else if self.factor.factor_slack[m] != self.work.states[m].slack {
             Some(if self.factor.factor_slack[m] {
-                c.compression_ratio * k
+                self.sample.members[m].compression_ratio * k
             } else {
                 k
             })

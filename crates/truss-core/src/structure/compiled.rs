@@ -97,9 +97,9 @@ impl Structure {
         self.tilt_framed
     }
 
-    /// Whether some cable of ratio 0 is solved near its limit r → 0 at
-    /// [`crate::limit::LIMIT_RATIO`] (the bars do not frame the tilt): a stage held by slack
-    /// cables alone may then have no well-resolved position, and a solve can fail there.
+    /// Whether some cable of ratio 0 is solved at its limit `r → 0` itself (the bars do not
+    /// frame the tilt), by continuation from [`crate::limit::LIMIT_RATIO`] (see
+    /// [`crate::limit`]).
     pub fn near_the_limit(&self) -> bool {
         !self.tilt_framed && self.members.iter().any(|c| c.limit)
     }

@@ -11,9 +11,10 @@ use crate::measure::distortion;
 /// is framed by bars (see [`crate::limit`]).
 pub const FRAMED_RATIO: f64 = 1e-4;
 
-/// The compression ratio at which a cable of ratio 0 stands for the limit `r → 0` where
-/// the tilt is not framed by bars (see [`crate::limit`]).
-pub const LIMIT_RATIO: f64 = 1e-7;
+/// Where the tilt is not framed by bars, the compression ratio from which the limit `r → 0`
+/// of a cable of ratio 0 is continued (see [`crate::limit`]): such cables are compiled with
+/// it, and it is the first stage of the solver's continuation.
+pub const LIMIT_RATIO: f64 = 1e-5;
 
 /// A one-sided member's stiffness factor in [`tilt_framed_by_bars`]'s bars-only stiffness:
 /// small enough to leave its mechanisms free, large enough to keep the matrix factorisable.

@@ -31,7 +31,10 @@ fn loaded(
     Some((solver.distortion()?.theta_p, slack))
 }
 
-/// On 60 draws of the Fig. 16 case (σ = 0.0067 mm), each sample is re-solved with a load
+/// On 60 draws of the Fig. 16 case (σ = 0.0067 mm) with the clearances a quarter of the
+/// paper's (U[0.001, 0.00425] mm, so that most joints bear: with the paper's, nine samples in
+/// ten have a stage floating at the limit, whose holding force is 0), each sample is
+/// re-solved with a load
 /// on the top node and along the direction its holding force names: at half the holding
 /// force θ_P moves by 1 % or less (first order: 0.5 %) in at least 85 % of the samples, by a
 /// median of at most 0.5 %; at twice it, θ_P moves by at least 0.5 % (first order: 2 %) or
@@ -50,7 +53,8 @@ fn the_holding_force_bounds_a_load_that_moves_theta_by_one_percent() {
     let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
     let (mut below, mut above, mut checked, mut limits) = (vec![], 0, 0, [0; 2]);
     for _ in 0..60 {
-        let draw = fig16_draw(&model, 0.0067, &mut rng);
+        let (errors, clearances) = fig16_draw(&model, 0.0067, &mut rng);
+        let draw: (Vec<f64>, Vec<f64>) = (errors, clearances.iter().map(|c| 0.25 * c).collect());
         solver
             .solve_perturbed(Perturbation {
                 length_errors: &draw.0,

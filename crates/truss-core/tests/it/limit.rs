@@ -4,9 +4,9 @@
 //!
 //! Sources: the paper's Table 1 and Fig. 16 case (σ = 0.0067 mm on battens and longerons,
 //! diagonals U[−3σ, 0] mm, clearances U[0.004, 0.017] mm); the check of a floating sample is
-//! by its definition (held by pretension alone), tested against an independent probe: a
-//! nanonewton load, which a stage framed by members does not notice and a floating one
-//! does.
+//! by its definition (held by nothing at the limit), tested against an independent probe: a
+//! micronewton load, which a stage held by the members that bear does not notice and a
+//! floating one does.
 
 use crate::common::*;
 use truss_core::prism::{BacklashOptions, PrismOptions};
@@ -67,13 +67,16 @@ fn the_framed_prism_gives_the_limits_theta() {
     assert!(worst <= 2e-4 * median, "{worst} rad, median {median} rad");
 }
 
-/// A floating sample is held by pretension alone: a horizontal load of 1 nN on a top node
-/// (a billionth of the forces in the truss) moves its θ_P by far more than it moves the θ_P
-/// of a sample framed by the members that bear. Over 200 samples of the Fig. 16 case, the
-/// median relative change of the floating ones is more than 10⁴ times that of the others
-/// (measured: 5e-3 against 8e-10), and both kinds occur.
+/// A floating sample is held by nothing at the limit, and a sample that is not floating is
+/// firmly held: a horizontal load of 1 µN on a top node (a millionth of the forces in the
+/// truss) moves the θ_P of a floating sample by a finite fraction (its stage moves until
+/// its joints come into contact), and that of a sample not floating by at most 1e-3 of
+/// itself. Over 120 samples of the Fig. 16 case, both kinds occur, the median relative
+/// change of the floating ones is more than 10⁴ times that of the others (measured on 200:
+/// 0.38 against 2.6e-7, at most 5.6e-5 among the held), and at most one loaded solve in 20
+/// fails (measured: 1 of 180).
 #[test]
-fn a_floating_sample_is_moved_by_a_nanonewton() {
+fn a_floating_sample_is_moved_by_a_micronewton_and_a_held_one_is_not() {
     let model = PrismOptions {
         backlash: Some(BacklashOptions::default()),
         ..PrismOptions::with_stages(5)
@@ -82,30 +85,31 @@ fn a_floating_sample_is_moved_by_a_nanonewton() {
     .unwrap();
     let top = model.node_index("n5.0").unwrap();
     let mut nudge = vec![[0.0; 3]; model.nodes().len()];
-    nudge[top] = [1e-9, 0.0, 0.0];
+    nudge[top] = [1e-6, 0.0, 0.0];
     let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
     let mut rng = Normals::new(16);
     let sigma = 0.0067;
-    let (mut floating, mut framed) = (Vec::new(), Vec::new());
-    for _ in 0..200 {
+    let (mut floating, mut held, mut failed) = (Vec::new(), Vec::new(), 0);
+    for _ in 0..120 {
         let (e, g) = fig16_draw(&model, sigma, &mut rng);
         let mut solve = |loads: &[[f64; 3]]| {
-            let report = solver
-                .solve_perturbed(Perturbation {
-                    length_errors: &e,
-                    clearances: &g,
-                    extra_loads: loads,
-                })
-                .unwrap();
-            (solver.distortion().unwrap().theta_p, report.floating)
+            let report = solver.solve_perturbed(Perturbation {
+                length_errors: &e,
+                clearances: &g,
+                extra_loads: loads,
+            });
+            report.map(|r| (solver.distortion().unwrap().theta_p, r.floating))
         };
-        let (theta, floats) = solve(&[]);
-        let (nudged, _) = solve(&nudge);
+        let (theta, floats) = solve(&[]).unwrap();
+        let Ok((nudged, _)) = solve(&nudge) else {
+            failed += 1;
+            continue;
+        };
         let change = (nudged / theta - 1.0).abs();
         if floats {
             floating.push(change);
         } else {
-            framed.push(change);
+            held.push(change);
         }
     }
     let median = |v: &mut Vec<f64>| {
@@ -113,16 +117,20 @@ fn a_floating_sample_is_moved_by_a_nanonewton() {
         v[v.len() / 2]
     };
     assert!(
-        floating.len() >= 20 && framed.len() >= 20,
+        floating.len() >= 8 && held.len() >= 8,
         "{} and {}",
         floating.len(),
-        framed.len()
+        held.len()
     );
-    let (f, r) = (median(&mut floating), median(&mut framed));
+    let (f, h) = (median(&mut floating), median(&mut held));
+    let worst_held = held.last().copied().unwrap_or(0.0);
     println!(
-        "1 nN: median |Δθ_P|/θ_P {f:.2e} floating ({} samples), {r:.2e} framed ({})",
+        "1 µN: median |Δθ_P|/θ_P {f:.2e} floating ({} samples), {h:.2e} held ({}, at most \
+         {worst_held:.2e}); {failed} loaded solves failed",
         floating.len(),
-        framed.len()
+        held.len()
     );
-    assert!(f > 1e4 * r, "floating {f}, framed {r}");
+    assert!(f > 1e4 * h, "floating {f}, held {h}");
+    assert!(worst_held <= 1e-3, "a held sample moved by {worst_held}");
+    assert!(failed * 20 <= 120, "{failed} loaded solves failed");
 }

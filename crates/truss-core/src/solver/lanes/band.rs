@@ -35,14 +35,9 @@ pub(super) struct BandLanes<const W: usize> {
     x: Vec<[[f64; W]; 3]>,
     /// The identity of the matrix whose factor each lane holds.
     holds: [Option<(u64, u64)>; W],
-    /// Factorisations so far, and how many met a pivot not safely positive.
-    tried: u64,
-    failed: u64,
+    /// Each lane's failed pivots of the last factorisation.
+    records: [Vec<PivotFailure>; W],
 }
-
-/// Factorisations are batched unless more than one in this many fails (then each failed
-/// lane would be factorised twice: the batch, then the one-sample code).
-const FAILURES_BATCHED: u64 = 4;
 
 /// A factorisation a lane waits for: its matrix, where its failed pivots go, and how many
 /// to collect (see [`BlockBandMatrix::factor_collecting`]).
@@ -71,69 +66,62 @@ impl<const W: usize> BandLanes<W> {
             inv: vec![[[1.0; W]; 3]; nb],
             x: vec![[[0.0; W]; 3]; nb],
             holds: [None; W],
-            tried: 0,
-            failed: 0,
+            records: std::array::from_fn(|_| Vec::new()),
         }
     }
 
     /// Factorises each lane's matrix (see the module doc); a lane's result is its
-    /// matrix's, as [`BlockBandMatrix::factor_collecting`] leaves it.
+    /// matrix's, and its failed pivots, as [`BlockBandMatrix::factor_collecting`] leaves
+    /// them.
     pub(super) fn factor(&mut self, lanes: &mut [Option<FactorLane<'_>>; W]) {
-        if self.tried >= 64 && self.failed * FAILURES_BATCHED > self.tried {
-            // Many failing (pin joints in free play, whose steps meet negative curvature):
-            // one lane at a time; a lane's first solve with its factor gathers it.
-            for (l, lane) in lanes.iter_mut().enumerate() {
-                let Some((m, failures, max)) = lane else {
-                    continue;
-                };
-                m.factor_collecting(failures, *max);
-                self.tried += 1;
-                self.holds[l] = None;
-                if !m.is_factored() {
-                    self.failed += 1;
-                }
-            }
-            return;
-        }
         let w = self.q + 1;
         let mut mask = [false; W];
+        let mut tolerance = [PIVOT_TOLERANCE; W];
+        let mut max = [0usize; W];
         for (l, lane) in lanes.iter().enumerate() {
-            let Some((m, _, _)) = lane else {
+            let Some((m, _, most)) = lane else {
                 continue;
             };
             gather(&mut self.a, m.factor_parts().0, l);
             mask[l] = true;
+            tolerance[l] = m.pivot_tolerance();
+            max[l] = *most;
             self.holds[l] = None;
         }
         for (d, row) in self.diag.iter_mut().zip(self.a.chunks_exact(w)) {
             let a = &row[self.q];
             *d = [a[0][0], a[1][1], a[2][2]];
         }
-        let failed = self.arch.dispatch(Factor {
+        for record in &mut self.records {
+            record.clear();
+        }
+        let rows = self.arch.dispatch(Factor {
             nb: self.nb,
             q: self.q,
             mask,
+            tolerance,
+            max,
+            records: &mut self.records,
             a: &mut self.a,
             diag: &self.diag,
             inv: &mut self.inv,
         });
         for (l, lane) in lanes.iter_mut().enumerate() {
-            let Some((m, failures, max)) = lane else {
+            let Some((m, failures, _)) = lane else {
                 continue;
             };
-            self.tried += 1;
-            if failed[l] {
-                self.failed += 1;
-                m.factor_collecting(failures, *max);
-                continue;
-            }
             failures.clear();
+            failures.extend_from_slice(&self.records[l]);
             let (a, diag, inv) = (&self.a, &self.diag, &self.inv);
-            m.install_factor(|blocks, d, i| {
+            let done = rows[l];
+            m.install_factor(!failures.is_empty(), |blocks, d, i| {
                 scatter(blocks, a, l);
-                for ((dk, ik), (dl, il)) in d.iter_mut().zip(i.iter_mut()).zip(diag.iter().zip(inv))
-                {
+                for (dk, dl) in d.iter_mut().zip(diag) {
                     *dk = [dl[0][l], dl[1][l], dl[2][l]];
+                }
+                // The rows after a stop keep their inverse pivots, as the one-sample code
+                // leaves them.
+                for (ik, il) in i.iter_mut().zip(inv).take(done) {
                     *ik = [il[0][l], il[1][l], il[2][l]];
                 }
             });
@@ -217,35 +205,61 @@ fn scatter<const W: usize>(blocks: &mut [crate::block::Block], lanes: &[BlockLan
 struct Factor<'k, const W: usize> {
     nb: usize,
     q: usize,
-    /// The lanes factorised: the others keep the factors they hold.
+    /// The lanes factorised: the others keep the factors they hold. A lane that has met
+    /// its most failures stops after that block row, as the one-sample factorisation does.
     mask: [bool; W],
+    /// Each lane's pivot tolerance (see [`BlockBandMatrix::factor_collecting`]).
+    tolerance: [f64; W],
+    /// Each lane's most failures to record before it stops.
+    max: [usize; W],
+    /// Each lane's failed pivots, in order.
+    records: &'k mut [Vec<PivotFailure>; W],
     a: &'k mut [BlockLanes<W>],
     diag: &'k [[[f64; W]; 3]],
     inv: &'k mut [[[f64; W]; 3]],
 }
 
 impl<const W: usize> pulp::WithSimd for Factor<'_, W> {
-    type Output = [bool; W];
+    /// Each lane's block rows factorised (all, unless it stopped).
+    type Output = [usize; W];
 
-    /// [`BlockBandMatrix::factor_collecting`] one block row at a time, lane by lane;
-    /// returns the lanes that met a pivot not above [`PIVOT_TOLERANCE`] times its row's
-    /// diagonal (their numbers are then not used).
+    /// [`BlockBandMatrix::factor_collecting`] one block row at a time, lane by lane: a
+    /// pivot not above its lane's tolerance times its row's diagonal is recorded and
+    /// replaced by that diagonal, as the one-sample code does.
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _: S) -> [bool; W] {
+    fn with_simd<S: pulp::Simd>(self, _: S) -> [usize; W] {
         let (q, w) = (self.q, self.q + 1);
-        let mut failed = [false; W];
+        let mut mask = self.mask;
+        let mut rows = [self.nb; W];
         for i in 0..self.nb {
+            if !mask.iter().any(|&m| m) {
+                break;
+            }
             let j0 = i.saturating_sub(q);
             let first = q - (i - j0);
             let (done, from_i) = self.a.split_at_mut(i * w);
             let row = &mut from_i[..w];
             for (n, row_j) in done[j0 * w..].chunks_exact(w).enumerate() {
-                off_diagonal(row, first, n, row_j, &self.inv[j0 + n], q, &self.mask);
+                off_diagonal(row, first, n, row_j, &self.inv[j0 + n], q, &mask);
             }
-            let inv = diagonal(row, first, &self.diag[i], &mut failed, &self.mask);
-            self.inv[i] = select3(&self.mask, inv, self.inv[i]);
+            let inv = diagonal(
+                row,
+                first,
+                i,
+                &self.diag[i],
+                &self.tolerance,
+                self.records,
+                &mask,
+            );
+            self.inv[i] = select3(&mask, inv, self.inv[i]);
+            for (l, m) in mask.iter_mut().enumerate() {
+                if *m && self.records[l].len() >= self.max[l] {
+                    *m = false;
+                    rows[l] = i + 1;
+                }
+            }
         }
-        failed
+        rows
     }
 }
 
@@ -299,14 +313,18 @@ fn select3<const W: usize>(
     std::array::from_fn(|k| lanes(|l| if mask[l] { new[k][l] } else { old[k][l] }))
 }
 
-/// `L_ii = chol(A_ii − Σ_k L_ik·L_ikᵀ)` (see `block::diagonal`); marks the lanes whose
-/// pivot is not above the tolerance, and returns the inverse pivots.
+/// `L_ii = chol(A_ii − Σ_k L_ik·L_ikᵀ)` (see `block::diagonal`): a lane's pivot not above
+/// its tolerance times its row's diagonal (NaN included, as the one-sample test reads) is
+/// recorded for that lane and replaced by the diagonal's magnitude; returns the inverse
+/// pivots.
 #[inline(always)]
 fn diagonal<const W: usize>(
     row: &mut [BlockLanes<W>],
     first: usize,
+    i: usize,
     diag: &[[f64; W]; 3],
-    failed: &mut [bool; W],
+    tolerance: &[f64; W],
+    records: &mut [Vec<PivotFailure>; W],
     mask: &[bool; W],
 ) -> [[f64; W]; 3] {
     let q = row.len() - 1;
@@ -325,26 +343,29 @@ fn diagonal<const W: usize>(
             }
         }
     }
-    let mut check = |k: usize, p: &[f64; W]| {
+    let mut pivot = |k: usize, mut p: [f64; W]| -> [f64; W] {
         for l in 0..W {
-            // Not above the tolerance (NaN included), as the one-sample test reads.
-            let above = p[l] > PIVOT_TOLERANCE * diag[k][l];
-            failed[l] |= mask[l] && !above;
+            let above = p[l] > tolerance[l] * diag[k][l];
+            if mask[l] && !above {
+                records[l].push(PivotFailure {
+                    index: 3 * i + k,
+                    pivot: p[l],
+                });
+                p[l] = diag[k][l].abs().max(f64::MIN_POSITIVE);
+            }
         }
+        p
     };
-    let p0 = s[0][0];
-    check(0, &p0);
+    let p0 = pivot(0, s[0][0]);
     let l00 = p0.map(f64::sqrt);
     let i0 = l00.map(|x| 1.0 / x);
     let l10 = lanes(|l| s[1][0][l] * i0[l]);
     let l20 = lanes(|l| s[2][0][l] * i0[l]);
-    let p1 = lanes(|l| s[1][1][l] - l10[l] * l10[l]);
-    check(1, &p1);
+    let p1 = pivot(1, lanes(|l| s[1][1][l] - l10[l] * l10[l]));
     let l11 = p1.map(f64::sqrt);
     let i1 = l11.map(|x| 1.0 / x);
     let l21 = lanes(|l| (s[2][1][l] - l20[l] * l10[l]) * i1[l]);
-    let p2 = lanes(|l| s[2][2][l] - l20[l] * l20[l] - l21[l] * l21[l]);
-    check(2, &p2);
+    let p2 = pivot(2, lanes(|l| s[2][2][l] - l20[l] * l20[l] - l21[l] * l21[l]));
     let l22 = p2.map(f64::sqrt);
     let zero = [0.0; W];
     let l = [[l00, zero, zero], [l10, l11, zero], [l20, l21, l22]];
