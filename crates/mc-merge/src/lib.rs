@@ -65,7 +65,7 @@
 //!
 //! Cases whose parameters agree except `sigma` form a σ-series (≥ 2 distinct σ): the target
 //! percentile against σ, least-squares lines through the origin and with intercept with R², and
-//! the allowable σ for the target angle (default 9.69e-5 rad = 20 arcsec at the 95th percentile)
+//! the allowable σ for the target angle (default 9.69e-5 rad, the paper's 20 arcsec rounded: 19.99″, at the 95th percentile)
 //! with a bootstrap interval from refitting every replicate series. Likewise `stages`: the
 //! percentiles normalised to the smallest stage count (paper Fig. 9) with intervals, and the
 //! stage count where it peaks.
@@ -116,6 +116,11 @@
 //!                             replicates_used, caveats[]},
 //!             stages_series[] {name, fixed, reference_stages, points[] {case, stages, value,
 //!                             normalised, relative_interval}, peak_stages, caveats[]}}
+//! answer     {target_angle, percentile, cases[] {case, value, against},
+//!             allowable_sigma[] {series, sigma, extrapolated},
+//!             rayleigh {tested, level, expected_by_chance,
+//!                       cases[] {case, verdict, p_value, holm_p_value, relative_difference},
+//!                       holm_rejected}}                  (drawn from the above, [`answer`])
 //! ```
 //!
 //! A *figure* (`value`, `lower`, `upper`, optional `reason`) carries its interval; whatever
@@ -221,6 +226,9 @@ pub fn build_report(dataset: &Dataset, settings: &Settings) -> Result<Report, Me
     let params: Vec<&BTreeMap<String, f64>> =
         dataset.cases.iter().map(|c| &c.info.parameters).collect();
     let sweep = sweep::sweep(&params, &analyses, settings);
+    let targets: Vec<report::Figure> = analyses.iter().map(|a| a.target.clone()).collect();
+    let cases: Vec<report::CaseReport> = analyses.into_iter().map(|a| a.report).collect();
+    let answer = answer::answer(&cases, &targets, &sweep, settings);
     let missing = dataset.missing();
     Ok(Report {
         format: report::REPORT_FORMAT,
@@ -242,8 +250,9 @@ pub fn build_report(dataset: &Dataset, settings: &Settings) -> Result<Report, Me
         },
         settings: settings.clone(),
         definitions: definitions::definitions(settings),
-        cases: analyses.into_iter().map(|a| a.report).collect(),
+        cases,
         sweep,
+        answer,
     })
 }
 

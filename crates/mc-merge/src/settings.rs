@@ -57,6 +57,14 @@ pub struct Settings {
     pub threads: usize,
 }
 
+impl Settings {
+    /// The target angle as it was set (`--target-angle`, in rad); its `Display` is the one
+    /// spelling of the target in the console, the reports and the plots.
+    pub fn target(&self) -> truss_units::TargetAngle {
+        truss_units::TargetAngle::Rad(self.target_angle)
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         Self {
@@ -128,7 +136,7 @@ impl Settings {
         }
         if !(self.target_angle > 0.0 && self.target_angle < MAX_TARGET_ANGLE) {
             return Err(usage(format!(
-                "--target-angle {}: must be a positive angle in rad below π/2 (e.g. 9.69e-5 for 20 arcsec)",
+                "--target-angle {}: must be a positive angle in rad below π/2 (e.g. 9.69e-5, the paper's 20 arcsec rounded)",
                 self.target_angle
             )));
         }

@@ -93,7 +93,7 @@ fn golden_job_shards_and_report() {
         "250ebc35d731f68192faca6b4669b8f390d78b9f27cebefb5b7b50bee177ec38",
         "098aa180429d0cc97595bed509b793c37bb7f0b0d30d29c5cf63ec6347cd8528",
         "7f95eed1a842b547589bf84637c37505cc0c2cfdc91b76242878045a89080f26",
-        "95691c3b1c3819a508808f3facd918ce6a7864e2a042b0a408d51c5eef8d582d",
+        "336a19aead0ab0005931eeab7225f9aced3b2515b99c263d14cda976b6c19192",
     ];
     for (what, (g, w)) in [
         "job id",
