@@ -85,7 +85,7 @@ fn run_all_runs_every_shard_then_merges() {
     let stderr = String::from_utf8_lossy(&again.stderr);
     for said in [
         format!(
-            "run-all: reusing 120 samples already in {}: 5 of 5 shards complete, 0 resumed",
+            "run-all: reusing 120 samples already in {}: all 5 shards complete (verified, not rerun)",
             all.display()
         ),
         "run-all: auditing: re-solving".to_string(),
@@ -99,6 +99,22 @@ fn run_all_runs_every_shard_then_merges() {
         Some(format!("report: {}", all.join("report/report.html").display()).as_str()),
         "{stdout}"
     );
+    // With shard 1's file gone, the rerun names the shards it reuses, and runs shard 1 again.
+    let mut files: Vec<_> = std::fs::read_dir(&all)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "jsonl"))
+        .collect();
+    files.sort();
+    std::fs::remove_file(&files[1]).unwrap();
+    let third = run_all(&[]);
+    assert!(third.status.success());
+    let stderr = String::from_utf8_lossy(&third.stderr);
+    assert!(
+        stderr.contains("shards complete (verified, not rerun): 0, 2-4\n"),
+        "{stderr}"
+    );
+    assert_eq!(sample_lines(&all), sample_lines(&single));
 }
 
 /// Exit codes of `run-all`: an invalid job is refused with mc-shard's code 3 before anything
