@@ -54,4 +54,22 @@ class Job:
     def inputs(self, case: Optional[str] = None, range: Optional[str] = None) -> Dict[str, Any]: ...
     def reproduce(self, case: str, sample: int, detail: bool = False) -> str: ...
 
+class Collected:
+    @property
+    def selection(self) -> bool: ...
+    def report(
+        self,
+        percentiles: Optional[Sequence[float]] = None,
+        confidence: float = 0.95,
+        replicates: int = 2000,
+        bootstrap_seed: int = 20210325,
+        gof_replicates: int = 1000,
+        gof_level: float = 0.05,
+        target_angle: float = 9.69e-5,
+        target_percentile: float = 95.0,
+        allow_partial: Optional[bool] = None,
+        allow_failed: bool = False,
+        threads: Optional[int] = None,
+    ) -> Tuple[str, str]: ...
+
 def read_shard_files(files: Sequence[str], partial: bool = False) -> Dict[str, Any]: ...

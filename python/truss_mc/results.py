@@ -4,11 +4,16 @@ sample lines) and :class:`Inputs` (each sample's drawn length errors and clearan
 
 from __future__ import annotations
 
-from typing import Any, Dict, Iterator, List, Optional
+import json
+from typing import TYPE_CHECKING, Any, Dict, Iterator, List, Optional, Sequence
 
 import numpy as np
 
 from . import _columns
+from .errors import UsageError
+
+if TYPE_CHECKING:
+    from .shards import Report
 
 __all__ = ["Samples", "Inputs"]
 
@@ -90,8 +95,11 @@ class Samples:
         inputs: Optional[Inputs] = None,
         job_id: Optional[str] = None,
         cases: Optional[List[Dict[str, Any]]] = None,
+        collected: Any = None,
     ) -> None:
         self._columns = columns
+        # The samples as mc-merge keeps them (native), for summary().
+        self._collected = collected
         #: The drawn inputs of each sample, when asked for.
         self.inputs = inputs
         #: The job id, for samples read from shard files.
@@ -131,6 +139,53 @@ class Samples:
     def to_pandas(self) -> Any:
         """A pandas DataFrame, one column per field (needs pandas)."""
         return _columns.frame(dict(self._columns))
+
+    def summary(
+        self,
+        *,
+        target_angle: float = 9.69e-5,
+        target_percentile: float = 95.0,
+        percentiles: Sequence[float] = (50.0, 90.0, 95.0, 99.0),
+        confidence: float = 0.95,
+        replicates: int = 2000,
+        bootstrap_seed: int = 20210325,
+        gof_replicates: int = 1000,
+        gof_level: float = 0.05,
+        allow_partial: Optional[bool] = None,
+        allow_failed: bool = False,
+        threads: Optional[int] = None,
+    ) -> "Report":
+        """The merge's statistics of these samples, computed by ``mc-merge``'s own code
+        (nothing is computed in Python): the :class:`~truss_mc.shards.Report` whose ``data``
+        is the ``report.json`` that ``mc-merge`` writes for shards of the same samples, byte
+        for byte, with its arrays (percentiles with their intervals, the Rayleigh law and
+        its verdicts, the allowable σ) and :attr:`~truss_mc.shards.Report.answer` (with the
+        console's answer lines as ``answer.text``). The keywords are ``mc-merge``'s settings
+        (``--target-angle`` in rad, …), refused as it refuses them. Samples missing from the
+        job are refused unless ``allow_partial`` (the default for a run of a case or a range,
+        and for ``read_shards(partial=True)``), which marks every figure partial as
+        ``mc-merge --allow-partial`` does; failed samples unless ``allow_failed``. Only for
+        samples from :meth:`Job.run` or :func:`read_shards`."""
+        from .shards import Report
+
+        if self._collected is None:
+            raise UsageError(
+                "summary() needs samples from Job.run or read_shards (these were built by hand)"
+            )
+        text, answer = self._collected.report(
+            [float(p) for p in percentiles],
+            float(confidence),
+            int(replicates),
+            int(bootstrap_seed),
+            int(gof_replicates),
+            float(gof_level),
+            float(target_angle),
+            float(target_percentile),
+            allow_partial,
+            bool(allow_failed),
+            threads,
+        )
+        return Report(json.loads(text), text=text, answer_text=answer)
 
     def __repr__(self) -> str:
         failed = int((~self.converged).sum()) if len(self) else 0
