@@ -190,6 +190,7 @@ impl Args {
         Ok(Options {
             paths: self.paths,
             plots: !self.no_plots,
+            progress: !self.quiet,
             out: self.out,
             settings,
         })

@@ -92,6 +92,9 @@ pub struct Options {
     pub out: Option<PathBuf>,
     /// Whether to draw plots (only with `out`).
     pub plots: bool,
+    /// Whether [`crate::run`] says on stderr where it is (the shards verified, each case,
+    /// the plots, the readable reports).
+    pub progress: bool,
     /// The statistics.
     pub settings: Settings,
 }

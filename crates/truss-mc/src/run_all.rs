@@ -272,6 +272,7 @@ async fn run_and_merge(
         paths: vec![options.out.clone()],
         out: Some(options.out.join("report")),
         plots: true,
+        progress: !options.quiet,
         settings: mc_merge::Settings {
             allow_failed: options.allow_failed,
             ..mc_merge::Settings::default()

@@ -66,6 +66,10 @@ fn run_all_runs_every_shard_then_merges() {
     };
     let r = run_all(&["--quiet"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(
+        !String::from_utf8_lossy(&r.stderr).contains("mc-merge: "),
+        "--quiet: no progress"
+    );
     let stdout = String::from_utf8_lossy(&r.stdout);
     assert!(
         stdout.contains("run-all: 120 samples in 5 shards on 3 workers"),
@@ -90,6 +94,11 @@ fn run_all_runs_every_shard_then_merges() {
         ),
         "run-all: auditing: re-solving".to_string(),
         "run-all: merging: verifying every shard".to_string(),
+        // The merge's own progress, stage by stage.
+        "mc-merge: 120 samples in 5 shard files verified (".to_string(),
+        "mc-merge: case 2 of 2 (uniform): percentiles, bootstrap, Rayleigh test (".to_string(),
+        "mc-merge: drawing the plots into ".to_string(),
+        "mc-merge: writing report.md and report.html (".to_string(),
     ] {
         assert!(stderr.contains(&said), "{said:?} not in {stderr}");
     }

@@ -71,6 +71,7 @@ fn golden_job_shards_and_report() {
         paths: vec![dir.path().to_path_buf()],
         out: Some(out.clone()),
         plots: false,
+        progress: false,
         settings: mc_merge::Settings {
             replicates: 200,
             gof_replicates: 100,

@@ -52,6 +52,7 @@ fn options(shards: &Path, out: &Path, plots: bool) -> mc_merge::Options {
         paths: vec![shards.to_path_buf()],
         out: Some(out.to_path_buf()),
         plots,
+        progress: false,
         settings: mc_merge::Settings {
             replicates: 100,
             gof_replicates: 19,
