@@ -9,7 +9,7 @@
 # 1. Build: every test target of the workspace and the binaries.
 # 2. cargo test --workspace --profile ci -- --include-ignored: unit, verification, property and
 #    CLI tests of every crate and the cross-crate pipeline (tests/), and in the same run the
-#    slow statistical checks that a plain `cargo test` ignores.
+#    slow statistical checks that a plain `cargo test` ignores (the README's, step 5, apart).
 # 3. The Python package: built into target/py-venv with `maturin develop --profile ci` (the
 #    feature unifier crates/workspace-hack gives its dependencies the binaries' features, so
 #    only PyO3 and the extension are compiled) and its pytest tests, which compare its
@@ -22,7 +22,15 @@
 #    - scripts/smoke-test.sh: the README's main command on a small job, and its SVG plots
 #      rendered to PNG with rsvg-convert, and mc-merge's own PNGs checked;
 #    - scripts/browser-test.sh: mc-merge's report.html opened in headless Chromium: every
-#      image loads, nothing is fetched, a screenshot is not blank, the page prints.
+#      image loads, nothing is fetched, the answer is on the first screen at 1280 x 900, a
+#      screenshot is not blank, the page prints.
+# 5. The README as pasted (tests/tests/it/readme.rs, readme_runs_as_pasted): every ```sh and
+#    ```python block of README.md, in order, in a clean shell in a copy of the repository
+#    (target/readme-test/clone), with the paper's job cut to 2,000 samples a case: its own
+#    release build (`cargo build --release`, kept in the copy's target/ between runs), its
+#    own virtual environment and `pip install .` (maturin and NumPy, and pandas for its
+#    snippet, from PyPI), the Monte Carlo, the merge, the diagnosis, the tolerance study and
+#    the browser check of the quick start's report.
 # Needs what scripts/setup.sh installs (run first when something is missing: Debian's Slurm,
 # munge, librsvg2-bin, fonts-dejavu-core and chromium through apt-get, and a Python virtual
 # environment with maturin, pytest and numpy from PyPI).
@@ -61,7 +69,7 @@ slurm_started=$SECONDS
 trap 'wait "$slurm" 2>/dev/null || true' EXIT
 
 phase "cargo test --workspace, default and slow tiers"
-cargo test --workspace --profile ci --quiet -- --include-ignored
+cargo test --workspace --profile ci --quiet -- --include-ignored --skip readme_runs_as_pasted
 
 phase "Python package: maturin develop --profile ci, then pytest"
 (
@@ -85,5 +93,8 @@ scripts/smoke-test.sh
 
 phase "report.html in a browser"
 scripts/browser-test.sh
+
+phase "the README as pasted, in a copy of the repository (its own release build and Python package)"
+cargo test --profile ci --quiet -p pipeline-tests --test it readme_runs_as_pasted -- --ignored
 
 phase "all passed"
