@@ -134,3 +134,12 @@ def test_a_run_of_one_case_is_partial_like_allow_partial(sweep, tmp_path: Path) 
     # Samples built by hand have nothing to summarise.
     with pytest.raises(truss_mc.UsageError, match="summary"):
         truss_mc.Samples({"index": np.array([0])}).summary()
+
+
+def test_the_defaults_are_mc_merges(sweep, tmp_path: Path) -> None:
+    # Every keyword left out is mc-merge's own default (taken from its settings, not copied):
+    # the summary is the report.json of a merge given no flag.
+    job, shards, _, _ = sweep
+    out = tmp_path / "report"
+    tool("mc-merge", str(shards), "--out", str(out), "--quiet")
+    assert truss_mc.read_shards(shards).summary().text == (out / "report.json").read_text()

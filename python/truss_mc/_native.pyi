@@ -60,15 +60,15 @@ class Collected:
     def report(
         self,
         percentiles: Optional[Sequence[float]] = None,
-        confidence: float = 0.95,
-        replicates: int = 2000,
-        bootstrap_seed: int = 20210325,
-        gof_replicates: int = 1000,
-        gof_level: float = 0.05,
-        target_angle: float = 9.69e-5,
-        target_percentile: float = 95.0,
+        confidence: Optional[float] = None,
+        replicates: Optional[int] = None,
+        bootstrap_seed: Optional[int] = None,
+        gof_replicates: Optional[int] = None,
+        gof_level: Optional[float] = None,
+        target_angle: Optional[float] = None,
+        target_percentile: Optional[float] = None,
         allow_partial: Optional[bool] = None,
-        allow_failed: bool = False,
+        allow_failed: Optional[bool] = None,
         threads: Optional[int] = None,
     ) -> Tuple[str, str]: ...
 

@@ -143,16 +143,16 @@ class Samples:
     def summary(
         self,
         *,
-        target_angle: float = 9.69e-5,
-        target_percentile: float = 95.0,
-        percentiles: Sequence[float] = (50.0, 90.0, 95.0, 99.0),
-        confidence: float = 0.95,
-        replicates: int = 2000,
-        bootstrap_seed: int = 20210325,
-        gof_replicates: int = 1000,
-        gof_level: float = 0.05,
+        target_angle: Optional[float] = None,
+        target_percentile: Optional[float] = None,
+        percentiles: Optional[Sequence[float]] = None,
+        confidence: Optional[float] = None,
+        replicates: Optional[int] = None,
+        bootstrap_seed: Optional[int] = None,
+        gof_replicates: Optional[int] = None,
+        gof_level: Optional[float] = None,
         allow_partial: Optional[bool] = None,
-        allow_failed: bool = False,
+        allow_failed: Optional[bool] = None,
         threads: Optional[int] = None,
     ) -> "Report":
         """The merge's statistics of these samples, computed by ``mc-merge``'s own code
@@ -161,7 +161,10 @@ class Samples:
         for byte, with its arrays (percentiles with their intervals, the Rayleigh law and
         its verdicts, the allowable σ) and :attr:`~truss_mc.shards.Report.answer` (with the
         console's answer lines as ``answer.text``). The keywords are ``mc-merge``'s settings
-        (``--target-angle`` in rad, …), refused as it refuses them. Samples missing from the
+        (``target_angle`` is ``--target-angle``, in rad, …), each ``mc-merge``'s default
+        where None (9.69e-5 rad at the 95th percentile; percentiles 50, 90, 95, 99; 95 %
+        intervals from B = 2000 replicates; 1000 null samples at level 0.05), refused as it
+        refuses them. Samples missing from the
         job are refused unless ``allow_partial`` (the default for a run of a case or a range,
         and for ``read_shards(partial=True)``), which marks every figure partial as
         ``mc-merge --allow-partial`` does; failed samples unless ``allow_failed``. Only for
@@ -173,16 +176,16 @@ class Samples:
                 "summary() needs samples from Job.run or read_shards (these were built by hand)"
             )
         text, answer = self._collected.report(
-            [float(p) for p in percentiles],
-            float(confidence),
-            int(replicates),
-            int(bootstrap_seed),
-            int(gof_replicates),
-            float(gof_level),
-            float(target_angle),
-            float(target_percentile),
+            None if percentiles is None else [float(p) for p in percentiles],
+            confidence,
+            replicates,
+            bootstrap_seed,
+            gof_replicates,
+            gof_level,
+            target_angle,
+            target_percentile,
             allow_partial,
-            bool(allow_failed),
+            allow_failed,
             threads,
         )
         return Report(json.loads(text), text=text, answer_text=answer)

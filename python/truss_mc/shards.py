@@ -143,7 +143,7 @@ class Answer:
 
     def __repr__(self) -> str:
         return (
-            f"Answer(target {self.target_angle:e} rad at P{self.percentile:g}: "
+            f"Answer(target {self.target_angle!r} rad at P{self.percentile:g}: "
             f"{len(self.above)} above, {len(self.within)} within)"
         )
 

@@ -89,21 +89,22 @@ impl PyCollected {
     }
 
     /// The merge's report of the samples: `(report_json, answer_lines)`, the text of
-    /// `report.json` and the console's closing answer lines, under `mc-merge`'s settings
-    /// (each refused as `mc-merge` refuses it, naming its flag). Missing samples are refused
-    /// unless `allow_partial` (the default for a selection), failed ones unless
-    /// `allow_failed`, as the merge refuses them.
+    /// `report.json` and the console's closing answer lines, under `mc-merge`'s settings,
+    /// each `mc-merge`'s default where None (`mc_merge::Settings::default`) and refused as
+    /// `mc-merge` refuses it, naming its flag. Missing samples are refused unless
+    /// `allow_partial` (by default, whether the samples are a selection), failed ones
+    /// unless `allow_failed`, as the merge refuses them.
     #[pyo3(signature = (
         percentiles = None,
-        confidence = 0.95,
-        replicates = 2000,
-        bootstrap_seed = mc_merge::settings::DEFAULT_SEED,
-        gof_replicates = 1000,
-        gof_level = 0.05,
-        target_angle = mc_merge::settings::DEFAULT_TARGET_ANGLE,
-        target_percentile = 95.0,
+        confidence = None,
+        replicates = None,
+        bootstrap_seed = None,
+        gof_replicates = None,
+        gof_level = None,
+        target_angle = None,
+        target_percentile = None,
         allow_partial = None,
-        allow_failed = false,
+        allow_failed = None,
         threads = None,
     ))]
     #[allow(clippy::too_many_arguments)]
@@ -111,31 +112,31 @@ impl PyCollected {
         &self,
         py: Python<'_>,
         percentiles: Option<Vec<f64>>,
-        confidence: f64,
-        replicates: u32,
-        bootstrap_seed: u64,
-        gof_replicates: u32,
-        gof_level: f64,
-        target_angle: f64,
-        target_percentile: f64,
+        confidence: Option<f64>,
+        replicates: Option<u32>,
+        bootstrap_seed: Option<u64>,
+        gof_replicates: Option<u32>,
+        gof_level: Option<f64>,
+        target_angle: Option<f64>,
+        target_percentile: Option<f64>,
         allow_partial: Option<bool>,
-        allow_failed: bool,
+        allow_failed: Option<bool>,
         threads: Option<usize>,
     ) -> PyResult<(String, String)> {
-        let defaults = Settings::default();
+        let d = Settings::default();
         let threads = mc_shard::cli::check_threads("threads", truss_threads::or_available(threads))
             .map_err(Failure::from)?;
         let settings = Settings {
-            percentiles: percentiles.unwrap_or(defaults.percentiles),
-            confidence,
-            replicates,
-            bootstrap_seed,
-            gof_replicates,
-            gof_level,
-            target_angle,
-            target_percentile,
+            percentiles: percentiles.unwrap_or(d.percentiles),
+            confidence: confidence.unwrap_or(d.confidence),
+            replicates: replicates.unwrap_or(d.replicates),
+            bootstrap_seed: bootstrap_seed.unwrap_or(d.bootstrap_seed),
+            gof_replicates: gof_replicates.unwrap_or(d.gof_replicates),
+            gof_level: gof_level.unwrap_or(d.gof_level),
+            target_angle: target_angle.unwrap_or(d.target_angle),
+            target_percentile: target_percentile.unwrap_or(d.target_percentile),
             allow_partial: allow_partial.unwrap_or(self.selection),
-            allow_failed,
+            allow_failed: allow_failed.unwrap_or(d.allow_failed),
             threads,
         };
         let data = Arc::clone(&self.data);
