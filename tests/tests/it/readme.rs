@@ -278,10 +278,19 @@ fn fresh_clone() -> PathBuf {
             std::fs::remove_file(&p).unwrap();
         }
     }
+    // Each copy keeps its file's modification time, so that the kept build rebuilds only
+    // the crates whose files changed since (a new time on every file rebuilt them all).
     for f in repository_files() {
-        let to = clone.join(&f);
+        let (from, to) = (root().join(&f), clone.join(&f));
         std::fs::create_dir_all(to.parent().unwrap()).unwrap();
-        std::fs::copy(root().join(&f), &to).unwrap();
+        std::fs::copy(&from, &to).unwrap();
+        let modified = std::fs::metadata(&from).unwrap().modified().unwrap();
+        std::fs::File::options()
+            .write(true)
+            .open(&to)
+            .unwrap()
+            .set_modified(modified)
+            .unwrap();
     }
     // The paper's job, 2,000 samples per case: the README's commands unchanged, seconds of
     // Monte Carlo.
@@ -352,7 +361,7 @@ fn cargo_dir() -> PathBuf {
 }
 
 /// The text between the marks of the block at README line `line` and the next.
-fn section<'a>(log: &'a str, line: usize) -> &'a str {
+fn section(log: &str, line: usize) -> &str {
     let mark = format!("=== README.md:{line} (");
     let start = log
         .find(&mark)
