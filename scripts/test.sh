@@ -31,11 +31,19 @@
 #    own virtual environment and `pip install .` (maturin and NumPy, and pandas for its
 #    snippet, from PyPI), the Monte Carlo, the merge, the diagnosis, the tolerance study and
 #    the browser check of the quick start's report.
-# Needs what scripts/setup.sh installs (run first when something is missing: Debian's Slurm,
-# munge, librsvg2-bin, fonts-dejavu-core and chromium through apt-get, and a Python virtual
-# environment with maturin, pytest and numpy from PyPI).
-# Takes about 11 minutes from a clean clone on 2 cores (the build about 6 of them), about
-# 4 once built.
+# Installs first, when something is missing, by scripts/setup.sh (as root or with sudo):
+# Debian's slurmctld, slurmd, slurm-client, munge, librsvg2-bin, fonts-dejavu-core and
+# chromium through apt-get, and the Python virtual environment target/py-venv with maturin,
+# pytest and numpy (and OpenTURNS where PyPI has a wheel) from PyPI; step 5 fetches maturin,
+# NumPy and pandas from PyPI into the copy's own environment. Crates come from crates.io as
+# cargo builds (Cargo.lock pins them).
+# Takes about 45 minutes from a clean clone on 2 cores (43 min 51 s measured on a machine
+# busy with other builds: step 1, 18 min; steps 2 and 3, 7 min, the Slurm check beside
+# them; step 4, 15 s; step 5, 18 min, most of it the copy's release build), and about
+# 13 minutes once built (measured part by part: step 1 finding nothing to build, 1 min;
+# steps 2 and 3, 8½ min; step 4, 15 s; step 5, 3½ min, its copy rebuilding only what
+# changed).
+# `scripts/test.sh --help` prints this and runs nothing.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$REPO"

@@ -220,6 +220,73 @@ fn readme_commands_are_checked() {
     assert!(run >= 25, "{run} commands run");
 }
 
+/// `scripts/test.sh --help` says what the test command runs, what it installs and how long
+/// it takes, and runs nothing: given a `PATH` of only `bash`, `sed` and `dirname`, it prints
+/// its header and exits 0 with nothing on stderr (a phase started would announce itself
+/// there, and installing or building would fail without its tools); an argument it does not
+/// know is refused (exit 2) the same way.
+#[test]
+fn test_command_help_runs_nothing() {
+    let bin = tempfile::tempdir().unwrap();
+    for tool in ["bash", "sed", "dirname"] {
+        let found = ["/usr/bin", "/bin"]
+            .iter()
+            .map(|d| Path::new(d).join(tool))
+            .find(|p| p.is_file())
+            .unwrap_or_else(|| panic!("no {tool}"));
+        std::os::unix::fs::symlink(found, bin.path().join(tool)).unwrap();
+    }
+    let run = |arg: &str| {
+        Command::new(root().join("scripts/test.sh"))
+            .arg(arg)
+            .current_dir(bin.path())
+            .env_clear()
+            .env("PATH", bin.path())
+            .output()
+            .unwrap()
+    };
+    let o = run("--help");
+    let (out, err) = (
+        String::from_utf8(o.stdout).unwrap(),
+        String::from_utf8(o.stderr).unwrap(),
+    );
+    assert!(
+        o.status.success() && err.is_empty(),
+        "{:?}: {err}",
+        o.status
+    );
+    let said = out.split_whitespace().collect::<Vec<_>>().join(" ");
+    for step in [
+        "1. Build",
+        "2. cargo test",
+        "3. The Python",
+        "4. The end-to-end",
+        "5. The README",
+    ] {
+        assert!(said.contains(step), "--help names no step {step:?}:\n{out}");
+    }
+    for installs in ["apt-get", "chromium", "slurmctld", "PyPI", "target/py-venv"] {
+        assert!(
+            said.contains(installs),
+            "--help does not say it installs {installs}:\n{out}"
+        );
+    }
+    assert!(
+        said.contains("Takes about")
+            && said.contains("from a clean clone")
+            && said.contains("once built"),
+        "--help says not how long:\n{out}"
+    );
+    assert!(!said.contains("WARM_"), "a placeholder in --help:\n{out}");
+    let o = run("--fast");
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(
+        err.starts_with("test.sh: takes no arguments (got: --fast)"),
+        "{err}"
+    );
+}
+
 /// The files of the repository as a clone has them: tracked and new, none ignored.
 fn repository_files() -> Vec<PathBuf> {
     let out = Command::new("git")
