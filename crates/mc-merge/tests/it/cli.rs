@@ -682,13 +682,21 @@ fn check_answer_last(stdout: &str, v: &Value, dir: &Path) {
         "{answer}\n{a}"
     );
     // The σ-sweep marks the target on both axes: the target written where its line meets
-    // the θ axis (besides the legend's entry), the allowable σ written where it meets the σ
-    // axis (the legend's entry starts "allowable").
+    // the θ axis (besides the legend's entry) and in arcsec on the arcsec axis, the
+    // allowable σ written where it meets the σ axis (the legend's entry starts "allowable").
     let sweep = std::fs::read_to_string(dir.join("sigma-sweep.svg")).unwrap();
     let texts: Vec<&str> = sweep.lines().collect();
     assert!(
         texts.iter().filter(|l| l.starts_with("target ")).count() >= 2,
         "no target at the θ axis"
+    );
+    let arcsec = format!(
+        "{:.2}″",
+        v["settings"]["target_angle"].as_f64().unwrap() * truss_units::ARCSEC_PER_RAD
+    );
+    assert!(
+        texts.iter().any(|l| *l == arcsec),
+        "no target {arcsec} at the arcsec axis"
     );
     assert!(
         texts
