@@ -10,10 +10,12 @@
 # - nothing is fetched (no resource entry: no file, no network) and there is no script;
 # - one h1, and every table has a caption;
 # - the answer's allowable σ is on the first screen: in a 1280 x 900 frame, not scrolled, the
-#   list item that starts "Allowable σ" ends at most 900 px down;
-# - a screenshot (1280 x 2400 px) is not blank: the standard deviation of its luminance is
-#   at least 20 (of 255) and at least 1 % of its pixels are ink (luminance below 200); a
-#   blank page gives about 7 and 0.2 %;
+#   list item that starts "Allowable σ" lies between 0 and 900 px down, is laid out (width
+#   and height above 0), is not hidden (visibility, display, opacity) and holds a σ in mm;
+# - screenshots of the first screen (1280 x 900 px, what a reader sees on opening the page)
+#   and of the page further down (1280 x 2400 px) are not blank: the standard deviation of
+#   their luminance is at least 20 (of 255) and at least 1 % of their pixels are ink
+#   (luminance below 200); a blank page gives about 7 and 0.2 %;
 # - the page prints (to PDF, with its print style sheet).
 #
 # How: `chromium --headless --dump-dom` on a small check page written here, which holds the
@@ -76,6 +78,8 @@ browser() {
         || { tail -20 "$WORK/$name.log" >&2; fail "chromium failed ($name)"; }
 }
 
+browser first --hide-scrollbars --window-size=1280,900 --screenshot="$WORK/first.png" "$URL"
+[[ -s "$WORK/first.png" ]] || fail "no screenshot of the first screen"
 browser screenshot --hide-scrollbars --window-size=1280,2400 --screenshot="$WORK/shot.png" "$URL"
 [[ -s "$WORK/shot.png" ]] || fail "no screenshot"
 browser print --no-pdf-header-footer --print-to-pdf="$WORK/report.pdf" "$URL"
@@ -90,10 +94,16 @@ pages="$(grep -ac '/Type /Page\($\|[^s]\)' "$WORK/report.pdf" || true)"
 <body>
 <pre id="images">not loaded</pre>
 <pre id="pixels">not loaded</pre>
+<pre id="first-pixels">not loaded</pre>
 <iframe id="page" src="$URL" width="1280" height="900"></iframe>
 <img id="shot" alt="screenshot" src="data:image/png;base64,
 HTML
     base64 -w0 "$WORK/shot.png"
+    cat <<'HTML'
+">
+<img id="first" alt="first screen" src="data:image/png;base64,
+HTML
+    base64 -w0 "$WORK/first.png"
     cat <<'HTML'
 ">
 <script>
@@ -107,7 +117,12 @@ document.getElementById('page').addEventListener('load', function () {
   var allowable = Array.prototype.slice.call(d.querySelectorAll('li')).filter(function (li) {
     return li.textContent.indexOf('Allowable σ') === 0;
   })[0];
-  var answerBottom = allowable ? Math.round(allowable.getBoundingClientRect().bottom) : 99999;
+  var box = allowable ? allowable.getBoundingClientRect() : null;
+  var style = allowable ? d.defaultView.getComputedStyle(allowable) : null;
+  var answerBottom = box ? Math.round(box.bottom) : 99999;
+  var answerShown = box && box.top >= 0 && box.width > 0 && box.height > 0 &&
+    style.visibility === 'visible' && style.display !== 'none' && parseFloat(style.opacity) > 0 &&
+    /[0-9.]+e-?[0-9]+ mm/.test(allowable.textContent) ? 1 : 0;
   out.textContent = 'IMAGES images=' + imgs.length +
     ' loaded=' + count(function (i) { return i.complete && i.naturalWidth > 0; }) +
     ' noalt=' + count(function (i) { return !i.alt; }) +
@@ -116,10 +131,11 @@ document.getElementById('page').addEventListener('load', function () {
     ' h1=' + d.querySelectorAll('h1').length +
     ' tables=' + d.querySelectorAll('table').length +
     ' captions=' + d.querySelectorAll('table > caption').length +
-    ' answer_bottom=' + answerBottom + ' end';
+    ' answer_bottom=' + answerBottom + ' answer_shown=' + answerShown + ' end';
 });
-window.addEventListener('load', function () {
-  var img = document.getElementById('shot');
+// The luminance statistics of a decoded screenshot, written into the <pre> of id `out`.
+function pixels(id, out) {
+  var img = document.getElementById(id);
   var c = document.createElement('canvas');
   c.width = img.naturalWidth;
   c.height = img.naturalHeight;
@@ -132,9 +148,13 @@ window.addEventListener('load', function () {
     n++; sum += y; sum2 += y * y; if (y < 200) ink++;
   }
   var mean = sum / Math.max(n, 1);
-  document.getElementById('pixels').textContent = 'PIXELS width=' + c.width +
+  document.getElementById(out).textContent = 'PIXELS width=' + c.width +
     ' height=' + c.height + ' sd=' + Math.sqrt(Math.max(0, sum2 / Math.max(n, 1) - mean * mean)).toFixed(1) +
     ' ink_permille=' + Math.round(1000 * ink / Math.max(n, 1)) + ' end';
+}
+window.addEventListener('load', function () {
+  pixels('shot', 'pixels');
+  pixels('first', 'first-pixels');
 });
 </script>
 </body></html>
@@ -145,8 +165,10 @@ browser check --allow-file-access-from-files --dump-dom "file://$WORK/check.html
 # The two result lines, as the check page's script wrote them into its <pre> elements.
 images="$(sed -n 's|.*<pre id="images">\([^<]*\)</pre>.*|\1|p' "$WORK/dom.html")"
 pixels="$(sed -n 's|.*<pre id="pixels">\([^<]*\)</pre>.*|\1|p' "$WORK/dom.html")"
+first="$(sed -n 's|.*<pre id="first-pixels">\([^<]*\)</pre>.*|\1|p' "$WORK/dom.html")"
 [[ "$images" == *" end" ]] || fail "the page did not load in the check page: ${images:-nothing}"
 [[ "$pixels" == *" end" ]] || fail "the screenshot did not decode: ${pixels:-nothing}"
+[[ "$first" == *" end" ]] || fail "the first screen's screenshot did not decode: ${first:-nothing}"
 # value KEY LINE: the number after KEY= in LINE.
 value() { sed -n "s/.* $1=\([0-9.]*\).*/\1/p" <<< "$2"; }
 n="$(value images "$images")"
@@ -161,8 +183,14 @@ tables="$(value tables "$images")"
 answer_bottom="$(value answer_bottom "$images")"
 ((answer_bottom > 0 && answer_bottom <= 900)) \
     || fail "the allowable σ is not on the first screen at 1280 × 900 (its bottom at ${answer_bottom} px; $images)"
+(($(value answer_shown "$images") == 1)) \
+    || fail "the allowable σ is on the first screen but not shown: hidden, empty or without a σ in mm ($images)"
 [[ "$pixels" == *"width=1280 height=2400"* ]] || fail "screenshot of the wrong size ($pixels)"
 sd="$(value sd "$pixels")"
 ink="$(value ink_permille "$pixels")"
 ((${sd%.*} >= 20 && ink >= 10)) || fail "the screenshot is blank ($pixels)"
-echo "browser-test: report.html in $("$CHROMIUM" --version 2>/dev/null | head -1): $n of $n images loaded, $tables tables, nothing fetched, no script; the allowable σ ends $answer_bottom px down the first screen (900); screenshot sd $sd, ink ${ink} ‰; printed $pages pages" >&2
+[[ "$first" == *"width=1280 height=900"* ]] || fail "first-screen screenshot of the wrong size ($first)"
+first_sd="$(value sd "$first")"
+first_ink="$(value ink_permille "$first")"
+((${first_sd%.*} >= 20 && first_ink >= 10)) || fail "the first screen is blank ($first)"
+echo "browser-test: report.html in $("$CHROMIUM" --version 2>/dev/null | head -1): $n of $n images loaded, $tables tables, nothing fetched, no script; the allowable σ shown, ending $answer_bottom px down the first screen (900), whose screenshot has sd $first_sd, ink ${first_ink} ‰; the page's sd $sd, ink ${ink} ‰; printed $pages pages" >&2

@@ -2,7 +2,9 @@
 
 Models and single solves (:func:`prism`, :meth:`Model.from_file`, :func:`solve`), jobs run
 in-process on all cores (:meth:`Job.from_file`, :meth:`Job.run`, :meth:`Job.inputs`,
-:meth:`Job.reproduce`), and runs read back (:func:`read_shards`, :func:`read_report`). Every
+:meth:`Job.reproduce`), runs read back (:func:`read_shards`, :func:`read_report`), and
+their statistics as ``mc-merge`` computes them (:meth:`Samples.summary`: percentiles with
+their intervals, the Rayleigh law's verdicts, the allowable σ, the answer). Every
 number comes from the same Rust code as the command-line tools, so it equals what they write,
 bit for bit; errors are :mod:`truss_mc.errors` exceptions with the tools' messages. Units:
 mm, N, MPa, rad.
@@ -26,7 +28,7 @@ from .errors import (
 from .job import IndexRange, Job
 from .model import Model, Solution, prism, solve
 from .results import Inputs, Samples
-from .shards import Report, read_report, read_shards
+from .shards import Answer, Report, read_report, read_shards
 
 __all__ = [
     "NUMERICS_VERSION",
@@ -43,6 +45,7 @@ __all__ = [
     "read_shards",
     "read_report",
     "Report",
+    "Answer",
     "TrussError",
     "UsageError",
     "InvalidInputError",

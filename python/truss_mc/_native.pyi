@@ -54,4 +54,22 @@ class Job:
     def inputs(self, case: Optional[str] = None, range: Optional[str] = None) -> Dict[str, Any]: ...
     def reproduce(self, case: str, sample: int, detail: bool = False) -> str: ...
 
+class Collected:
+    @property
+    def selection(self) -> bool: ...
+    def report(
+        self,
+        percentiles: Optional[Sequence[float]] = None,
+        confidence: Optional[float] = None,
+        replicates: Optional[int] = None,
+        bootstrap_seed: Optional[int] = None,
+        gof_replicates: Optional[int] = None,
+        gof_level: Optional[float] = None,
+        target_angle: Optional[float] = None,
+        target_percentile: Optional[float] = None,
+        allow_partial: Optional[bool] = None,
+        allow_failed: Optional[bool] = None,
+        threads: Optional[int] = None,
+    ) -> Tuple[str, str]: ...
+
 def read_shard_files(files: Sequence[str], partial: bool = False) -> Dict[str, Any]: ...

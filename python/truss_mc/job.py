@@ -93,7 +93,8 @@ class Job:
         ``range`` (all if None) on ``threads`` threads (default: all cores), and returns them
         in index order: the numbers of their shard lines. With ``inputs``, also each sample's
         drawn inputs (:class:`~truss_mc.results.Inputs`). Ctrl-C stops it
-        (``KeyboardInterrupt``)."""
+        (``KeyboardInterrupt``). :meth:`~truss_mc.results.Samples.summary` gives their
+        statistics as ``mc-merge`` computes them."""
         if threads is not None and (
             isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= MAX_THREADS
         ):
@@ -105,6 +106,7 @@ class Job:
             inputs=Inputs(raw) if raw is not None else None,
             job_id=self.id,
             cases=self.cases,
+            collected=r["collected"],
         )
 
     def inputs(self, case: Optional[str] = None, range: Optional[IndexRange] = None) -> Inputs:

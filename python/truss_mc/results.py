@@ -4,11 +4,16 @@ sample lines) and :class:`Inputs` (each sample's drawn length errors and clearan
 
 from __future__ import annotations
 
-from typing import Any, Dict, Iterator, List, Optional
+import json
+from typing import TYPE_CHECKING, Any, Dict, Iterator, List, Optional, Sequence
 
 import numpy as np
 
 from . import _columns
+from .errors import UsageError
+
+if TYPE_CHECKING:
+    from .shards import Report
 
 __all__ = ["Samples", "Inputs"]
 
@@ -90,8 +95,11 @@ class Samples:
         inputs: Optional[Inputs] = None,
         job_id: Optional[str] = None,
         cases: Optional[List[Dict[str, Any]]] = None,
+        collected: Any = None,
     ) -> None:
         self._columns = columns
+        # The samples as mc-merge keeps them (native), for summary().
+        self._collected = collected
         #: The drawn inputs of each sample, when asked for.
         self.inputs = inputs
         #: The job id, for samples read from shard files.
@@ -131,6 +139,56 @@ class Samples:
     def to_pandas(self) -> Any:
         """A pandas DataFrame, one column per field (needs pandas)."""
         return _columns.frame(dict(self._columns))
+
+    def summary(
+        self,
+        *,
+        target_angle: Optional[float] = None,
+        target_percentile: Optional[float] = None,
+        percentiles: Optional[Sequence[float]] = None,
+        confidence: Optional[float] = None,
+        replicates: Optional[int] = None,
+        bootstrap_seed: Optional[int] = None,
+        gof_replicates: Optional[int] = None,
+        gof_level: Optional[float] = None,
+        allow_partial: Optional[bool] = None,
+        allow_failed: Optional[bool] = None,
+        threads: Optional[int] = None,
+    ) -> "Report":
+        """The merge's statistics of these samples, computed by ``mc-merge``'s own code
+        (nothing is computed in Python): the :class:`~truss_mc.shards.Report` whose ``data``
+        is the ``report.json`` that ``mc-merge`` writes for shards of the same samples, byte
+        for byte, with its arrays (percentiles with their intervals, the Rayleigh law and
+        its verdicts, the allowable σ) and :attr:`~truss_mc.shards.Report.answer` (with the
+        console's answer lines as ``answer.text``). The keywords are ``mc-merge``'s settings
+        (``target_angle`` is ``--target-angle``, in rad, …), each ``mc-merge``'s default
+        where None (9.69e-5 rad at the 95th percentile; percentiles 50, 90, 95, 99; 95 %
+        intervals from B = 2000 replicates; 1000 null samples at level 0.05), refused as it
+        refuses them. Samples missing from the
+        job are refused unless ``allow_partial`` (the default for a run of a case or a range,
+        and for ``read_shards(partial=True)``), which marks every figure partial as
+        ``mc-merge --allow-partial`` does; failed samples unless ``allow_failed``. Only for
+        samples from :meth:`Job.run` or :func:`read_shards`."""
+        from .shards import Report
+
+        if self._collected is None:
+            raise UsageError(
+                "summary() needs samples from Job.run or read_shards (these were built by hand)"
+            )
+        text, answer = self._collected.report(
+            None if percentiles is None else [float(p) for p in percentiles],
+            confidence,
+            replicates,
+            bootstrap_seed,
+            gof_replicates,
+            gof_level,
+            target_angle,
+            target_percentile,
+            allow_partial,
+            allow_failed,
+            threads,
+        )
+        return Report(json.loads(text), text=text, answer_text=answer)
 
     def __repr__(self) -> str:
         failed = int((~self.converged).sum()) if len(self) else 0

@@ -7,7 +7,7 @@ import json
 import math
 import os
 from pathlib import Path
-from typing import Any, Dict, Iterable, List, Union
+from typing import Any, Dict, Iterable, List, Optional, Union
 
 import numpy as np
 
@@ -15,7 +15,7 @@ from . import _columns, _native
 from .errors import InvalidInputError
 from .results import Samples
 
-__all__ = ["read_shards", "read_report", "Report"]
+__all__ = ["read_shards", "read_report", "Report", "Answer"]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -48,23 +48,121 @@ def read_shards(paths: Union[PathLike, Iterable[PathLike]], *, partial: bool = F
     :class:`~truss_mc.errors.VerificationError`. A path that is not a regular file (a FIFO, a
     device) raises :class:`~truss_mc.errors.InvalidInputError` before it is opened. With ``partial``, an incomplete file (a run
     still going) gives the samples its last checkpoint verifies. Missing ranges are not an
-    error here (``mc-merge`` checks coverage)."""
+    error here; :meth:`~truss_mc.results.Samples.summary` checks them as ``mc-merge``
+    does."""
     r = _native.read_shard_files(_shard_files(paths), partial)
-    return Samples(_columns.arrays(r["columns"]), job_id=r["job_id"], cases=r["cases"])
+    return Samples(
+        _columns.arrays(r["columns"]),
+        job_id=r["job_id"],
+        cases=r["cases"],
+        collected=r["collected"],
+    )
 
 
 def _number(x: Any) -> float:
     return float("nan") if x is None else float(x)
 
 
-class Report:
-    """``report.json`` of ``mc-merge`` (documented in ``crates/mc-merge/README.md``):
-    ``data`` is the whole document; ``percentiles`` and ``cases`` are its main tables as
-    arrays (angles in rad, NaN where the report has null)."""
+class Answer:
+    """The answer of a merge (``report.json``'s ``answer``, computed by ``mc-merge``): each
+    case's θ_P at the target percentile against the target, each σ-series' allowable σ, and
+    the Rayleigh verdicts with what chance alone gives and Holm's adjustment across the
+    cases. Angles in rad, σ in mm, NaN where the report has null."""
 
-    def __init__(self, data: Dict[str, Any]) -> None:
+    def __init__(self, data: Dict[str, Any], text: Optional[str] = None) -> None:
+        #: The parsed ``answer`` section.
+        self.data = data
+        #: The target angle [rad], as set.
+        self.target_angle: float = float(data["target_angle"])
+        #: The percentile that must meet it [%].
+        self.percentile: float = float(data["percentile"])
+
+        def figure(f: Dict[str, Any], key: str) -> float:
+            return _number((f or {}).get(key))
+
+        cases = data["cases"]
+        #: Per case: ``case``, ``value`` (θ_P at the target percentile) with ``lower`` and
+        #: ``upper`` [rad], and ``against`` (``"above"``, ``"within"``, or ``"undefined"``
+        #: where there is no value).
+        self.cases: Dict[str, np.ndarray] = {
+            "case": np.array([c["case"] for c in cases], dtype=str),
+            "value": np.array([figure(c["value"], "value") for c in cases]),
+            "lower": np.array([figure(c["value"], "lower") for c in cases]),
+            "upper": np.array([figure(c["value"], "upper") for c in cases]),
+            "against": np.array([c["against"] for c in cases], dtype=str),
+        }
+        series = data["allowable_sigma"]
+        #: Per σ-series: ``series``, the allowable σ ``value`` with ``lower`` and ``upper``
+        #: (the conservative choice) [mm], and ``extrapolated``.
+        self.allowable_sigma: Dict[str, np.ndarray] = {
+            "series": np.array([a["series"] for a in series], dtype=str),
+            "value": np.array([figure(a["sigma"], "value") for a in series]),
+            "lower": np.array([figure(a["sigma"], "lower") for a in series]),
+            "upper": np.array([figure(a["sigma"], "upper") for a in series]),
+            "extrapolated": np.array([bool(a["extrapolated"]) for a in series], dtype=bool),
+        }
+        r = data["rayleigh"]
+        #: Cases whose Rayleigh law was tested.
+        self.tested: int = int(r["tested"])
+        #: The level α of each test.
+        self.level: float = float(r["level"])
+        #: Rejections expected by chance alone if the law held in every tested case (m·α).
+        self.expected_by_chance: float = float(r["expected_by_chance"])
+        #: The cases still rejected after Holm's adjustment across the tested cases.
+        self.holm_rejected: List[str] = list(r["holm_rejected"])
+        v = r["cases"]
+        #: Per tested case: ``case``, ``verdict`` (``"holds"``/``"rejected"``), ``p_value``
+        #: (the smaller of KS's and AD's), ``holm_p_value``, and the effect size
+        #: ``relative_difference`` ((Rayleigh − empirical)/empirical at the target
+        #: percentile) with ``relative_lower`` and ``relative_upper``.
+        self.rayleigh: Dict[str, np.ndarray] = {
+            "case": np.array([c["case"] for c in v], dtype=str),
+            "verdict": np.array([c["verdict"] for c in v], dtype=str),
+            "p_value": np.array([float(c["p_value"]) for c in v]),
+            "holm_p_value": np.array([float(c["holm_p_value"]) for c in v]),
+            "relative_difference": np.array([figure(c["relative_difference"], "value") for c in v]),
+            "relative_lower": np.array([figure(c["relative_difference"], "lower") for c in v]),
+            "relative_upper": np.array([figure(c["relative_difference"], "upper") for c in v]),
+        }
+        #: The answer lines ``mc-merge`` ends its console output with (for a summary
+        #: computed in-process; None for a report read from a file).
+        self.text = text
+
+    @property
+    def above(self) -> List[str]:
+        """The cases above the target, in job order."""
+        return [str(c) for c, a in zip(self.cases["case"], self.cases["against"]) if a == "above"]
+
+    @property
+    def within(self) -> List[str]:
+        """The cases at or below the target, in job order."""
+        return [str(c) for c, a in zip(self.cases["case"], self.cases["against"]) if a == "within"]
+
+    def __str__(self) -> str:
+        return self.text if self.text is not None else repr(self)
+
+    def __repr__(self) -> str:
+        return (
+            f"Answer(target {self.target_angle!r} rad at P{self.percentile:g}: "
+            f"{len(self.above)} above, {len(self.within)} within)"
+        )
+
+
+class Report:
+    """``report.json`` of ``mc-merge`` (documented in ``crates/mc-merge/README.md``), read
+    from a file (:func:`read_report`) or computed in-process by ``mc-merge``'s code
+    (:meth:`~truss_mc.results.Samples.summary`): ``data`` is the whole document;
+    ``percentiles``, ``cases``, ``rayleigh`` and ``allowable_sigma`` are its main tables as
+    arrays (angles in rad, σ in mm, NaN where the report has null), ``answer`` its answer."""
+
+    def __init__(
+        self, data: Dict[str, Any], text: Optional[str] = None, answer_text: Optional[str] = None
+    ) -> None:
         #: The parsed report.
         self.data = data
+        #: The report's JSON text, for one computed in-process (what ``mc-merge`` writes as
+        #: ``report.json``); None for one read from a file.
+        self.text = text
         #: The job id.
         self.job_id: str = data["job_id"]
         rows: Dict[str, List[Any]] = {
@@ -100,8 +198,8 @@ class Report:
             k: np.array(v, dtype=str if k == "case" else np.float64) for k, v in rows.items()
         }
 
-        def figure(x: Any) -> float:
-            return _number(x.get("value")) if isinstance(x, dict) else _number(x)
+        def figure(x: Any, key: str = "value") -> float:
+            return _number(x.get(key)) if isinstance(x, dict) else _number(x)
 
         cases = data["cases"]
         #: Per case: ``name``, ``n`` (samples used), ``failed``, ``sigma_t`` (pooled σ of the
@@ -120,6 +218,46 @@ class Report:
                 [_number(((c.get("gof") or {}).get("ad") or {}).get("p_value")) for c in cases]
             ),
         }
+        ray: Dict[str, List[Any]] = {
+            k: []
+            for k in ("case", "percentile", "value", "lower", "upper", "empirical", "relative_difference")
+        }
+        for case in cases:
+            for p in (case.get("rayleigh") or {}).get("percentiles", []):
+                ray["case"].append(case["name"])
+                ray["percentile"].append(float(p["percentile"]))
+                ray["value"].append(figure(p.get("value")))
+                ray["lower"].append(figure(p.get("value"), "lower"))
+                ray["upper"].append(figure(p.get("value"), "upper"))
+                ray["empirical"].append(_number(p.get("empirical")))
+                ray["relative_difference"].append(figure(p.get("relative_difference")))
+        #: Per case and percentile, the Rayleigh law's (eq. 28): ``case``, ``percentile``
+        #: (%), ``value`` with ``lower`` and ``upper`` [rad], the ``empirical`` percentile
+        #: [rad] and their ``relative_difference``.
+        self.rayleigh: Dict[str, np.ndarray] = {
+            k: np.array(v, dtype=str if k == "case" else np.float64) for k, v in ray.items()
+        }
+        series = (data.get("sweep") or {}).get("sigma_series", [])
+        #: Per σ-series: ``series``, the allowable σ through the origin (``value``, ``lower``,
+        #: ``upper``) and with intercept (``with_intercept``, …) [mm], and ``extrapolated``.
+        self.allowable_sigma: Dict[str, np.ndarray] = {
+            "series": np.array([s["name"] for s in series], dtype=str),
+            "value": np.array([figure(s["allowable_sigma"]["through_origin"]) for s in series]),
+            "lower": np.array([figure(s["allowable_sigma"]["through_origin"], "lower") for s in series]),
+            "upper": np.array([figure(s["allowable_sigma"]["through_origin"], "upper") for s in series]),
+            "with_intercept": np.array([figure(s["allowable_sigma"]["with_intercept"]) for s in series]),
+            "with_intercept_lower": np.array(
+                [figure(s["allowable_sigma"]["with_intercept"], "lower") for s in series]
+            ),
+            "with_intercept_upper": np.array(
+                [figure(s["allowable_sigma"]["with_intercept"], "upper") for s in series]
+            ),
+            "extrapolated": np.array([bool(s["allowable_sigma"]["extrapolated"]) for s in series], dtype=bool),
+        }
+        #: The answer (None for a report written before mc-merge wrote one).
+        self.answer: Optional[Answer] = (
+            Answer(data["answer"], answer_text) if "answer" in data else None
+        )
 
     def percentiles_frame(self) -> Any:
         """``percentiles`` as a pandas DataFrame (needs pandas)."""

@@ -117,7 +117,9 @@ pub fn format_p(p: f64, replicates: usize) -> String {
     } else if p < 0.01 {
         format!("p = {p:.4}")
     } else {
-        format!("p = {p:.2}")
+        // Three decimals, the resolution of 1000 null samples: 0.047 is not shown as 0.05,
+        // the level it is compared with.
+        format!("p = {p:.3}")
     }
 }
 
@@ -581,6 +583,8 @@ mod tests {
     #[test]
     fn p_value_floor_is_shown_as_bound() {
         assert_eq!(format_p(1.0 / 1001.0, 1000), "p ≤ 1.0e-3");
-        assert_eq!(format_p(0.41, 1000), "p = 0.41");
+        assert_eq!(format_p(0.41, 1000), "p = 0.410");
+        // Not rounded onto the level it is compared with.
+        assert_eq!(format_p(0.047, 1000), "p = 0.047");
     }
 }

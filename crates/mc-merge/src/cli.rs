@@ -100,7 +100,7 @@ pub struct Args {
     #[arg(long, default_value_t = 0.05, allow_negative_numbers = true)]
     pub gof_level: f64,
 
-    /// Target distortion angle in rad for the allowable σ (9.69e-5 rad = 20 arcsec).
+    /// Target distortion angle in rad for the allowable σ (9.69e-5 rad: the paper's 20 arcsec, rounded; 19.99 arcsec).
     #[arg(long, default_value_t = DEFAULT_TARGET_ANGLE, allow_negative_numbers = true)]
     pub target_angle: f64,
 
@@ -190,6 +190,7 @@ impl Args {
         Ok(Options {
             paths: self.paths,
             plots: !self.no_plots,
+            progress: !self.quiet,
             out: self.out,
             settings,
         })

@@ -125,6 +125,16 @@ pub enum MergeError {
         /// Digest of the second's.
         second_sha256: String,
     },
+    /// A sample given from memory ([`crate::load::Collector`]) does not belong: its index is
+    /// outside the job, it was given twice with different lines, or its converged θ_P is no
+    /// angle between the surfaces.
+    #[error("sample {index}: {message}")]
+    Sample {
+        /// Its global index.
+        index: u64,
+        /// What is wrong.
+        message: String,
+    },
     /// Some global indices are in no shard.
     #[error(
         "{present} of {expected} samples present; missing {}{}: give the missing shards, or --allow-partial to compute on what is there",
@@ -229,6 +239,7 @@ impl MergeError {
             | MergeError::HeaderMismatch { .. }
             | MergeError::OverlapDisagrees { .. }
             | MergeError::DuplicateDiffers { .. }
+            | MergeError::Sample { .. }
             | MergeError::Missing { .. } => VERIFICATION,
             MergeError::FailedSamples { .. } => FAILED_SAMPLES,
             MergeError::InTheWay { .. } => IN_THE_WAY,

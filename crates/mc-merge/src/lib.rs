@@ -65,7 +65,7 @@
 //!
 //! Cases whose parameters agree except `sigma` form a σ-series (≥ 2 distinct σ): the target
 //! percentile against σ, least-squares lines through the origin and with intercept with R², and
-//! the allowable σ for the target angle (default 9.69e-5 rad = 20 arcsec at the 95th percentile)
+//! the allowable σ for the target angle (default 9.69e-5 rad, the paper's 20 arcsec rounded: 19.99″, at the 95th percentile)
 //! with a bootstrap interval from refitting every replicate series. Likewise `stages`: the
 //! percentiles normalised to the smallest stage count (paper Fig. 9) with intervals, and the
 //! stage count where it peaks.
@@ -78,9 +78,11 @@
 //! results with their units, the plots linked or embedded), each written atomically and never through a link into a directory that holds no other
 //! job's report and that no other merge is writing; a rerun removes only the files it listed
 //! in its manifest ([`report_dir`]).
-//! Unless `--quiet`: a table on stdout (angles in rad and arcsec). With `--export FILE`: every
-//! sample as a flat row ([`export`]; for pandas, `read_json(…, lines=True,
-//! precise_float=True)`).
+//! Unless `--quiet`: on stderr, where the merge is (the shards verified, each case's
+//! statistics, the plots, the readable reports, with the seconds since it started), and a
+//! table on stdout (angles in rad and arcsec) that ends with the answer ([`answer`]). With
+//! `--export FILE`: every sample as a flat row ([`export`]; for pandas, `read_json(…,
+//! lines=True, precise_float=True)`).
 //!
 //! ### report.json
 //!
@@ -116,6 +118,11 @@
 //!                             replicates_used, caveats[]},
 //!             stages_series[] {name, fixed, reference_stages, points[] {case, stages, value,
 //!                             normalised, relative_interval}, peak_stages, caveats[]}}
+//! answer     {target_angle, percentile, cases[] {case, value, against},
+//!             allowable_sigma[] {series, sigma, extrapolated},
+//!             rayleigh {tested, level, expected_by_chance,
+//!                       cases[] {case, verdict, p_value, holm_p_value, relative_difference},
+//!                       holm_rejected}}                  (drawn from the above, [`answer`])
 //! ```
 //!
 //! A *figure* (`value`, `lower`, `upper`, optional `reason`) carries its interval; whatever
@@ -191,9 +198,41 @@ pub struct Merge {
     pub report: Report,
 }
 
+/// Where a merge is, for a progress display: the shards verified, then each case's
+/// statistics as they start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Progress<'a> {
+    /// The shards verified: `files` files holding `samples` samples.
+    Verified {
+        /// Shard files read.
+        files: usize,
+        /// Samples present.
+        samples: u64,
+    },
+    /// Case `index` (0-based) of `cases`, named `name`: its percentiles, bootstrap and
+    /// Rayleigh test start.
+    Case {
+        /// The case's position.
+        index: usize,
+        /// How many cases the job has.
+        cases: usize,
+        /// Its name.
+        name: &'a str,
+    },
+}
+
 /// Verifies the shards at `paths` and computes the report, writing nothing. The settings are
 /// checked first ([`Settings::validate`]).
 pub fn merge(paths: &[PathBuf], settings: &Settings) -> Result<Merge, MergeError> {
+    merge_with(paths, settings, &mut |_| {})
+}
+
+/// [`merge`], telling `progress` where it is.
+pub fn merge_with(
+    paths: &[PathBuf],
+    settings: &Settings,
+    progress: &mut dyn FnMut(Progress<'_>),
+) -> Result<Merge, MergeError> {
     let settings = &settings.validate()?;
     let files = load::shard_files(paths)?;
     let dataset = load::load(
@@ -204,23 +243,48 @@ pub fn merge(paths: &[PathBuf], settings: &Settings) -> Result<Merge, MergeError
             threads: settings.threads,
         },
     )?;
-    let report = build_report(&dataset, settings)?;
+    progress(Progress::Verified {
+        files: dataset.files.len(),
+        samples: dataset.present(),
+    });
+    let report = build_report_with(&dataset, settings, progress)?;
     Ok(Merge { dataset, report })
 }
 
 /// Computes the report of a verified dataset; the settings are checked first
 /// ([`Settings::validate`]).
 pub fn build_report(dataset: &Dataset, settings: &Settings) -> Result<Report, MergeError> {
+    build_report_with(dataset, settings, &mut |_| {})
+}
+
+/// [`build_report`], telling `progress` as each case starts.
+pub fn build_report_with(
+    dataset: &Dataset,
+    settings: &Settings,
+    progress: &mut dyn FnMut(Progress<'_>),
+) -> Result<Report, MergeError> {
     let settings = &settings.validate()?;
     let mut cache = CalibrationCache::default();
+    let cases = dataset.cases.len();
     let analyses: Vec<CaseAnalysis> = dataset
         .cases
         .iter()
-        .map(|c| analyse_case(c, settings, &mut cache))
+        .enumerate()
+        .map(|(index, c)| {
+            progress(Progress::Case {
+                index,
+                cases,
+                name: &c.info.name,
+            });
+            analyse_case(c, settings, &mut cache)
+        })
         .collect();
     let params: Vec<&BTreeMap<String, f64>> =
         dataset.cases.iter().map(|c| &c.info.parameters).collect();
     let sweep = sweep::sweep(&params, &analyses, settings);
+    let targets: Vec<report::Figure> = analyses.iter().map(|a| a.target.clone()).collect();
+    let cases: Vec<report::CaseReport> = analyses.into_iter().map(|a| a.report).collect();
+    let answer = answer::answer(&cases, &targets, &sweep, settings);
     let missing = dataset.missing();
     Ok(Report {
         format: report::REPORT_FORMAT,
@@ -242,8 +306,9 @@ pub fn build_report(dataset: &Dataset, settings: &Settings) -> Result<Report, Me
         },
         settings: settings.clone(),
         definitions: definitions::definitions(settings),
-        cases: analyses.into_iter().map(|a| a.report).collect(),
+        cases,
         sweep,
+        answer,
     })
 }
 
@@ -282,7 +347,25 @@ pub fn execute(args: Args, out: &mut dyn Write) -> Result<(), MergeError> {
 /// locked, another job's report directory is refused, every file written atomically and
 /// never through a link, only our own earlier files removed).
 pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError> {
-    let merge = merge(&options.paths, &options.settings)?;
+    // Progress on stderr: a large job's statistics and plots take some seconds each.
+    let started = std::time::Instant::now();
+    let say = |what: String| {
+        if options.progress {
+            eprintln!(
+                "mc-merge: {what} ({:.1} s)",
+                started.elapsed().as_secs_f64()
+            );
+        }
+    };
+    let merge = merge_with(&options.paths, &options.settings, &mut |p| match p {
+        Progress::Verified { files, samples } => {
+            say(format!("{samples} samples in {files} shard files verified"))
+        }
+        Progress::Case { index, cases, name } => say(format!(
+            "case {} of {cases} ({name}): percentiles, bootstrap, Rayleigh test",
+            index + 1
+        )),
+    })?;
     let json = report_json(&merge.report)?;
     let mut text = table::render(&merge.report, merge.dataset.files.len());
     if let Some(dir) = &options.out {
@@ -295,10 +378,12 @@ pub fn run(options: &Options, out: &mut dyn Write) -> Result<Report, MergeError>
         files.write(report_dir::REPORT_FILE, json.as_bytes())?;
         text.push('\n');
         let plots = if options.plots {
+            say(format!("drawing the plots into {}", dir.display()));
             plot::draw_all(&mut files, &merge.dataset.cases, &merge.report)?
         } else {
             vec![]
         };
+        say("writing report.md and report.html".to_string());
         let readable = readable::write(&mut files, &merge.report, &merge.dataset.writers, &plots)?;
         files.finish()?;
         // One line for the files (a report has dozens of plots), then the answer, then where

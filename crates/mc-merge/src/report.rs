@@ -170,6 +170,84 @@ pub struct Report {
     pub cases: Vec<CaseReport>,
     /// Series over σ and over the number of stages.
     pub sweep: SweepReport,
+    /// The answer drawn from the cases and the sweeps: what the console prints last and the
+    /// readable report shows first.
+    pub answer: AnswerReport,
+}
+
+/// The answer a merge is run for, drawn from the cases and the sweeps of the same report:
+/// nothing in it is estimated again, except the Holm adjustment of the Rayleigh verdicts'
+/// p-values across the cases.
+#[derive(Debug, Clone, Serialize)]
+pub struct AnswerReport {
+    /// The target angle (rad), as set.
+    pub target_angle: Real,
+    /// The percentile that must meet it, in percent.
+    pub percentile: Real,
+    /// Each case's θ_P at the target percentile against the target, in job order.
+    pub cases: Vec<CaseAgainstTarget>,
+    /// Each σ-series' allowable σ (the line through the origin, as the sweep's first).
+    pub allowable_sigma: Vec<AllowableAnswer>,
+    /// The Rayleigh law's verdicts over the cases, with what chance alone gives.
+    pub rayleigh: RayleighVerdicts,
+}
+
+/// A case's θ_P at the target percentile against the target.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaseAgainstTarget {
+    /// Case name.
+    pub case: String,
+    /// θ_P at the target percentile (rad) with its BCa interval (percentile interval where
+    /// BCa is null), as the sweeps use it.
+    pub value: Figure,
+    /// `"above"` the target, `"within"` it (at or below), or `"undefined"` where `value` is
+    /// null (its reason says why).
+    pub against: &'static str,
+}
+
+/// A σ-series' allowable σ in the answer.
+#[derive(Debug, Clone, Serialize)]
+pub struct AllowableAnswer {
+    /// The series' name.
+    pub series: String,
+    /// The allowable σ (mm) of the line through the origin, with its bootstrap interval
+    /// (whose lower end is the conservative choice).
+    pub sigma: Figure,
+    /// Whether the allowable σ lies outside the σ range of the series.
+    pub extrapolated: bool,
+}
+
+/// The Rayleigh law's verdicts over the cases.
+#[derive(Debug, Clone, Serialize)]
+pub struct RayleighVerdicts {
+    /// Cases whose Rayleigh law was tested.
+    pub tested: usize,
+    /// The significance level α of each case's test.
+    pub level: Real,
+    /// `tested × level`: the rejections expected by chance alone if the law held in every
+    /// tested case.
+    pub expected_by_chance: Real,
+    /// The tested cases, in job order.
+    pub cases: Vec<RayleighVerdict>,
+    /// The cases still rejected at `level` after Holm's adjustment across the tested cases
+    /// (which holds the chance of any false rejection among them at `level`).
+    pub holm_rejected: Vec<String>,
+}
+
+/// One case's Rayleigh verdict with its multiplicity context and effect size.
+#[derive(Debug, Clone, Serialize)]
+pub struct RayleighVerdict {
+    /// Case name.
+    pub case: String,
+    /// `"holds"` or `"rejected"` at `level`, as the case's `gof.verdict`.
+    pub verdict: &'static str,
+    /// The p-value the verdict compares with the level: the smaller of KS's and AD's.
+    pub p_value: Real,
+    /// That p-value adjusted by Holm's step-down method across the tested cases.
+    pub holm_p_value: Real,
+    /// (Rayleigh − empirical)/empirical at the target percentile, with its bootstrap
+    /// interval: how much the law's verdict matters for the answer.
+    pub relative_difference: Figure,
 }
 
 /// Coverage of the global index range.

@@ -57,6 +57,14 @@ pub struct Settings {
     pub threads: usize,
 }
 
+impl Settings {
+    /// The target angle as it was set (`--target-angle`, in rad); its `Display` is the one
+    /// spelling of the target in the console, the reports and the plots.
+    pub fn target(&self) -> truss_units::TargetAngle {
+        truss_units::TargetAngle::Rad(self.target_angle)
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         Self {
@@ -84,6 +92,9 @@ pub struct Options {
     pub out: Option<PathBuf>,
     /// Whether to draw plots (only with `out`).
     pub plots: bool,
+    /// Whether [`crate::run`] says on stderr where it is (the shards verified, each case,
+    /// the plots, the readable reports).
+    pub progress: bool,
     /// The statistics.
     pub settings: Settings,
 }
@@ -128,7 +139,7 @@ impl Settings {
         }
         if !(self.target_angle > 0.0 && self.target_angle < MAX_TARGET_ANGLE) {
             return Err(usage(format!(
-                "--target-angle {}: must be a positive angle in rad below π/2 (e.g. 9.69e-5 for 20 arcsec)",
+                "--target-angle {}: must be a positive angle in rad below π/2 (e.g. 9.69e-5, the paper's 20 arcsec rounded)",
                 self.target_angle
             )));
         }

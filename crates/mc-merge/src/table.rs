@@ -9,17 +9,17 @@ fn rad(x: f64) -> String {
     format!("{x:.3e}")
 }
 
-/// `9.690e-5 (19.99") [19.82, 20.16]`: rad, then arcsec with the interval in arcsec.
+/// `9.690e-5 (19.99″) [19.82, 20.16]`: rad, then arcsec with the interval in arcsec.
 fn angle(f: &Figure) -> String {
     match (f.get(), f.interval()) {
         (Some(v), Some((lo, hi))) => format!(
-            "{} ({:.2}\") [{:.2}, {:.2}]",
+            "{} ({:.2}″) [{:.2}, {:.2}]",
             rad(v),
             v * ARCSEC_PER_RAD,
             lo * ARCSEC_PER_RAD,
             hi * ARCSEC_PER_RAD
         ),
-        (Some(v), None) => format!("{} ({:.2}\") [no interval]", rad(v), v * ARCSEC_PER_RAD),
+        (Some(v), None) => format!("{} ({:.2}″) [no interval]", rad(v), v * ARCSEC_PER_RAD),
         _ => format!("- ({})", f.reason.as_deref().unwrap_or("undefined")),
     }
 }
@@ -192,10 +192,9 @@ pub fn render(report: &Report, files: usize) -> String {
         let a = &ser.allowable_sigma;
         let _ = writeln!(
             s,
-            "  allowable σ for θ_P{} ≤ {:.3e} rad ({:.2}\"): {} mm (through origin), {} mm (with intercept){}",
-            a.percentile.0,
-            a.target_angle.0,
-            a.target_arcsec.0,
+            "  allowable σ for θ_P{} ≤ {}: {} mm (through origin), {} mm (with intercept){}",
+            short(a.percentile.0),
+            report.settings.target(),
             plain(&a.through_origin, 3),
             plain(&a.with_intercept, 3),
             if a.extrapolated {
@@ -237,55 +236,56 @@ pub fn render(report: &Report, files: usize) -> String {
     s
 }
 
-/// The answer ([`crate::answer::Answer`]), printed last: each case's θ_P at the target
+/// The answer ([`crate::report::AnswerReport`]), printed last: each case's θ_P at the target
 /// percentile against the target angle (above it, or at or below it), each σ-series'
-/// allowable σ with its interval and its conservative end, and how many Rayleigh-law
-/// rejections chance alone would give.
+/// allowable σ with its interval and its conservative end, and the Rayleigh-law rejections
+/// with their p-values and effect sizes, against what chance alone gives and after Holm's
+/// adjustment across the cases.
 pub fn answer(report: &Report) -> String {
-    let a = crate::answer::Answer::of(report);
+    let a = &report.answer;
+    let pct = short(a.percentile.0);
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "\nanswer: θ_P{} against the target {} rad ({:.2}\"):",
-        short(a.percentile),
-        rad(a.target),
-        a.target * ARCSEC_PER_RAD
+        "\nanswer: θ_P{pct} against the target {}:",
+        report.settings.target()
     );
-    let list = |v: &[crate::answer::Placed]| {
+    let list = |v: Vec<&crate::report::CaseAgainstTarget>| {
         if v.is_empty() {
             "none".to_string()
         } else {
             v.iter()
-                .map(|p| format!("{} ({:.2}\")", p.name, p.theta * ARCSEC_PER_RAD))
+                .map(|c| {
+                    let t = c.value.get().unwrap_or(f64::NAN);
+                    format!("{} ({:.2}″)", c.case, t * ARCSEC_PER_RAD)
+                })
                 .collect::<Vec<_>>()
                 .join(", ")
         }
     };
-    let _ = writeln!(s, "  above the target: {}", list(&a.above));
-    let _ = writeln!(s, "  at or below it: {}", list(&a.within));
-    if !a.undefined.is_empty() {
-        let _ = writeln!(
-            s,
-            "  no θ_P{}: {}",
-            short(a.percentile),
-            a.undefined.join(", ")
-        );
+    let _ = writeln!(s, "  above the target: {}", list(a.above().collect()));
+    let _ = writeln!(s, "  at or below it: {}", list(a.within().collect()));
+    let undefined: Vec<&str> = a.undefined().collect();
+    if !undefined.is_empty() {
+        let _ = writeln!(s, "  no θ_P{pct}: {}", undefined.join(", "));
     }
-    for (name, sigma) in &a.allowable {
+    for sigma in &a.allowable_sigma {
         let conservative = sigma
-            .through_origin
+            .sigma
             .interval()
             .map(|(lo, _)| {
                 format!(
-                    "; conservative σ ≤ {lo:.3e} mm (lower {:.0} % bound)",
+                    "; conservative σ ≤ {:.3e} mm (lower {:.0} % bound)",
+                    lo,
                     report.settings.confidence * 100.0
                 )
             })
             .unwrap_or_default();
         let _ = writeln!(
             s,
-            "  allowable σ [{name}]: {} mm{conservative}{}",
-            plain(&sigma.through_origin, 3),
+            "  allowable σ [{}]: {} mm{conservative}{}",
+            sigma.series,
+            plain(&sigma.sigma, 3),
             if sigma.extrapolated {
                 " [extrapolated beyond the σ range]"
             } else {
@@ -293,18 +293,59 @@ pub fn answer(report: &Report) -> String {
             }
         );
     }
-    if let (Some(level), Some(chance)) = (a.level, a.expected_by_chance()) {
+    let r = &a.rayleigh;
+    if r.tested > 0 {
+        let rejected: Vec<String> = r
+            .rejected()
+            .map(|v| {
+                format!(
+                    "{} (p = {:.3}; Rayleigh θ_P{pct} against the empirical: {})",
+                    v.case,
+                    v.p_value.0,
+                    relative(&v.relative_difference)
+                )
+            })
+            .collect();
         let _ = writeln!(
             s,
-            "  Rayleigh law rejected in {} of {} cases at α = {level}{} ({chance:.1} expected by chance alone if it held in all)",
-            a.rejected.len(),
-            a.tested,
-            if a.rejected.is_empty() {
+            "  Rayleigh law rejected in {} of {} cases at α = {} ({:.1} expected by chance alone if it held in all){}",
+            rejected.len(),
+            r.tested,
+            short(r.level.0),
+            r.expected_by_chance.0,
+            if rejected.is_empty() {
                 String::new()
             } else {
-                format!(": {}", a.rejected.join(", "))
+                format!(": {}", rejected.join(", "))
             },
+        );
+        let _ = writeln!(
+            s,
+            "  after Holm's adjustment across the {} cases: {}",
+            r.tested,
+            if r.holm_rejected.is_empty() {
+                format!(
+                    "none rejected (smallest adjusted p = {:.3})",
+                    r.smallest_holm_p().unwrap_or(1.0)
+                )
+            } else {
+                format!("rejected in {}", r.holm_rejected.join(", "))
+            }
         );
     }
     s
+}
+
+/// A relative difference with its interval, in percent: `−0.3 % [−1.2, +0.6] %`.
+fn relative(f: &Figure) -> String {
+    match (f.get(), f.interval()) {
+        (Some(v), Some((lo, hi))) => format!(
+            "{:+.1} % [{:+.1}, {:+.1}] %",
+            v * 100.0,
+            lo * 100.0,
+            hi * 100.0
+        ),
+        (Some(v), None) => format!("{:+.1} %", v * 100.0),
+        _ => "no effect size".to_string(),
+    }
 }

@@ -15,9 +15,18 @@ pub struct ToleranceArgs {
     /// The case whose groups' tolerances are allocated (its σ values are the starting point).
     #[arg(long)]
     pub case: String,
-    /// The budget: θ_P at the percentile must not exceed this angle (arcsec).
+    /// The budget: θ_P at the percentile must not exceed this angle (rad; mc-merge's
+    /// `--target-angle`, so that both answer for the same target, e.g. 9.69e-5).
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        required_unless_present = "target_arcsec",
+        conflicts_with = "target_arcsec"
+    )]
+    pub target_angle: Option<f64>,
+    /// The budget in arcsec instead (20 is 9.6963e-5 rad).
     #[arg(long, allow_negative_numbers = true)]
-    pub target_arcsec: f64,
+    pub target_arcsec: Option<f64>,
     /// The percentile of θ_P the budget applies to (%).
     #[arg(long, default_value_t = 95.0, allow_negative_numbers = true)]
     pub percentile: f64,
@@ -61,7 +70,11 @@ pub fn run(args: &ToleranceArgs, out: &mut dyn Write) -> Result<(), CliError> {
         ..truss_tolerance::Options::new(
             args.job.clone(),
             &args.case,
-            args.target_arcsec,
+            match (args.target_angle, args.target_arcsec) {
+                (Some(rad), _) => truss_tolerance::TargetAngle::Rad(rad),
+                (None, Some(arcsec)) => truss_tolerance::TargetAngle::Arcsec(arcsec),
+                (None, None) => unreachable!("clap requires one of the two"),
+            },
             args.out.clone(),
         )
     };
@@ -81,13 +94,13 @@ pub fn run(args: &ToleranceArgs, out: &mut dyn Write) -> Result<(), CliError> {
     }
     writeln!(
         out,
-        "theta_p{}: {:.4e} rad [{:.4e}, {:.4e}] over {} samples, target {:.4e} rad\nuniform_sigma: {:.4e} mm\ncost_ratio: {:.4}",
+        "theta_p{}: {:.4e} rad [{:.4e}, {:.4e}] over {} samples, target {}\nuniform_sigma: {:.4e} mm\ncost_ratio: {:.4}",
         t.percentile,
         last.theta,
         last.interval.0,
         last.interval.1,
         last.samples,
-        t.target_rad,
+        t.target_set,
         t.uniform_sigma,
         t.cost_ratio()
     )?;

@@ -272,6 +272,7 @@ async fn run_and_merge(
         paths: vec![options.out.clone()],
         out: Some(options.out.join("report")),
         plots: true,
+        progress: !options.quiet,
         settings: mc_merge::Settings {
             allow_failed: options.allow_failed,
             ..mc_merge::Settings::default()
@@ -320,6 +321,57 @@ pub fn die_with_parent() {
     let _ = parent;
 }
 
+/// Which shards a rerun reuses, by their number `I` of `--shard I/K`: those complete (skipped:
+/// their files are verified, not rerun) and those resumed where they stopped, with the lines
+/// they keep; `counted` holds each shard file's (offset, sample lines).
+fn reused(ranges: &[ShardRange], counted: &[(u64, u64)]) -> String {
+    let k = ranges.len();
+    let complete: Vec<usize> = (0..k)
+        .filter(|&i| counted[i].1 == ranges[i].len())
+        .collect();
+    let resumed: Vec<String> = (0..k)
+        .filter(|&i| counted[i].1 > 0 && counted[i].1 < ranges[i].len())
+        .map(|i| format!("{i} ({} of {})", counted[i].1, ranges[i].len()))
+        .collect();
+    let complete = match complete.len() {
+        0 => format!("no shard of {k} complete"),
+        n if n == k => format!("all {k} shards complete (verified, not rerun)"),
+        n => format!(
+            "{n} of {k} shards complete (verified, not rerun): {}",
+            index_runs(&complete)
+        ),
+    };
+    if resumed.is_empty() {
+        complete
+    } else {
+        format!(
+            "{complete}; resumed where they stopped: {}",
+            resumed.join(", ")
+        )
+    }
+}
+
+/// Ascending indices as runs: `0-3, 5, 7-8`.
+fn index_runs(indices: &[usize]) -> String {
+    let mut runs: Vec<(usize, usize)> = vec![];
+    for &i in indices {
+        match runs.last_mut() {
+            Some((_, end)) if *end + 1 == i => *end = i,
+            _ => runs.push((i, i)),
+        }
+    }
+    runs.iter()
+        .map(|&(a, b)| {
+            if a == b {
+                a.to_string()
+            } else {
+                format!("{a}-{b}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// How long a child may take to stop after SIGTERM before it is killed.
 pub const GRACE: Duration = Duration::from_secs(10);
 
@@ -342,15 +394,10 @@ async fn run_children(
         kept += count_new_lines(&options.out.join(r.file_name()), offset, lines, r.len());
     }
     if kept > 0 && !options.quiet {
-        let complete = ranges
-            .iter()
-            .zip(&counted)
-            .filter(|(r, (_, lines))| *lines == r.len())
-            .count();
-        let resumed = counted.iter().filter(|(_, lines)| *lines > 0).count() - complete;
         eprintln!(
-            "run-all: reusing {kept} samples already in {}: {complete} of {k} shards complete, {resumed} resumed where they stopped",
-            options.out.display()
+            "run-all: reusing {kept} samples already in {}: {}",
+            options.out.display(),
+            reused(ranges, &counted)
         );
     }
     let limit = Arc::new(tokio::sync::Semaphore::new(options.workers.max(1)));

@@ -66,6 +66,10 @@ fn run_all_runs_every_shard_then_merges() {
     };
     let r = run_all(&["--quiet"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(
+        !String::from_utf8_lossy(&r.stderr).contains("mc-merge: "),
+        "--quiet: no progress"
+    );
     let stdout = String::from_utf8_lossy(&r.stdout);
     assert!(
         stdout.contains("run-all: 120 samples in 5 shards on 3 workers"),
@@ -85,11 +89,16 @@ fn run_all_runs_every_shard_then_merges() {
     let stderr = String::from_utf8_lossy(&again.stderr);
     for said in [
         format!(
-            "run-all: reusing 120 samples already in {}: 5 of 5 shards complete, 0 resumed",
+            "run-all: reusing 120 samples already in {}: all 5 shards complete (verified, not rerun)",
             all.display()
         ),
         "run-all: auditing: re-solving".to_string(),
         "run-all: merging: verifying every shard".to_string(),
+        // The merge's own progress, stage by stage.
+        "mc-merge: 120 samples in 5 shard files verified (".to_string(),
+        "mc-merge: case 2 of 2 (uniform): percentiles, bootstrap, Rayleigh test (".to_string(),
+        "mc-merge: drawing the plots into ".to_string(),
+        "mc-merge: writing report.md and report.html (".to_string(),
     ] {
         assert!(stderr.contains(&said), "{said:?} not in {stderr}");
     }
@@ -99,6 +108,22 @@ fn run_all_runs_every_shard_then_merges() {
         Some(format!("report: {}", all.join("report/report.html").display()).as_str()),
         "{stdout}"
     );
+    // With shard 1's file gone, the rerun names the shards it reuses, and runs shard 1 again.
+    let mut files: Vec<_> = std::fs::read_dir(&all)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "jsonl"))
+        .collect();
+    files.sort();
+    std::fs::remove_file(&files[1]).unwrap();
+    let third = run_all(&[]);
+    assert!(third.status.success());
+    let stderr = String::from_utf8_lossy(&third.stderr);
+    assert!(
+        stderr.contains("shards complete (verified, not rerun): 0, 2-4\n"),
+        "{stderr}"
+    );
+    assert_eq!(sample_lines(&all), sample_lines(&single));
 }
 
 /// Exit codes of `run-all`: an invalid job is refused with mc-shard's code 3 before anything

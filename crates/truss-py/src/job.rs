@@ -10,6 +10,7 @@
 use crate::columns::{Table, bytes, f64_bytes};
 use crate::errors::Failure;
 use crate::model::PyModel;
+use crate::summary::Collecting;
 use mc_shard::inputs::{Draws, InputTable};
 use mc_shard::select;
 use pyo3::exceptions::PyRuntimeError;
@@ -50,6 +51,19 @@ fn selection(
             (Some(c), ShardRange::new(start, r.end.clamp(start, to)))
         }
     })
+}
+
+/// The job's cases as a shard's begin line lists them.
+fn case_infos(job: &Job) -> Vec<shard_record::CaseInfo> {
+    job.cases
+        .iter()
+        .map(|c| shard_record::CaseInfo {
+            name: c.name.clone(),
+            start: c.start,
+            samples: c.samples,
+            parameters: c.parameters.clone(),
+        })
+        .collect()
 }
 
 /// The inputs of `table`'s width per row, absent cells NaN, as a dict for Python.
@@ -129,13 +143,7 @@ impl PyJob {
     /// `parameters` (as the shard header writes them).
     #[getter]
     fn cases<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let info = self.job.cases.iter().map(|c| shard_record::CaseInfo {
-            name: c.name.clone(),
-            start: c.start,
-            samples: c.samples,
-            parameters: c.parameters.clone(),
-        });
-        crate::columns::cases(py, info)
+        crate::columns::cases(py, case_infos(&self.job).into_iter())
     }
 
     /// The model of case `case`.
@@ -164,16 +172,26 @@ impl PyJob {
         let threads = mc_shard::cli::check_threads("threads", truss_threads::or_available(threads))
             .map_err(Failure::from)?;
         let table = inputs.then(|| InputTable::new(&job, c, range));
-        let (samples, values) = py.detach(|| {
+        let selection = c.is_some() || range != ShardRange::new(0, job.samples());
+        let (samples, values, collected) = py.detach(|| {
             let mut samples = Table::new();
             let mut values = Vec::new();
-            type Row = (Vec<u8>, Option<Vec<f64>>);
+            // The samples as the merge keeps them, for its statistics (`Samples.summary`).
+            let mut collected = Collecting::new(
+                &job.id,
+                job.samples(),
+                &case_infos(&job),
+                "truss_mc",
+                env!("CARGO_PKG_VERSION"),
+            );
+            type Row = (shard_record::Sample, Vec<u8>, Option<Vec<f64>>);
             let each = |chunk: &mut Vec<Row>, _: &SampleSolver<'_>, result: SampleResult| {
                 // The shard line's bytes, read back into columns on the calling thread: a
                 // worker allocates little that another thread frees (the allocator's
                 // arenas would be contended).
                 let mut line = Vec::with_capacity(256);
-                mc_shard::worker::record(&job, &result).write_line(&mut line);
+                let sample = mc_shard::worker::record(&job, &result);
+                sample.write_line(&mut line);
                 let row = table.as_ref().map(|t| {
                     let mut v = Vec::with_capacity(t.width());
                     let mut row = vec![None; t.width()];
@@ -187,12 +205,12 @@ impl PyJob {
                     );
                     v
                 });
-                chunk.push((line, row));
+                chunk.push((sample, line, row));
             };
             let engine = Engine::new(&job, threads);
             engine.run(range.start..range.end, each, |chunk| match chunk {
                 Some(chunk) => {
-                    for (line, row) in chunk {
+                    for (sample, line, row) in chunk {
                         let record: serde_json::Map<String, serde_json::Value> =
                             serde_json::from_slice(&line).map_err(|e| {
                                 PyRuntimeError::new_err(format!(
@@ -200,16 +218,18 @@ impl PyJob {
                                 ))
                             })?;
                         samples.push(&record);
+                        collected.add(&sample, &line)?;
                         values.extend(row.unwrap_or_default());
                     }
                     Ok(())
                 }
                 None => Python::attach(|py| py.check_signals()),
             })?;
-            Ok::<_, PyErr>((samples, values))
+            Ok::<_, PyErr>((samples, values, collected.finish(selection)?))
         })?;
         let out = PyDict::new(py);
         out.set_item("columns", samples.to_python(py)?)?;
+        out.set_item("collected", Py::new(py, collected)?)?;
         match &table {
             Some(t) => out.set_item("inputs", inputs_dict(py, t, &values)?)?,
             None => out.set_item("inputs", py.None())?,

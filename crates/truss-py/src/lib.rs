@@ -13,6 +13,7 @@
 //! | `Job.from_file`, `job.run(case=…, range=…, threads=…, inputs=True)` | `truss_job::Job`, `truss_job::engine::Engine` writing the runner's records (`mc_shard::worker::record`), `mc_shard::inputs::InputTable` (as `mc-shard run` and `mc-shard inputs`) |
 //! | `job.reproduce(case, sample, detail=…)` | `mc_shard::reproduce::reproduce` (as `mc-shard reproduce`) |
 //! | `read_shards(paths)` | `shard_record::read_shard` (as the merge verifies) |
+//! | `samples.summary(…)` (of a run or of shards read back) | `mc_merge::load::Collector`, `mc_merge::build_report`, `mc_merge::table::answer` (as `mc-merge` computes `report.json` and its answer lines) |
 //!
 //! Errors become the exceptions of `truss_mc.errors` with the tools' messages and exit
 //! codes ([`errors`]); no path through this crate panics on a user's input. Solving and
@@ -23,6 +24,7 @@ pub mod errors;
 pub mod job;
 pub mod model;
 pub mod shards;
+pub mod summary;
 
 use pyo3::prelude::*;
 
@@ -31,6 +33,7 @@ use pyo3::prelude::*;
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<model::PyModel>()?;
     m.add_class::<job::PyJob>()?;
+    m.add_class::<summary::PyCollected>()?;
     m.add_function(wrap_pyfunction!(shards::read_shard_files, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("NUMERICS_VERSION", truss_job::NUMERICS_VERSION)?;

@@ -9,6 +9,7 @@
 
 use crate::columns::Table;
 use crate::errors::{Failure, Kind};
+use crate::summary::Collecting;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use shard_record::{
@@ -36,10 +37,12 @@ fn fingerprint(line: &[u8]) -> u64 {
     h.finish()
 }
 
-/// What the files hold: the first file's header and the samples as columns.
+/// What the files hold: the first file's header, the samples as columns, and as the merge
+/// keeps them (for its statistics).
 struct Read {
     begin: Begin,
     table: Table,
+    collected: crate::summary::PyCollected,
 }
 
 /// Reads `files` (see the module doc).
@@ -61,10 +64,23 @@ fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
         .collect();
     order.sort();
     let mut table = Table::new();
+    // The samples as the merge keeps them, once the first header names the job.
+    let mut collecting: Option<Collecting> = None;
     // (index, fingerprint, file) of every sample taken, in index order.
     let mut taken: Vec<(u64, u64, usize)> = Vec::new();
     let mut first: Option<(Begin, &PathBuf)> = None;
     for (n, (_, path)) in order.iter().enumerate() {
+        if collecting.is_none()
+            && let Some(b) = header(path)
+        {
+            collecting = Some(Collecting::new(
+                &b.job_id,
+                b.job_samples,
+                &b.cases,
+                &b.program,
+                &b.program_version,
+            ));
+        }
         let visit = |_line_number: u64, sample: &shard_record::Sample, line: &[u8]| {
             sample.check_angles()?;
             let index = sample.index;
@@ -84,6 +100,9 @@ fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
             let record: serde_json::Map<String, serde_json::Value> =
                 serde_json::from_slice(line).map_err(|e| format!("not a JSON object: {e}"))?;
             table.push(&record);
+            if let Some(c) = collecting.as_mut() {
+                c.add(sample, line).map_err(|f| f.message)?;
+            }
             taken.push((index, fp, n));
             Ok(())
         };
@@ -121,7 +140,21 @@ fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
         }
     }
     let (begin, _) = first.expect("at least one file was read");
-    Ok(Read { begin, table })
+    let collecting = collecting.ok_or_else(|| {
+        Failure::new(
+            Kind::Verification,
+            "no readable begin line in the shard files",
+        )
+    })?;
+    // Incomplete files read on purpose are a selection of the job: their statistics allow
+    // the rest to be missing (otherwise missing samples are refused, as the merge refuses
+    // them, unless asked).
+    let selection = partial;
+    Ok(Read {
+        begin,
+        table,
+        collected: collecting.finish(selection)?,
+    })
 }
 
 /// Reads shard files (see the module doc): returns `job_id`, `job_samples`, `cases` (as the
@@ -142,6 +175,7 @@ pub fn read_shard_files<'py>(
         crate::columns::cases(py, read.begin.cases.into_iter())?,
     )?;
     out.set_item("columns", read.table.to_python(py)?)?;
+    out.set_item("collected", Py::new(py, read.collected)?)?;
     Ok(out)
 }
 

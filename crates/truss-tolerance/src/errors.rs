@@ -77,7 +77,7 @@ pub enum ToleranceError {
     /// The fixed groups alone already use up the budget.
     #[error(
         "target unreachable: the fixed groups ({groups}) alone give θ_P{percentile} ≈ \
-         {theta_fixed:.3e} rad ({arcsec:.2}\"), at or above the target {target:.3e} rad"
+         {theta_fixed:.3e} rad ({arcsec:.2}″), at or above the target {target}"
     )]
     Unreachable {
         /// The fixed groups, comma-separated.
@@ -88,8 +88,8 @@ pub enum ToleranceError {
         theta_fixed: f64,
         /// Its value in arcseconds.
         arcsec: f64,
-        /// The target \[rad\].
-        target: f64,
+        /// The target, as it was set.
+        target: truss_units::TargetAngle,
     },
     /// Some samples did not solve; none are dropped silently.
     #[error(
@@ -113,7 +113,7 @@ pub enum ToleranceError {
     /// The allocation did not verify (the files were written; the report says how far off).
     #[error(
         "verification failed: θ_P{percentile} = {theta:.4e} rad, 95 % interval [{lower:.4e}, \
-         {upper:.4e}], target {target:.4e} rad (must have upper ≤ target and estimate ≥ 0.9 × target)"
+         {upper:.4e}], target {target} (must have upper ≤ target and estimate ≥ 0.9 × target)"
     )]
     Verification {
         /// The percentile (in %).
@@ -124,8 +124,8 @@ pub enum ToleranceError {
         lower: f64,
         /// The interval's upper end \[rad\].
         upper: f64,
-        /// The target \[rad\].
-        target: f64,
+        /// The target, as it was set.
+        target: truss_units::TargetAngle,
     },
     /// A file could not be written.
     #[error("{}: cannot write: {source}", path.display())]

@@ -1,7 +1,7 @@
 //! # truss-tolerance: which members matter, and what tolerance each group should get
 //!
-//! `truss tolerance --job JOB --case CASE --target-arcsec 20 [--percentile 95]
-//! [--cost GROUP=W …] [--fix GROUP=SIGMA …] --out DIR` answers three questions about a job's
+//! `truss tolerance --job JOB --case CASE --target-angle 9.69e-5|--target-arcsec 20
+//! [--percentile 95] [--cost GROUP=W …] [--fix GROUP=SIGMA …] --out DIR` answers three questions about a job's
 //! case whose member groups have zero-mean length errors (σ in mm):
 //!
 //! 1. **Sensitivity** ([`sensitivity`]): each member's and each group's share of the variance
@@ -95,6 +95,6 @@ pub mod study;
 pub mod verify;
 
 pub use errors::ToleranceError;
-pub use options::Options;
+pub use options::{Options, TargetAngle};
 pub use outcome::{GroupResult, Tolerance};
 pub use study::run;

@@ -4,6 +4,7 @@
 
 use crate::errors::ToleranceError;
 use std::path::PathBuf;
+pub use truss_units::TargetAngle;
 
 /// What to study.
 #[derive(Debug, Clone)]
@@ -12,8 +13,8 @@ pub struct Options {
     pub job: PathBuf,
     /// The case's name.
     pub case: String,
-    /// The target θ* \[arcsec\].
-    pub target_arcsec: f64,
+    /// The target θ*, as it was set (in rad or in arcsec).
+    pub target: TargetAngle,
     /// The percentile, in % (0 < p < 100).
     pub percentile: f64,
     /// `GROUP=WEIGHT` cost weights.
@@ -36,11 +37,11 @@ pub struct Options {
 
 impl Options {
     /// Default options for a job, case, target and output directory.
-    pub fn new(job: PathBuf, case: &str, target_arcsec: f64, out: PathBuf) -> Self {
+    pub fn new(job: PathBuf, case: &str, target: TargetAngle, out: PathBuf) -> Self {
         Self {
             job,
             case: case.to_string(),
-            target_arcsec,
+            target,
             percentile: 95.0,
             costs: Vec::new(),
             fixes: Vec::new(),
@@ -56,21 +57,22 @@ impl Options {
 
 impl Options {
     /// Refuses values outside their documented ranges, naming the flag: the target in
-    /// (0, 324000) arcsec, the percentile in (0, 100) %, at least 1000 verification samples.
+    /// (0, 324000) arcsec (below π/2 rad), the percentile in (0, 100) %, at least 1000 verification samples.
     /// (The sensitivity run's least sample count depends on the model, so
     /// [`crate::run`] checks it once the members are known.)
     pub fn check(&self) -> Result<(), ToleranceError> {
-        if !(self.target_arcsec.is_finite()
-            && self.target_arcsec > 0.0
-            && self.target_arcsec < 324_000.0)
-        {
-            return Err(bad(
-                "--target-arcsec",
-                format!(
-                    "{} is not an angle in (0, 324000) arcsec",
-                    self.target_arcsec
+        let arcsec = self.target.arcsec();
+        if !(arcsec.is_finite() && arcsec > 0.0 && arcsec < 324_000.0) {
+            return Err(match self.target {
+                TargetAngle::Arcsec(a) => bad(
+                    "--target-arcsec",
+                    format!("{a} is not an angle in (0, 324000) arcsec"),
                 ),
-            ));
+                TargetAngle::Rad(r) => bad(
+                    "--target-angle",
+                    format!("{r} is not an angle in (0, π/2) rad"),
+                ),
+            });
         }
         if !(self.percentile.is_finite() && self.percentile > 0.0 && self.percentile < 100.0) {
             return Err(bad(

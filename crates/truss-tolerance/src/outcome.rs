@@ -39,6 +39,8 @@ pub struct Tolerance {
     pub job_id: String,
     /// θ* \[rad\].
     pub target_rad: f64,
+    /// The target as it was set (its `Display` is the target's one spelling).
+    pub target_set: truss_units::TargetAngle,
     /// The percentile in %.
     pub percentile: f64,
     /// Per group.

@@ -130,9 +130,8 @@ pub fn markdown(t: &Tolerance) -> String {
     let _ = writeln!(s, "# Tolerance allocation: case `{}`\n", t.case);
     let _ = writeln!(
         s,
-        "Target: θ_P{q} ≤ {:.4e} rad ({:.2}\"). Job `{}`. Units: σ in mm, angles in rad.\n",
-        t.target_rad,
-        arcsec(t.target_rad),
+        "Target: θ_P{q} ≤ {}. Job `{}`. Units: σ in mm, angles in rad.\n",
+        t.target_set,
         &t.job_id[..12.min(t.job_id.len())]
     );
     let _ = writeln!(

@@ -69,7 +69,6 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
     let study = Study::read(&o.job, &o.case, &o.costs, &o.fixes)?;
     let mut result = analyse(o, &study)?;
     let last = result.verified_run().1;
-    let target = result.target_rad;
     let mut out = run_dir::OutputDir::open(&o.out, WRITER)?;
     out.check_names(&outputs)?;
     result.files = report::write_all(&study, &result, &mut out, o.plots)?;
@@ -80,7 +79,7 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
             theta: last.theta,
             lower: last.interval.0,
             upper: last.interval.1,
-            target,
+            target: o.target,
         });
     }
     Ok(result)
@@ -91,7 +90,7 @@ pub fn run(options: &Options) -> Result<Tolerance, ToleranceError> {
 /// allocation; 3. verification with the homogeneity rescale; 4. the uniform σ the same way.
 fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
     let job_id = truss_job::Job::new(&study.spec, &study.base)?.id;
-    let target = o.target_arcsec / ARCSEC_PER_RAD;
+    let target = o.target.rad();
     let q = o.percentile / 100.0;
     let threads = truss_threads::or_available(o.threads).max(1);
     let seed = study.spec.seed;
@@ -187,7 +186,7 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
             percentile: o.percentile,
             theta_fixed,
             arcsec: theta_fixed * ARCSEC_PER_RAD,
-            target,
+            target: o.target,
         }
     };
     let allocate_for = |model_target: f64| {
@@ -249,6 +248,7 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
         case: o.case.clone(),
         job_id,
         target_rad: target,
+        target_set: o.target,
         percentile: o.percentile,
         groups,
         members,

@@ -16,6 +16,13 @@
 //!
 //! A value in the stored unit times the factor is the value in the shown unit:
 //! `theta * ARCSEC_PER_RAD` is θ in arcseconds, `arcsec / ARCSEC_PER_RAD` the angle in rad.
+//!
+//! A pointing target is written one way everywhere ([`TargetAngle`]'s `Display`): the value
+//! as the user gave it, in the unit they gave it in, then the other unit, so that the console,
+//! the reports and the plots of every tool name the same target, and a target given as
+//! `9.69e-5` rad is never shown as if it were 20 arcsec (it is 19.99).
+
+use std::fmt;
 
 /// Arcseconds in a radian: 180·3600/π = 648000/π.
 pub const ARCSEC_PER_RAD: f64 = 648_000.0 / std::f64::consts::PI;
@@ -29,9 +36,59 @@ pub const ARCSEC_PER_MICRORAD: f64 = ARCSEC_PER_RAD / MICRORAD_PER_RAD;
 /// Micrometres in a millimetre.
 pub const MICROMETRE_PER_MM: f64 = 1e3;
 
+/// A target angle as the user set it: in rad or in arcsec.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TargetAngle {
+    /// Given in rad (`--target-angle`).
+    Rad(f64),
+    /// Given in arcsec (`--target-arcsec`).
+    Arcsec(f64),
+}
+
+impl TargetAngle {
+    /// The angle \[rad\].
+    pub fn rad(self) -> f64 {
+        match self {
+            Self::Rad(r) => r,
+            Self::Arcsec(a) => a / ARCSEC_PER_RAD,
+        }
+    }
+
+    /// The angle \[arcsec\].
+    pub fn arcsec(self) -> f64 {
+        match self {
+            Self::Rad(r) => r * ARCSEC_PER_RAD,
+            Self::Arcsec(a) => a,
+        }
+    }
+}
+
+impl fmt::Display for TargetAngle {
+    /// `9.69e-5 rad (19.99″)` for a target given in rad (its shortest exact form, so as it
+    /// was typed), `20″ (9.6963e-5 rad)` for one given in arcsec.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::Rad(r) => write!(f, "{r:e} rad ({:.2}″)", r * ARCSEC_PER_RAD),
+            Self::Arcsec(a) => write!(f, "{a}″ ({:.4e} rad)", a / ARCSEC_PER_RAD),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A target reads as it was set, with the other unit beside it.
+    #[test]
+    fn a_target_reads_as_it_was_set() {
+        assert_eq!(
+            TargetAngle::Rad(9.69e-5).to_string(),
+            "9.69e-5 rad (19.99″)"
+        );
+        assert_eq!(TargetAngle::Arcsec(20.0).to_string(), "20″ (9.6963e-5 rad)");
+        assert_eq!(TargetAngle::Arcsec(20.0).arcsec(), 20.0);
+        assert_eq!(TargetAngle::Rad(1e-4).rad(), 1e-4);
+    }
 
     /// The factors against independent definitions: a full turn is 360 degrees of 3600
     /// arcseconds, 20 arcseconds is the paper's 9.69e-5 rad.

@@ -71,6 +71,7 @@ fn golden_job_shards_and_report() {
         paths: vec![dir.path().to_path_buf()],
         out: Some(out.clone()),
         plots: false,
+        progress: false,
         settings: mc_merge::Settings {
             replicates: 200,
             gof_replicates: 100,
@@ -93,7 +94,7 @@ fn golden_job_shards_and_report() {
         "250ebc35d731f68192faca6b4669b8f390d78b9f27cebefb5b7b50bee177ec38",
         "c5753b56848e65975611ccfe35ae9fd31ffa92e67afa1de9c27593684b0ae7c6",
         "7f95eed1a842b547589bf84637c37505cc0c2cfdc91b76242878045a89080f26",
-        "9197a3d03247601b08e5f5ac29ef635f513e605a28ca464335274e7d9eca327c",
+        "04a135486377d2c856389fd196741b12c88e71f64e9520a2861a2f93d8d7bf73",
     ];
     for (what, (g, w)) in [
         "job id",

@@ -40,6 +40,7 @@ fn merge(dir: &Path) -> (serde_json::Value, Vec<u8>) {
         paths: vec![dir.to_path_buf()],
         out: Some(out.clone()),
         plots: false,
+        progress: false,
         settings: mc_merge::Settings {
             replicates: 400,
             gof_replicates: 200,
@@ -135,6 +136,7 @@ fn a_missing_shard_is_named() {
         paths: vec![dir.path().to_path_buf()],
         out: None,
         plots: false,
+        progress: false,
         settings: mc_merge::Settings::default(),
     };
     let err = mc_merge::run(&options, &mut Vec::new())

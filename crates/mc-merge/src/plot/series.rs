@@ -195,12 +195,23 @@ pub fn sigma(report: &Report) -> Drawn {
             DOTTED,
             BLACK.stroke_width(1),
         ))?;
-        // The target marked on the θ axis, where its line starts.
+        // The target marked on the θ axis, where its line starts, and on the arcsec axis,
+        // where it ends (a tick and its value in arcsec, beside that axis's own labels).
         let (px, py) = chart.backend_coord(&(xlo, target));
         root.draw(&Text::new(
             format!("target {}", angle(target)),
             (px + 6, py - 4),
             label_style(HPos::Left, VPos::Bottom),
+        ))?;
+        let (qx, qy) = chart.backend_coord(&(xhi, target));
+        root.draw(&PathElement::new(
+            vec![(qx, qy), (qx + 6, qy)],
+            BLACK.stroke_width(1),
+        ))?;
+        root.draw(&Text::new(
+            format!("{:.2}″", target * ARCSEC_PER_MICRORAD),
+            (qx + 9, qy),
+            label_style(HPos::Left, VPos::Center),
         ))?;
         for (k, s) in series.iter().enumerate() {
             let color = palette(k);

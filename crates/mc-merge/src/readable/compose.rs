@@ -12,9 +12,9 @@ use super::plots;
 use super::rayleigh::rayleigh_section;
 use super::sweeps;
 use super::words::{
-    NONE, arcsec, figure_interval, figure_value, parameters, plain, rad, sci, verdict,
+    NONE, arcsec, figure_interval, figure_value, parameters, plain, rad, sci, signed_percent,
+    verdict,
 };
-use crate::answer::Answer;
 use crate::load::ShardWriter;
 use crate::report::Report;
 use std::collections::BTreeSet;
@@ -76,35 +76,35 @@ fn contents(doc: &Document) -> Vec<Line> {
         .collect()
 }
 
-/// The answer first, in three lines ([`crate::answer::Answer`]): the allowable σ for the
-/// target with its interval, the cases above and below the target, and what the Rayleigh
-/// verdicts mean given how many were tested.
+/// The answer first, in three lines ([`crate::report::AnswerReport`]): the allowable σ for
+/// the target with its interval, the cases above and below the target, and what the Rayleigh
+/// verdicts mean given how many were tested (the rejections chance alone gives, Holm's
+/// adjustment across the cases) and how much they matter (each rejection's effect size).
 fn answer_section(doc: &mut Document, report: &Report) {
-    let a = Answer::of(report);
-    let pct = plain(a.percentile);
-    let target = format!(
-        "θ_P{pct} ≤ {} rad ({} arcsec)",
-        rad(a.target),
-        arcsec(a.target)
-    );
+    let a = &report.answer;
+    let pct = plain(a.percentile.0);
+    let target = format!("θ_P{pct} ≤ {}", report.settings.target());
     doc.heading(2, "The answer", "answer");
     let mut items: Vec<Line> = vec![];
-    if a.allowable.is_empty() {
+    if a.allowable_sigma.is_empty() {
         items.push(vec![text(format!(
             "Allowable σ: none here, since no cases of this job differ only in σ (a σ-series); the cases are compared with the target {target} one by one below."
         ))]);
     }
-    for (name, sigma) in &a.allowable {
+    for sigma in &a.allowable_sigma {
         let mut line = vec![
-            text(format!("Allowable σ for {target}, series {name}: ")),
-            strong(format!("{} mm", figure_value(&sigma.through_origin, sci))),
+            text(format!(
+                "Allowable σ for {target}, series {}: ",
+                sigma.series
+            )),
+            strong(format!("{} mm", figure_value(&sigma.sigma, sci))),
             text(format!(
                 ", {} % interval {} mm",
                 plain(100.0 * report.settings.confidence),
-                figure_interval(&sigma.through_origin, sci)
+                figure_interval(&sigma.sigma, sci)
             )),
         ];
-        if let Some((lo, _)) = sigma.through_origin.interval() {
+        if let Some((lo, _)) = sigma.sigma.interval() {
             line.push(text("; the conservative choice is "));
             line.push(strong(format!("σ ≤ {} mm", sci(lo))));
             line.push(text(" (the interval's lower end)"));
@@ -115,40 +115,84 @@ fn answer_section(doc: &mut Document, report: &Report) {
         line.push(text("."));
         items.push(line);
     }
-    let list = |v: &[crate::answer::Placed]| {
+    let list = |v: Vec<&crate::report::CaseAgainstTarget>| {
         if v.is_empty() {
             "none".to_string()
         } else {
             v.iter()
-                .map(|p| format!("{} ({} arcsec)", p.name, arcsec(p.theta)))
+                .map(|c| format!("{} ({} arcsec)", c.case, figure_value(&c.value, arcsec)))
                 .collect::<Vec<_>>()
                 .join(", ")
         }
     };
     let mut cases = format!(
         "θ_P{pct} above the target: {}; at or below it: {}",
-        list(&a.above),
-        list(&a.within)
+        list(a.above().collect()),
+        list(a.within().collect())
     );
-    if !a.undefined.is_empty() {
-        cases += &format!("; too few samples for θ_P{pct}: {}", a.undefined.join(", "));
+    let undefined: Vec<&str> = a.undefined().collect();
+    if !undefined.is_empty() {
+        cases += &format!("; too few samples for θ_P{pct}: {}", undefined.join(", "));
     }
     items.push(vec![text(cases + ".")]);
-    if let (Some(level), Some(chance)) = (a.level, a.expected_by_chance()) {
-        let rejected = if a.rejected.is_empty() {
-            "in none".to_string()
+    let r = &a.rayleigh;
+    if r.tested > 0 {
+        let rejected: Vec<String> = r
+            .rejected()
+            .map(|v| {
+                format!(
+                    "{} (p = {:.3}; its Rayleigh θ_P{pct} differs from the empirical by {})",
+                    v.case,
+                    v.p_value.0,
+                    signed_figure(&v.relative_difference)
+                )
+            })
+            .collect();
+        let rejected = if rejected.is_empty() {
+            format!("in none of the {} cases tested", r.tested)
         } else {
-            format!("in {} ({})", a.rejected.len(), a.rejected.join(", "))
+            format!(
+                "in {} of the {} cases tested: {}",
+                rejected.len(),
+                r.tested,
+                rejected.join("; ")
+            )
+        };
+        let holm = if r.holm_rejected.is_empty() {
+            format!(
+                "after Holm's adjustment across the {} cases none is rejected (smallest adjusted p = {:.3})",
+                r.tested,
+                r.smallest_holm_p().unwrap_or(1.0)
+            )
+        } else {
+            format!(
+                "after Holm's adjustment across the {} cases it is still rejected in {}",
+                r.tested,
+                r.holm_rejected.join(", ")
+            )
         };
         items.push(vec![text(format!(
-            "The paper's Rayleigh law is rejected {rejected} of {} cases at level {}: with {} tests, {:.2} rejections are expected by chance alone where it holds. The θ_P{pct} above are the empirical percentiles, whatever the verdict; the Rayleigh figure is a cross-check (section The Rayleigh law gives the difference).",
-            a.tested,
-            plain(level),
-            a.tested,
-            chance
+            "The paper's Rayleigh law is rejected at level {} {rejected}. With {} tests, {:.2} rejections are expected by chance alone where it holds; {holm}. The θ_P{pct} above are the empirical percentiles, whatever the verdict; the Rayleigh figure is a cross-check (section The Rayleigh law gives the difference).",
+            plain(r.level.0),
+            r.tested,
+            r.expected_by_chance.0
         ))]);
     }
     doc.list(items);
+}
+
+/// A relative difference with its interval, in percent: `−0.3 % [−1.2 %, +0.6 %]`.
+fn signed_figure(f: &crate::report::Figure) -> String {
+    match (f.get(), f.interval()) {
+        (Some(v), Some((lo, hi))) => format!(
+            "{} [{}, {}]",
+            signed_percent(v),
+            signed_percent(lo),
+            signed_percent(hi)
+        ),
+        (Some(v), None) => signed_percent(v),
+        _ => NONE.to_string(),
+    }
 }
 
 fn run_section(doc: &mut Document, report: &Report, writers: &[ShardWriter]) {
@@ -204,10 +248,9 @@ fn run_section(doc: &mut Document, report: &Report, writers: &[ShardWriter]) {
             plain(s.gof_level)
         ))],
         vec![text(format!(
-            "Target: θ_P{} ≤ {} rad ({} arcsec).",
+            "Target: θ_P{} ≤ {}.",
             plain(s.target_percentile),
-            rad(s.target_angle),
-            arcsec(s.target_angle)
+            s.target()
         ))],
         vec![text(format!(
             "Units: angles in rad and in arcsec (1 rad = {ARCSEC_PER_RAD:.1} arcsec); σ, the member length standard deviation, in mm; tan θ_x, tan θ_y dimensionless."

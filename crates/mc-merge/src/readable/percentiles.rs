@@ -91,9 +91,8 @@ pub fn summary_section(doc: &mut Document, report: &Report) {
         .collect();
     doc.table(Table {
         caption: format!(
-            "θ_P{pct} of each case with its {conf} % BCa interval, in rad and arcsec, against the target {} rad ({} arcsec), and the Rayleigh law's verdict.",
-            rad(s.target_angle),
-            arcsec(s.target_angle)
+            "θ_P{pct} of each case with its {conf} % BCa interval, in rad and arcsec, against the target {}, and the Rayleigh law's verdict.",
+            s.target()
         ),
         header: vec![
             "case".into(),

@@ -115,10 +115,9 @@ fn sigma_series(doc: &mut Document, report: &Report, s: &SigmaSeries, k: usize) 
     let a = &s.allowable_sigma;
     let mm = |x: f64| format!("{} mm", sci(x));
     let mut line = vec![text(format!(
-        "Allowable σ for θ_P{} ≤ {} rad ({:.1} arcsec): ",
+        "Allowable σ for θ_P{} ≤ {}: ",
         plain(a.percentile.0),
-        rad(a.target_angle.0),
-        a.target_arcsec.0
+        report.settings.target()
     ))];
     match a.through_origin.get() {
         Some(v) => line.push(strong(mm(v))),

@@ -682,13 +682,21 @@ fn check_answer_last(stdout: &str, v: &Value, dir: &Path) {
         "{answer}\n{a}"
     );
     // The σ-sweep marks the target on both axes: the target written where its line meets
-    // the θ axis (besides the legend's entry), the allowable σ written where it meets the σ
-    // axis (the legend's entry starts "allowable").
+    // the θ axis (besides the legend's entry) and in arcsec on the arcsec axis, the
+    // allowable σ written where it meets the σ axis (the legend's entry starts "allowable").
     let sweep = std::fs::read_to_string(dir.join("sigma-sweep.svg")).unwrap();
     let texts: Vec<&str> = sweep.lines().collect();
     assert!(
         texts.iter().filter(|l| l.starts_with("target ")).count() >= 2,
         "no target at the θ axis"
+    );
+    let arcsec = format!(
+        "{:.2}″",
+        v["settings"]["target_angle"].as_f64().unwrap() * truss_units::ARCSEC_PER_RAD
+    );
+    assert!(
+        texts.iter().any(|l| *l == arcsec),
+        "no target {arcsec} at the arcsec axis"
     );
     assert!(
         texts
@@ -717,5 +725,68 @@ fn check_answer_last(stdout: &str, v: &Value, dir: &Path) {
             "Rayleigh law rejected in {rejected} of 3 cases at α = 0.05"
         )),
         "{answer}"
+    );
+    check_answer_section(v, &answer);
+}
+
+/// report.json's `answer` holds what the cases and the sweep say: each case's θ_P95 and its
+/// side of the target, the allowable σ, and each verdict's p-value (the smaller of KS's and
+/// AD's) with Holm's adjustment, recomputed here from the sorted p-values; the console
+/// names the cases Holm still rejects (or the smallest adjusted p).
+fn check_answer_section(v: &Value, console: &str) {
+    let a = &v["answer"];
+    let target = v["settings"]["target_angle"].as_f64().unwrap();
+    assert_eq!(a["target_angle"].as_f64(), Some(target));
+    let cases = v["cases"].as_array().unwrap();
+    for (case, placed) in cases.iter().zip(a["cases"].as_array().unwrap()) {
+        assert_eq!(placed["case"], case["name"]);
+        let p95 = crate::readable::p95(case);
+        assert_eq!(placed["value"]["value"].as_f64(), Some(p95));
+        let side = if p95 > target { "above" } else { "within" };
+        assert_eq!(placed["against"], side, "{placed}");
+    }
+    assert_eq!(
+        a["allowable_sigma"][0]["sigma"],
+        v["sweep"]["sigma_series"][0]["allowable_sigma"]["through_origin"]
+    );
+    let p: Vec<f64> = cases
+        .iter()
+        .map(|c| {
+            let ks = c["gof"]["ks"]["p_value"].as_f64().unwrap();
+            let ad = c["gof"]["ad"]["p_value"].as_f64().unwrap();
+            ks.min(ad)
+        })
+        .collect();
+    let m = p.len();
+    let mut sorted = p.clone();
+    sorted.sort_by(f64::total_cmp);
+    let verdicts = a["rayleigh"]["cases"].as_array().unwrap();
+    assert_eq!(verdicts.len(), m);
+    let mut holm_rejected = vec![];
+    for (k, (verdict, &pk)) in verdicts.iter().zip(&p).enumerate() {
+        assert_eq!(verdict["p_value"].as_f64(), Some(pk));
+        let rank = sorted.iter().position(|&x| x == pk).unwrap();
+        let adjusted = (0..=rank)
+            .map(|j| ((m - j) as f64 * sorted[j]).min(1.0))
+            .fold(0.0, f64::max);
+        let got = verdict["holm_p_value"].as_f64().unwrap();
+        assert!((got - adjusted).abs() < 1e-12, "{got} vs {adjusted}");
+        if adjusted < 0.05 {
+            holm_rejected.push(cases[k]["name"].clone());
+        }
+        assert_eq!(
+            verdict["relative_difference"],
+            cases[k]["gof"]["effect"]["relative_difference"]
+        );
+    }
+    assert_eq!(
+        a["rayleigh"]["holm_rejected"],
+        Value::from(holm_rejected.clone())
+    );
+    assert!(
+        console.contains(&format!("after Holm's adjustment across the {m} cases: "))
+            && (holm_rejected.is_empty()
+                == console.contains("none rejected (smallest adjusted p = ")),
+        "{console}"
     );
 }

@@ -3,6 +3,7 @@
 
 mod authorship;
 mod cli;
+mod collect;
 mod common;
 mod export;
 #[path = "../../../run-dir/tests/support/hostile.rs"]

@@ -52,6 +52,7 @@ fn options(shards: &Path, out: &Path, plots: bool) -> mc_merge::Options {
         paths: vec![shards.to_path_buf()],
         out: Some(out.to_path_buf()),
         plots,
+        progress: false,
         settings: mc_merge::Settings {
             replicates: 100,
             gof_replicates: 19,
@@ -177,7 +178,12 @@ fn check_markdown(out: &Path, report: &serde_json::Value) {
     for p in p95s(report) {
         assert!(md.contains(&p), "{p}");
     }
-    assert!(md.contains("Allowable σ for θ_P95 ≤ 9.690e-5 rad"), "{md}");
+    // The target as it was set (9.69e-5 rad), the same words wherever it is named.
+    assert!(
+        md.contains("Allowable σ for θ_P95 ≤ 9.69e-5 rad (19.99″)"),
+        "{md}"
+    );
+    assert!(md.contains("Target: θ_P95 ≤ 9.69e-5 rad (19.99″)."), "{md}");
     assert!(md.contains("floating stages in 100 of 300 samples"), "{md}");
     // The hostile name never opens markup: no raw tag, link or code span of it.
     assert!(!md.contains("<script>") && !md.contains("[b](c)"));

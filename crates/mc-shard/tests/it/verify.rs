@@ -89,6 +89,7 @@ fn a_resume_verifies_the_lines_it_keeps_and_the_header() {
             paths: vec![out.clone()],
             out: None,
             plots: false,
+            progress: false,
             settings: Default::default(),
         },
         &mut Vec::new(),

@@ -41,6 +41,7 @@ fn merged_report(dir: &Path) -> Vec<u8> {
         paths: vec![dir.to_path_buf()],
         out: Some(report.clone()),
         plots: false,
+        progress: false,
         settings: mc_merge::Settings {
             replicates: 200,
             gof_replicates: 100,

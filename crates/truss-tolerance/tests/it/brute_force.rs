@@ -16,7 +16,7 @@ use truss_stats::bootstrap::{
 };
 use truss_tolerance::setup::Study;
 use truss_tolerance::simulate::run_case;
-use truss_tolerance::{Options, run};
+use truss_tolerance::{Options, TargetAngle, run};
 
 /// The 95th-percentile replicates of `theta` (Poisson bootstrap, fixed seed, B = 400).
 fn replicates(theta: &[f64]) -> Vec<Option<f64>> {
@@ -44,7 +44,12 @@ fn zeroing_a_group_changes_theta_p95_as_the_shares_predict() {
         sensitivity_samples: n,
         samples: 1000,
         plots: false,
-        ..Options::new(path.clone(), "c", 20.0, dir.path().join("out"))
+        ..Options::new(
+            path.clone(),
+            "c",
+            TargetAngle::Arcsec(20.0),
+            dir.path().join("out"),
+        )
     };
     let t = run(&options).unwrap();
     let study = Study::read(&path, "c", &[], &[]).unwrap();

@@ -1,14 +1,19 @@
 //! What the study refuses, each with a clear error naming the cause.
 
 use crate::common::{both, job};
-use truss_tolerance::{Options, ToleranceError, run};
+use truss_tolerance::{Options, TargetAngle, ToleranceError, run};
 
 fn options(path: std::path::PathBuf, case: &str, dir: &tempfile::TempDir) -> Options {
     Options {
         sensitivity_samples: 1000,
         samples: 1000,
         plots: false,
-        ..Options::new(path, case, 20.0, dir.path().join("out"))
+        ..Options::new(
+            path,
+            case,
+            TargetAngle::Arcsec(20.0),
+            dir.path().join("out"),
+        )
     }
 }
 
@@ -120,7 +125,7 @@ fn unknown_groups_and_bad_numbers_are_refused() {
         (20.0, 0.0),
     ] {
         let o = Options {
-            target_arcsec: target,
+            target: TargetAngle::Arcsec(target),
             percentile: pct,
             ..base.clone()
         };

@@ -5,13 +5,13 @@
 use crate::common::{both, job};
 use truss_job::Job;
 use truss_tolerance::study::MARGIN;
-use truss_tolerance::{Options, run};
+use truss_tolerance::{Options, TargetAngle, run};
 
 fn small(path: std::path::PathBuf, out: std::path::PathBuf) -> Options {
     Options {
         sensitivity_samples: 1500,
         samples: 3000,
-        ..Options::new(path, "c", 20.0, out)
+        ..Options::new(path, "c", TargetAngle::Arcsec(20.0), out)
     }
 }
 
@@ -98,7 +98,7 @@ fn the_result_does_not_depend_on_the_thread_count() {
             samples: 1000,
             plots: false,
             fixes: vec!["batten=0.01".into()],
-            ..Options::new(path.clone(), "c", 20.0, out.clone())
+            ..Options::new(path.clone(), "c", TargetAngle::Arcsec(20.0), out.clone())
         };
         // A fixed group: verified or not, the files are written.
         let _ = run(&o);
@@ -121,7 +121,7 @@ fn truncated_normals_are_scaled_with_their_limit() {
         sensitivity_samples: 1000,
         samples: 1000,
         plots: false,
-        ..Options::new(path, "c", 20.0, out.clone())
+        ..Options::new(path, "c", TargetAngle::Arcsec(20.0), out.clone())
     };
     let t = match run(&o) {
         Ok(t) => t,
@@ -161,7 +161,7 @@ fn the_paper_case_allocation_verifies() {
     let o = Options::new(
         root.join("jobs/paper-3.1.json"),
         "sigma-0.0063",
-        20.0,
+        TargetAngle::Arcsec(20.0),
         dir.path().to_path_buf(),
     );
     let t = run(&o).unwrap();
