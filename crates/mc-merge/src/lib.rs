@@ -152,12 +152,14 @@
 
 pub mod analysis;
 pub mod answer;
+pub mod budget;
 pub mod cli;
 pub mod definitions;
 pub mod errors;
 pub mod export;
 pub mod gof;
 pub mod load;
+pub mod placement;
 pub mod plot;
 pub mod rayleigh;
 pub mod readable;
@@ -211,16 +213,37 @@ pub fn merge(paths: &[PathBuf], settings: &Settings) -> Result<Merge, MergeError
 /// Computes the report of a verified dataset; the settings are checked first
 /// ([`Settings::validate`]).
 pub fn build_report(dataset: &Dataset, settings: &Settings) -> Result<Report, MergeError> {
-    let settings = &settings.validate()?;
+    let mut settings = settings.validate()?;
+    // A budget's percentile is computed with the others (see [`budget`]).
+    if let Some(b) = &dataset.budget
+        && !settings.percentiles.contains(&b.percentile)
+    {
+        settings.percentiles.push(b.percentile);
+        settings.percentiles.sort_by(f64::total_cmp);
+    }
+    let settings = &settings;
     let mut cache = CalibrationCache::default();
     let analyses: Vec<CaseAnalysis> = dataset
         .cases
         .iter()
-        .map(|c| analyse_case(c, settings, &mut cache))
+        .map(|c| {
+            let mut a = analyse_case(c, settings, &mut cache);
+            let (decenter, despace) =
+                placement::analyse(c, settings, &mut cache, &a.report.caveats);
+            a.report.decenter = decenter.as_ref().map(|q| q.report.clone());
+            a.report.despace = despace.as_ref().map(|q| q.report.clone());
+            a.decenter = decenter.map(|q| q.levels);
+            a.despace = despace.map(|q| q.levels);
+            a
+        })
         .collect();
     let params: Vec<&BTreeMap<String, f64>> =
         dataset.cases.iter().map(|c| &c.info.parameters).collect();
     let sweep = sweep::sweep(&params, &analyses, settings);
+    let budget = dataset
+        .budget
+        .as_ref()
+        .map(|b| budget::budget_report(b, &params, &analyses, settings));
     let missing = dataset.missing();
     Ok(Report {
         format: report::REPORT_FORMAT,
@@ -244,6 +267,7 @@ pub fn build_report(dataset: &Dataset, settings: &Settings) -> Result<Report, Me
         definitions: definitions::definitions(settings),
         cases: analyses.into_iter().map(|a| a.report).collect(),
         sweep,
+        budget,
     })
 }
 

@@ -22,9 +22,11 @@
 //! ## Memory
 //!
 //! Per sample only what the statistics need is kept, in dense per-case columns indexed by the
-//! sample's position in its case: a state byte, θ_P, tan θ_x, tan θ_y, a loose-joint byte and,
-//! until verification ends, the fingerprint and the number of the file that held it: 38 bytes
-//! per sample (26 after). A case's columns are allocated when its first sample is read. The
+//! sample's position in its case: a state byte, θ_P, tan θ_x, tan θ_y, decenter_x, decenter_y,
+//! despace, a loose-joint and a floating byte, the holding force and, until verification
+//! ends, the fingerprint and the number of the file that held it: 76 bytes per sample (64
+//! after). `decenter` is not kept: it is `decenter_x.hypot(decenter_y)`, the writer's own
+//! definition (`truss_core::measure`), recomputed when asked for. A case's columns are allocated when its first sample is read. The
 //! parsed sample lines are not kept.
 //!
 //! ## Threads
@@ -35,7 +37,7 @@
 
 use crate::errors::{FailedCase, MergeError, MissingRange};
 use crate::rng::mix64;
-use shard_record::{Begin, CaseInfo, Sample, ScanError, ShardRange, read_shard};
+use shard_record::{Begin, Budget, CaseInfo, Sample, ScanError, ShardRange, read_shard};
 use std::path::{Path, PathBuf};
 
 /// How many failure reasons (the lowest indices) to keep per case.
@@ -79,6 +81,25 @@ pub struct Point {
     pub tan_y: f64,
     /// The holding force \[N\] (NaN where the sample does not record it).
     pub holding: f64,
+    /// decenter_x \[mm\] (NaN where the sample does not record it: a shard of numerics
+    /// version 7 or earlier).
+    pub decenter_x: f64,
+    /// decenter_y \[mm\] (NaN where not recorded).
+    pub decenter_y: f64,
+    /// despace \[mm\] (NaN where not recorded).
+    pub despace: f64,
+}
+
+impl Point {
+    /// `√(decenter_x² + decenter_y²)` \[mm\] (NaN where not recorded).
+    pub fn decenter(&self) -> f64 {
+        self.decenter_x.hypot(self.decenter_y)
+    }
+
+    /// Whether the sample records its decenter and despace.
+    pub fn placed(&self) -> bool {
+        !(self.decenter_x.is_nan() || self.decenter_y.is_nan() || self.despace.is_nan())
+    }
 }
 
 #[derive(Debug, Default)]
@@ -94,6 +115,10 @@ struct Columns {
     floating: Vec<u8>,
     /// The holding force \[N\]; NaN: not recorded.
     holding: Vec<f64>,
+    /// decenter_x, decenter_y, despace \[mm\]; NaN: not recorded.
+    decenter_x: Vec<f64>,
+    decenter_y: Vec<f64>,
+    despace: Vec<f64>,
 }
 
 fn zeroed<T: Clone>(n: usize, v: T) -> Result<Vec<T>, String> {
@@ -115,6 +140,9 @@ impl Columns {
             loose: zeroed(n, 0)?,
             floating: zeroed(n, 0)?,
             holding: zeroed(n, f64::NAN)?,
+            decenter_x: zeroed(n, f64::NAN)?,
+            decenter_y: zeroed(n, f64::NAN)?,
+            despace: zeroed(n, f64::NAN)?,
         })
     }
 }
@@ -158,6 +186,9 @@ impl CaseData {
                     tan_x: c.tan_x[k],
                     tan_y: c.tan_y[k],
                     holding: c.holding[k],
+                    decenter_x: c.decenter_x[k],
+                    decenter_y: c.decenter_y[k],
+                    despace: c.despace[k],
                 })
         })
     }
@@ -244,6 +275,8 @@ pub struct Dataset {
     pub files: Vec<PathBuf>,
     /// The programs that wrote the files, as their headers name them, in order.
     pub writers: Vec<ShardWriter>,
+    /// The job's alignment budget, as the headers carry it.
+    pub budget: Option<Budget>,
 }
 
 /// A program that wrote shard files of the dataset, as the files' begin lines name it.
@@ -391,6 +424,8 @@ fn compare_headers(reference: &Reference, path: &Path, begin: &Begin) -> Result<
         ))
     } else if begin.cases != r.cases {
         Some("the cases (names, ranges or parameters)".to_string())
+    } else if begin.budget != r.budget {
+        Some("the budget".to_string())
     } else {
         None
     };
@@ -418,6 +453,8 @@ struct Rec {
     floating: u8,
     /// The holding force \[N\]; NaN: not recorded.
     holding: f64,
+    /// decenter_x, decenter_y, despace \[mm\]; NaN: not recorded.
+    placement: [f64; 3],
     /// `Some` for a failed sample.
     reason: Option<Box<str>>,
 }
@@ -443,6 +480,9 @@ impl Rec {
                 Some(true) => 2,
             },
             holding: s.holding_force.unwrap_or(f64::NAN),
+            placement: s
+                .placement()
+                .map_or([f64::NAN; 3], |p| [p.decenter_x, p.decenter_y, p.despace]),
             reason: match a {
                 Some(_) => None,
                 None => Some(s.reason.clone().unwrap_or_default().into_boxed_str()),
@@ -508,6 +548,7 @@ impl Store {
         cols.loose[k] = r.loose;
         cols.floating[k] = r.floating;
         cols.holding[k] = r.holding;
+        [cols.decenter_x[k], cols.decenter_y[k], cols.despace[k]] = r.placement;
         match r.reason {
             None => cols.state[k] = CONVERGED,
             Some(why) => {
@@ -736,7 +777,9 @@ pub fn load(files: &[PathBuf], options: LoadOptions) -> Result<Dataset, MergeErr
         }
     }
     drop(store.owner);
+    let budget = reference.begin.budget;
     let data = Dataset {
+        budget,
         job_id: reference.begin.job_id,
         job_samples: reference.begin.job_samples,
         cases,

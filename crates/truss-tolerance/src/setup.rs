@@ -245,7 +245,8 @@ impl Study {
     pub fn case_with(&self, sigmas: &[f64], samples: u64) -> CaseSpec {
         let mut case = self.case().clone();
         case.samples = samples;
-        case.length_errors = self
+        // The groups' own parts scaled; their lots' shared parts, if any, kept as given.
+        case.length_errors.parts = self
             .groups
             .iter()
             .zip(sigmas)
@@ -286,6 +287,7 @@ impl Study {
             model: self.spec.model.clone(),
             seed: self.spec.seed,
             cases: vec![self.case_with(sigmas, samples)],
+            budget: self.spec.budget,
         };
         Ok(Job::new(&spec, &self.base)?)
     }

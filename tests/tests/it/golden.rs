@@ -89,11 +89,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "eff1ebfec9e37a41ac7d6f085613e96c8dda168b569ac5e37aac842a050c7d87",
-        "250ebc35d731f68192faca6b4669b8f390d78b9f27cebefb5b7b50bee177ec38",
-        "098aa180429d0cc97595bed509b793c37bb7f0b0d30d29c5cf63ec6347cd8528",
-        "7f95eed1a842b547589bf84637c37505cc0c2cfdc91b76242878045a89080f26",
-        "95691c3b1c3819a508808f3facd918ce6a7864e2a042b0a408d51c5eef8d582d",
+        "f42f9eb60f0b73e789dcdc6fd84eff8f115869362d739aefd12639d0363108b8",
+        "94ce944399e4677c5705bde025cc92a70f975a9f2ab7c855a7e8f13ecf665d24",
+        "c4a5a371df028554f1f90511db956cb8aa4afe2099aec15f989c01c4e06aeec1",
+        "7b94c46945c2820f627e0bdcc5aa42e331a0f6fe76f9a1cbbfa384b72441d183",
+        "201c2b0b5edece9bdbb1e83156617888b769ae32d75277712f52f52f4bd9736b",
     ];
     for (what, (g, w)) in [
         "job id",

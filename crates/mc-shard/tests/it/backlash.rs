@@ -146,11 +146,11 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "56288efb7ae33d0035c9b0894f623bef5c5a861bf21b2f4377079669b469cfa2"
+        "4da50f118d9997ff94295fc88e3aefbfd82bd0436fa55310711bfd09112d975d"
     );
     assert_eq!(
         digest,
-        "0800f1eff1ff051fe373207d684753017c20717f6ca9d5b95982594742a6b0b1"
+        "229287e88c9492ce4850c5441c2fce67acf2d66f8e9cc51b13c0f865b9e12c03"
     );
 }
 
