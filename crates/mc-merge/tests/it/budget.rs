@@ -118,3 +118,50 @@ fn the_table_opens_with_the_budget() {
     assert!(budget < cases, "{table}");
     assert!(table.contains("binds: decenter"), "{table}");
 }
+
+/// report.md opens with the budget: its section comes before the answer, with the
+/// allowable σ and the binding line.
+#[test]
+fn the_readable_report_opens_with_the_budget() {
+    let mut job = SynthJob::new(
+        44,
+        vec![
+            SynthCase::rayleigh("s1", 400, 2e-5, &[("sigma", 0.0033)]),
+            SynthCase::rayleigh("s2", 400, 4e-5, &[("sigma", 0.0066)]),
+        ],
+    );
+    job.budget = Some(Budget {
+        percentile: 95.0,
+        theta_p: Some(THETA),
+        decenter: Some(0.05),
+        despace: None,
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let shards = dir.path().join("shards");
+    std::fs::create_dir_all(&shards).unwrap();
+    job.write_split(&shards, 2);
+    let out = dir.path().join("report");
+    let options = mc_merge::Options {
+        paths: vec![shards],
+        out: Some(out.clone()),
+        plots: false,
+        settings: mc_merge::Settings {
+            replicates: 50,
+            gof_replicates: 19,
+            ..Default::default()
+        },
+    };
+    mc_merge::run(&options, &mut Vec::new()).unwrap();
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    let budget = md
+        .find("## The alignment budget")
+        .expect("a budget section");
+    let answer = md.find("## The answer").unwrap();
+    assert!(budget < answer, "{md}");
+    let section = &md[budget..answer];
+    assert!(section.contains("decenter binds"), "{section}");
+    assert!(
+        section.contains("Allowable σ meeting every line, series"),
+        "{section}"
+    );
+}
