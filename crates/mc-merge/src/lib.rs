@@ -60,6 +60,15 @@
 //!   the relative difference of the Rayleigh and empirical target percentiles (with a bootstrap
 //!   interval) and the max CDF gap; a verdict in words.
 //! - **Loose joints**: fraction of samples with ≥ 1 loose backlash joint (Clopper–Pearson).
+//! - **Decenter and despace** ([`placement`]), where the samples record them (mm): their
+//!   percentiles (of decenter and |despace|) with the same three intervals; decenter's
+//!   Rayleigh law (fit from Σ decenter²/2n, χ²(2n) interval, KS and AD of decenter² against
+//!   the exponential), despace's normal law (folded-normal percentiles of |despace|, KS and
+//!   AD with mean and spread estimated).
+//! - **The budget** ([`budget`]), where the job states one: per case which lines pass and
+//!   the allowable σ meeting every line, `σ·min over lines of limit/q`, with the line that
+//!   binds; per σ-series the same from the lines through the origin. First in the table
+//!   and in `report.md`.
 //!
 //! ## 3. Sweeps ([`sweep`])
 //!
