@@ -18,7 +18,18 @@ import pytest
 import truss_mc
 from conftest import SMALL_JOB, sample_lines, tool
 
-FLOAT_FIELDS = ("theta_p", "tan_theta_x", "tan_theta_y", "residual", "slack_cables", "loose_joints")
+FLOAT_FIELDS = (
+    "theta_p",
+    "tan_theta_x",
+    "tan_theta_y",
+    "decenter_x",
+    "decenter_y",
+    "decenter",
+    "despace",
+    "residual",
+    "slack_cables",
+    "loose_joints",
+)
 
 
 def bits(x: float) -> bytes:
@@ -140,7 +151,7 @@ def test_solve_equals_truss_solve(tmp_path: Path) -> None:
     errors = {"longeron.1.0": 0.012, "batten.2.1": -0.007, "diagonal.3.2.a": 0.003}
     cli = json.loads(tool("truss", "solve", str(path), *[f"--length-error={k}={v!r}" for k, v in errors.items()]).stdout)
     s = truss_mc.solve(truss_mc.Model.from_file(path), errors)
-    for f in ("theta_p", "tan_theta_x", "tan_theta_y", "residual"):
+    for f in ("theta_p", "tan_theta_x", "tan_theta_y", "decenter_x", "decenter_y", "decenter", "despace", "residual"):
         assert bits(getattr(s, f)) == bits(cli[f]), f
     assert (s.iterations, s.factorisations) == (cli["iterations"], cli["factorisations"])
     assert s.node_ids == list(cli["displacements"])

@@ -142,6 +142,15 @@ class Solution:
     tan_theta_x: Optional[float]
     #: tan θ_y of the top surface [-].
     tan_theta_y: Optional[float]
+    #: The top surface centroid's displacement against the bottom's (the supported nodes'),
+    #: δ = (u₁ + u₂ + u₃)/3 − Σ s_k/m, along the bottom frame's e_x [mm].
+    decenter_x: Optional[float]
+    #: δ·e_y, e_y = n_b × e_x [mm].
+    decenter_y: Optional[float]
+    #: √(decenter_x² + decenter_y²): the shift in the bottom plane [mm].
+    decenter: Optional[float]
+    #: δ·n_b: the shift along the bottom's normal, signed, positive apart [mm].
+    despace: Optional[float]
     #: Newton iterations (linear solves).
     iterations: int
     #: Tangent factorisations.
@@ -196,6 +205,10 @@ def solve(model: Model, length_errors: Optional[Mapping[str, float]] = None) -> 
         theta_p=r["theta_p"],
         tan_theta_x=r["tan_theta_x"],
         tan_theta_y=r["tan_theta_y"],
+        decenter_x=r["decenter_x"],
+        decenter_y=r["decenter_y"],
+        decenter=r["decenter"],
+        despace=r["despace"],
         iterations=r["iterations"],
         factorisations=r["factorisations"],
         residual=r["residual"],

@@ -82,7 +82,9 @@ class Samples:
     """Per-sample results, one NumPy array per field of the shard's sample lines, in index
     order: ``index`` (global), ``case``, ``sample`` (within the case), ``status``
     (``"converged"``/``"failed"``), ``iterations``, ``theta_p`` [rad], ``tan_theta_x``,
-    ``tan_theta_y``, ``residual`` [N], ``slack_cables``, ``loose_joints`` (float, NaN where a
+    ``tan_theta_y``, ``decenter_x``, ``decenter_y``, ``decenter``, ``despace`` [mm] (where the
+    top surface's centroid sits against the bottom's frame; NaN where a record has none),
+    ``residual`` [N], ``slack_cables``, ``loose_joints`` (float, NaN where a
     record has none), ``reason`` (empty unless failed), and any other field the lines carry,
     such as ``floating`` (a boolean: 1.0 or 0.0, NaN where a line has none) and
     ``holding_force`` [N] (the largest force on a top node that, to first order, moves

@@ -13,8 +13,9 @@ use crate::report::*;
 use crate::settings::Settings;
 use statrs::distribution::{Beta, ContinuousCDF};
 
-/// A case's report plus what the sweeps need: the target percentile, its interval and its
-/// bootstrap replicates.
+/// A case's report plus what the sweeps and the budget need: the target percentile, its
+/// interval and its bootstrap replicates, and every percentile's, of θ_P, decenter and
+/// |despace|.
 #[derive(Debug, Clone)]
 pub struct CaseAnalysis {
     /// The case's section of the report.
@@ -23,6 +24,35 @@ pub struct CaseAnalysis {
     pub target: Figure,
     /// The target percentile of each bootstrap replicate (`None`: empty replicate, or no bootstrap).
     pub target_replicates: Vec<Option<f64>>,
+    /// θ_P at every percentile of the settings.
+    pub theta: Levels,
+    /// Decenter at every percentile, where the samples record it ([`crate::merge`] fills
+    /// it in from [`crate::placement`], as the decenter and despace of `report`).
+    pub decenter: Option<Levels>,
+    /// |despace| at every percentile, where the samples record it.
+    pub despace: Option<Levels>,
+}
+
+/// A quantity's percentiles at every level of the settings, with their bootstrap replicates.
+#[derive(Debug, Clone, Default)]
+pub struct Levels {
+    /// The levels, in percent.
+    pub percentiles: Vec<f64>,
+    /// Per level, the estimate with its BCa (else percentile) interval.
+    pub primary: Vec<Figure>,
+    /// Per level, the estimate of each bootstrap replicate (empty without a bootstrap).
+    pub replicates: Vec<Vec<Option<f64>>>,
+}
+
+impl Levels {
+    /// The figure and replicates at percentile `pct`, if it is one of the levels.
+    pub fn at(&self, pct: f64) -> Option<(&Figure, &[Option<f64>])> {
+        let j = self.percentiles.iter().position(|&p| p == pct)?;
+        Some((
+            &self.primary[j],
+            self.replicates.get(j).map_or(&[][..], |r| &r[..]),
+        ))
+    }
 }
 
 /// The holding forces of a case's converged samples (see [`HoldingForces`]); `target` is
@@ -123,7 +153,7 @@ pub fn format_p(p: f64, replicates: usize) -> String {
     }
 }
 
-fn component_report(stats: Option<ComponentStats>) -> ComponentReport {
+pub(crate) fn component_report(stats: Option<ComponentStats>) -> ComponentReport {
     let Some(s) = stats else {
         let none = || Figure::null("no converged sample");
         return ComponentReport {
@@ -176,13 +206,13 @@ pub fn replicate_interval(
     bootstrap::percentile_interval(&v, confidence)
 }
 
-struct Percentiles {
-    reports: Vec<PercentileReport>,
+pub(crate) struct Percentiles {
+    pub(crate) reports: Vec<PercentileReport>,
     /// Per level: point estimate and primary (BCa, else percentile) interval.
-    primary: Vec<Figure>,
+    pub(crate) primary: Vec<Figure>,
 }
 
-fn percentiles(
+pub(crate) fn percentiles(
     sample: &SortedSample,
     boot: Option<&QuantileReplicates>,
     settings: &Settings,
@@ -272,7 +302,7 @@ fn percentiles(
 }
 
 /// Relative difference (Rayleigh − empirical)/empirical at level `p`, with its bootstrap interval.
-fn relative_difference(
+pub(crate) fn relative_difference(
     sigma: f64,
     empirical: Option<f64>,
     p: f64,
@@ -304,29 +334,34 @@ fn relative_difference(
     }
 }
 
-fn gof_report(
-    sample: &SortedSample,
-    rayleigh_sigma: Option<f64>,
-    empirical_target: Option<f64>,
-    target_rel: &Figure,
-    settings: &Settings,
-    cache: &mut CalibrationCache,
-    caveats: &[String],
-) -> GofReport {
-    let config = GofConfig {
+/// The goodness-of-fit settings of `settings`.
+pub(crate) fn gof_config(settings: &Settings) -> GofConfig {
+    GofConfig {
         replicates: settings.gof_replicates,
         seed: settings.bootstrap_seed,
         threads: settings.threads,
-    };
+    }
+}
+
+/// The report of a goodness-of-fit test of law `law` ("Rayleigh", "normal"), whose
+/// percentile at the target percentile is `law_target`.
+pub(crate) fn gof_report(
+    result: Result<gof::RayleighGof, String>,
+    law: &str,
+    law_target: Option<f64>,
+    empirical_target: Option<f64>,
+    target_rel: &Figure,
+    settings: &Settings,
+    caveats: &[String],
+) -> GofReport {
     let level = settings.gof_level;
     let pct = settings.target_percentile;
-    let result = gof::rayleigh_gof(&sample.values, cache, &config);
     let g = match result {
         Ok(g) => g,
         Err(reason) => {
             return GofReport {
                 verdict: None,
-                summary: format!("Rayleigh law not tested: {reason}"),
+                summary: format!("{law} law not tested: {reason}"),
                 level: Real(level),
                 ks: None,
                 ad: None,
@@ -339,10 +374,10 @@ fn gof_report(
     };
     let holds = g.ks_p >= level && g.ad_p >= level;
     let m = g.calibration_replicates;
-    let effect = match (rayleigh_sigma, empirical_target) {
-        (Some(s), Some(q)) => Some(EffectReport {
+    let effect = match (law_target, empirical_target) {
+        (Some(l), Some(q)) => Some(EffectReport {
             percentile: Real(pct),
-            rayleigh: Real(rayleigh::percentile(s, pct / 100.0)),
+            rayleigh: Real(l),
             empirical: Real(q),
             relative_difference: target_rel.clone(),
             max_cdf_gap: Real(g.statistics.ks),
@@ -350,7 +385,7 @@ fn gof_report(
         _ => None,
     };
     let mut summary = format!(
-        "Rayleigh law {} (KS {}, AD {})",
+        "{law} law {} (KS {}, AD {})",
         if holds { "holds" } else { "rejected" },
         format_p(g.ks_p, m),
         format_p(g.ad_p, m)
@@ -359,12 +394,12 @@ fn gof_report(
         let pct_txt = format!("{pct}th percentile");
         if holds {
             summary.push_str(&format!(
-                "; Rayleigh {pct_txt} within {:.1} % of the empirical one",
+                "; {law} {pct_txt} within {:.1} % of the empirical one",
                 rel.abs() * 100.0
             ));
         } else {
             summary.push_str(&format!(
-                "; Rayleigh {pct_txt} {:.1} % {} the empirical one",
+                "; {law} {pct_txt} {:.1} % {} the empirical one",
                 rel.abs() * 100.0,
                 if rel >= 0.0 { "above" } else { "below" }
             ));
@@ -492,12 +527,12 @@ pub fn analyse_case(
         caveats: caveats.clone(),
     };
     let gof = gof_report(
-        &sample,
-        fit.map(|f| f.sigma),
+        gof::rayleigh_gof(&sample.values, cache, &gof_config(settings)),
+        "Rayleigh",
+        fit.map(|f| rayleigh::percentile(f.sigma, settings.target_percentile / 100.0)),
         empirical_target,
         &rel_target,
         settings,
-        cache,
         &caveats,
     );
 
@@ -554,13 +589,24 @@ pub fn analyse_case(
         percentiles: pcts.reports,
         rayleigh,
         gof,
+        // Filled in by the caller from `crate::placement::analyse`.
+        decenter: None,
+        despace: None,
     };
     CaseAnalysis {
         report,
         target: pcts.primary[target_j].clone(),
         target_replicates: boot
+            .as_ref()
             .map(|b| b.quantiles[target_j].clone())
             .unwrap_or_default(),
+        theta: Levels {
+            percentiles: settings.percentiles.clone(),
+            primary: pcts.primary,
+            replicates: boot.map(|b| b.quantiles).unwrap_or_default(),
+        },
+        decenter: None,
+        despace: None,
     }
 }
 

@@ -9,11 +9,14 @@
 //! - `.csv`: a header row, then one row per sample in global index order, with the columns
 //!   [`COLUMNS`]: `index` (global sample index), `case` (case name), `sample` (index within
 //!   the case), `status` (`converged` or `failed`), `theta_p` \[rad\], `tan_theta_x` \[-\],
-//!   `tan_theta_y` \[-\], `iterations` (Newton iterations), `slack_cables` (slack
-//!   tension-only members), `loose_joints` (loose pin joints; empty for models without
-//!   joints), `holding_force` \[N\] (the largest force on a top node that, to first order,
-//!   moves θ_P by at most 1 % and lets no bearing member go; empty where not recorded). A field a sample does not have (the angles of a failed sample) is empty. Case
-//!   names are quoted as RFC 4180 says when they hold a comma, a quote or a line break.
+//!   `tan_theta_y` \[-\], `decenter_x`, `decenter_y`, `decenter`, `despace` \[mm\] (where
+//!   the top surface's centroid sits against the bottom's frame, `truss_core::measure`;
+//!   empty in shards of numerics version 7 or earlier), `iterations` (Newton iterations),
+//!   `slack_cables` (slack tension-only members), `loose_joints` (loose pin joints; empty for
+//!   models without joints), `holding_force` \[N\] (the largest force on a top node that, to
+//!   first order, moves θ_P by at most 1 % and lets no bearing member go; empty where not
+//!   recorded). A field a sample does not have (the angles of a failed sample) is empty.
+//!   Case names are quoted as RFC 4180 says when they hold a comma, a quote or a line break.
 //! - `.jsonl`: one object per sample with the same keys, absent fields as `null`.
 //!
 //! Numbers are the bytes of the shard lines, copied, not reformatted: the shortest
@@ -39,7 +42,7 @@ use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 
 /// The exported columns, in order.
-pub const COLUMNS: [&str; 11] = [
+pub const COLUMNS: [&str; 15] = [
     "index",
     "case",
     "sample",
@@ -47,6 +50,10 @@ pub const COLUMNS: [&str; 11] = [
     "theta_p",
     "tan_theta_x",
     "tan_theta_y",
+    "decenter_x",
+    "decenter_y",
+    "decenter",
+    "despace",
     "iterations",
     "slack_cables",
     "loose_joints",
@@ -329,18 +336,21 @@ mod tests {
     /// case name with a comma and a quote is quoted.
     #[test]
     fn rows_copy_the_bytes() {
-        let line = br#"{"record":"sample","index":12,"case":"a,\"b\"","sample":2,"status":"converged","iterations":3,"theta_p":0.000015191290325887272,"tan_theta_x":-9.12659139265723e-6,"tan_theta_y":1e-5,"residual":7.5e-15,"slack_cables":6,"floating":false,"holding_force":2.5e-9}"#;
+        let line = br#"{"record":"sample","index":12,"case":"a,\"b\"","sample":2,"status":"converged","iterations":3,"theta_p":0.000015191290325887272,"tan_theta_x":-9.12659139265723e-6,"tan_theta_y":1e-5,"decenter_x":0.0041,"decenter_y":-0.0023,"decenter":0.0047,"despace":0.0012,"residual":7.5e-15,"slack_cables":6,"floating":false,"holding_force":2.5e-9}"#;
         let fields = flat_fields(line).unwrap();
         let mut row = Vec::new();
         csv_row(&fields, &mut row);
         assert_eq!(
             String::from_utf8(row).unwrap(),
-            "12,\"a,\"\"b\"\"\",2,converged,0.000015191290325887272,-9.12659139265723e-6,1e-5,3,6,,2.5e-9\n"
+            "12,\"a,\"\"b\"\"\",2,converged,0.000015191290325887272,-9.12659139265723e-6,1e-5,0.0041,-0.0023,0.0047,0.0012,3,6,,2.5e-9\n"
         );
         let failed = br#"{"record":"sample","index":1,"case":"c","sample":1,"status":"failed","iterations":60,"reason":"Newton did not converge, {really}"}"#;
         let mut row = Vec::new();
         csv_row(&flat_fields(failed).unwrap(), &mut row);
-        assert_eq!(String::from_utf8(row).unwrap(), "1,c,1,failed,,,,60,,,\n");
+        assert_eq!(
+            String::from_utf8(row).unwrap(),
+            "1,c,1,failed,,,,,,,,60,,,\n"
+        );
         let mut row = Vec::new();
         json_row(&flat_fields(failed).unwrap(), &mut row);
         let v: serde_json::Value = serde_json::from_slice(&row).unwrap();

@@ -60,6 +60,15 @@
 //!   the relative difference of the Rayleigh and empirical target percentiles (with a bootstrap
 //!   interval) and the max CDF gap; a verdict in words.
 //! - **Loose joints**: fraction of samples with ≥ 1 loose backlash joint (Clopper–Pearson).
+//! - **Decenter and despace** ([`placement`]), where the samples record them (mm): their
+//!   percentiles (of decenter and |despace|) with the same three intervals; decenter's
+//!   Rayleigh law (fit from Σ decenter²/2n, χ²(2n) interval, KS and AD of decenter² against
+//!   the exponential), despace's normal law (folded-normal percentiles of |despace|, KS and
+//!   AD with mean and spread estimated).
+//! - **The budget** ([`budget`]), where the job states one: per case which lines pass and
+//!   the allowable σ meeting every line, `σ·min over lines of limit/q`, with the line that
+//!   binds; per σ-series the same from the lines through the origin. First in the table
+//!   and in `report.md`.
 //!
 //! ## 3. Sweeps ([`sweep`])
 //!
@@ -159,12 +168,14 @@
 
 pub mod analysis;
 pub mod answer;
+pub mod budget;
 pub mod cli;
 pub mod definitions;
 pub mod errors;
 pub mod export;
 pub mod gof;
 pub mod load;
+pub mod placement;
 pub mod plot;
 pub mod rayleigh;
 pub mod readable;
@@ -263,7 +274,15 @@ pub fn build_report_with(
     settings: &Settings,
     progress: &mut dyn FnMut(Progress<'_>),
 ) -> Result<Report, MergeError> {
-    let settings = &settings.validate()?;
+    let mut settings = settings.validate()?;
+    // A budget's percentile is computed with the others (see [`budget`]).
+    if let Some(b) = &dataset.budget
+        && !settings.percentiles.contains(&b.percentile)
+    {
+        settings.percentiles.push(b.percentile);
+        settings.percentiles.sort_by(f64::total_cmp);
+    }
+    let settings = &settings;
     let mut cache = CalibrationCache::default();
     let cases = dataset.cases.len();
     let analyses: Vec<CaseAnalysis> = dataset
@@ -276,12 +295,23 @@ pub fn build_report_with(
                 cases,
                 name: &c.info.name,
             });
-            analyse_case(c, settings, &mut cache)
+            let mut a = analyse_case(c, settings, &mut cache);
+            let (decenter, despace) =
+                placement::analyse(c, settings, &mut cache, &a.report.caveats);
+            a.report.decenter = decenter.as_ref().map(|q| q.report.clone());
+            a.report.despace = despace.as_ref().map(|q| q.report.clone());
+            a.decenter = decenter.map(|q| q.levels);
+            a.despace = despace.map(|q| q.levels);
+            a
         })
         .collect();
     let params: Vec<&BTreeMap<String, f64>> =
         dataset.cases.iter().map(|c| &c.info.parameters).collect();
     let sweep = sweep::sweep(&params, &analyses, settings);
+    let budget = dataset
+        .budget
+        .as_ref()
+        .map(|b| budget::budget_report(b, &params, &analyses, settings));
     let targets: Vec<report::Figure> = analyses.iter().map(|a| a.target.clone()).collect();
     let cases: Vec<report::CaseReport> = analyses.into_iter().map(|a| a.report).collect();
     let answer = answer::answer(&cases, &targets, &sweep, settings);
@@ -309,6 +339,7 @@ pub fn build_report_with(
         cases,
         sweep,
         answer,
+        budget,
     })
 }
 

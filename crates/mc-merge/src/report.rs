@@ -173,6 +173,9 @@ pub struct Report {
     /// The answer drawn from the cases and the sweeps: what the console prints last and the
     /// readable report shows first.
     pub answer: AnswerReport,
+    /// The job's alignment budget, case by case and per σ-series, if it states one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub budget: Option<BudgetReport>,
 }
 
 /// The answer a merge is run for, drawn from the cases and the sweeps of the same report:
@@ -351,6 +354,156 @@ pub struct CaseReport {
     pub rayleigh: RayleighReport,
     /// Goodness of fit of the Rayleigh law.
     pub gof: GofReport,
+    /// Decenter's percentiles and its Rayleigh law; absent where the samples do not record
+    /// it (shards of numerics version 7 or earlier).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub decenter: Option<QuantityReport>,
+    /// |despace|'s percentiles and despace's normal law; absent where not recorded.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub despace: Option<QuantityReport>,
+}
+
+/// A measured quantity beside θ_P (decenter, despace: mm): its percentiles with the same
+/// intervals as θ_P's, the law it follows under small errors, and that law's goodness of fit.
+#[derive(Debug, Clone, Serialize)]
+pub struct QuantityReport {
+    /// `"decenter"` or `"despace"`.
+    pub quantity: &'static str,
+    /// What the percentiles are of: `"decenter"`, or `"|despace|"` (the budget's reading of
+    /// a signed shift).
+    pub of: &'static str,
+    /// `"mm"`.
+    pub unit: &'static str,
+    /// Converged samples that record it.
+    pub n: u64,
+    /// Empirical percentiles with intervals \[mm\].
+    pub percentiles: Vec<PercentileReport>,
+    /// The law under small errors.
+    pub law: LawReport,
+    /// Goodness of fit of the law (KS and AD, parameters estimated, Monte Carlo calibrated).
+    pub gof: GofReport,
+}
+
+/// The law a quantity follows under small errors: Rayleigh for decenter (its two
+/// components, decenter_x and decenter_y, nearly N(0, σ²) each, as tan θ_x and tan θ_y are
+/// for θ_P), normal for despace.
+#[derive(Debug, Clone, Serialize)]
+pub struct LawReport {
+    /// `"rayleigh"` or `"normal"`.
+    pub law: &'static str,
+    /// Mean, standard deviation and zero-mean scale of each component (`decenter_x`,
+    /// `decenter_y`; `despace`) \[mm\].
+    pub components: BTreeMap<&'static str, ComponentReport>,
+    /// The Rayleigh scale σ̂ = √(Σ decenter²/2n) with its χ²(2n) interval \[mm\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sigma: Option<Figure>,
+    /// The normal law's mean (despace's sample mean, Student-t interval) \[mm\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean: Option<Figure>,
+    /// The normal law's standard deviation (χ²(n−1) interval) \[mm\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub std: Option<Figure>,
+    /// The law's percentiles (Rayleigh's eq. 28 at σ̂; for |despace| the folded normal's
+    /// at the mean and standard deviation) beside the empirical ones \[mm\].
+    pub percentiles: Vec<RayleighPercentile>,
+    /// Caveats (the case's).
+    pub caveats: Vec<String>,
+}
+
+/// The job's alignment budget against the Monte Carlo: per case, which lines pass and the
+/// σ that would meet them all; per σ-series, the same from the fitted lines.
+#[derive(Debug, Clone, Serialize)]
+pub struct BudgetReport {
+    /// The percentile every line is read at, in %.
+    pub percentile: Real,
+    /// The lines, in the order θ_P, decenter, despace.
+    pub lines: Vec<BudgetLine>,
+    /// Each case, in job order.
+    pub cases: Vec<BudgetCase>,
+    /// Each σ-series (cases differing only in σ), as in `sweep.sigma_series`.
+    pub series: Vec<BudgetSeries>,
+}
+
+/// One line of a budget.
+#[derive(Debug, Clone, Serialize)]
+pub struct BudgetLine {
+    /// `"theta_p"`, `"decenter"` or `"despace"`.
+    pub quantity: &'static str,
+    /// What its percentile is of: `"θ_P"`, `"decenter"`, `"|despace|"`.
+    pub of: &'static str,
+    /// The limit (rad for θ_P, mm otherwise).
+    pub limit: Real,
+    /// `"rad"` or `"mm"`.
+    pub unit: &'static str,
+}
+
+/// One case against the budget.
+#[derive(Debug, Clone, Serialize)]
+pub struct BudgetCase {
+    /// The case's name.
+    pub case: String,
+    /// Its σ \[mm\] (the `sigma` parameter), if it has one.
+    pub sigma: Option<Real>,
+    /// Each line: the percentile with its interval, and whether it passes.
+    pub lines: Vec<BudgetCaseLine>,
+    /// Whether every line passes (null where some line's percentile is undefined).
+    pub passes: Option<bool>,
+    /// The σ meeting every line by the scaling of each percentile with σ (homogeneity under
+    /// small errors), `σ · min over lines of limit/percentile` \[mm\], with the bootstrap
+    /// interval of that minimum.
+    pub allowable_sigma: Figure,
+    /// The line that binds (the minimum's), if any.
+    pub binding: Option<&'static str>,
+    /// The fraction of bootstrap replicates in which that line binds.
+    pub binding_share: Option<Real>,
+}
+
+/// One line's reading for one case.
+#[derive(Debug, Clone, Serialize)]
+pub struct BudgetCaseLine {
+    /// The quantity.
+    pub quantity: &'static str,
+    /// Its percentile (rad or mm) with the BCa (else percentile) interval.
+    pub value: Figure,
+    /// The limit.
+    pub limit: Real,
+    /// `value / limit` \[-\].
+    pub ratio: Option<Real>,
+    /// Whether the percentile is at or below the limit (null where undefined).
+    pub passes: Option<bool>,
+    /// Whether the whole interval lies on the same side of the limit as the value.
+    pub clear: Option<bool>,
+}
+
+/// One σ-series against the budget.
+#[derive(Debug, Clone, Serialize)]
+pub struct BudgetSeries {
+    /// The series' name, as in `sweep.sigma_series`.
+    pub name: String,
+    /// Its cases, in job order.
+    pub cases: Vec<String>,
+    /// Per line: the fitted line through the origin and where it meets the limit.
+    pub lines: Vec<BudgetSeriesLine>,
+    /// The σ meeting every line, `min over lines of limit/slope` \[mm\], with the bootstrap
+    /// interval from refitting every replicate series.
+    pub allowable_sigma: Figure,
+    /// The line that binds, if any.
+    pub binding: Option<&'static str>,
+    /// The fraction of replicate series in which that line binds.
+    pub binding_share: Option<Real>,
+    /// Whether the allowable σ lies outside the series' σ range.
+    pub extrapolated: bool,
+}
+
+/// One line of a σ-series.
+#[derive(Debug, Clone, Serialize)]
+pub struct BudgetSeriesLine {
+    /// The quantity.
+    pub quantity: &'static str,
+    /// The slope of the percentile against σ, through the origin (rad/mm or mm/mm).
+    pub slope: Figure,
+    /// `limit / slope` \[mm\].
+    pub allowable_sigma: Figure,
 }
 
 /// Failed samples of a case.
@@ -586,14 +739,15 @@ pub struct NullCalibrationReport {
     pub replicates: usize,
 }
 
-/// Effect size of a deviation from the Rayleigh law.
+/// Effect size of a deviation from the law (Rayleigh's for θ_P and decenter, the normal's
+/// for despace).
 #[derive(Debug, Clone, Serialize)]
 pub struct EffectReport {
     /// The percentile compared (the target percentile), in percent.
     pub percentile: Real,
-    /// Rayleigh percentile (rad).
+    /// The law's percentile (rad; mm for decenter and |despace|).
     pub rayleigh: Real,
-    /// Empirical percentile (rad).
+    /// Empirical percentile (rad; mm for decenter and |despace|).
     pub empirical: Real,
     /// (Rayleigh − empirical)/empirical with its bootstrap interval.
     pub relative_difference: Figure,

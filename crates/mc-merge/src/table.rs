@@ -1,4 +1,5 @@
-//! The readable summary printed on stdout: one row per case, then the sweeps and the allowable σ.
+//! The readable summary printed on stdout: the alignment budget when the job states one, one
+//! row per case, then the sweeps and the allowable σ.
 //! Angles in rad and arcsec.
 
 use crate::report::{Figure, Report, short};
@@ -84,6 +85,9 @@ pub fn render(report: &Report, files: usize) -> String {
         set.replicates,
         set.bootstrap_seed
     );
+    if let Some(b) = &report.budget {
+        s.push_str(&budget(b, set.confidence));
+    }
     // One row per case.
     let name_w = report
         .cases
@@ -233,6 +237,104 @@ pub fn render(report: &Report, files: usize) -> String {
             let _ = writeln!(s, "  peak at {} stages", peak.0);
         }
     }
+    s
+}
+
+/// A budget line's number in its unit: arcsec beside rad for θ_P, µm for lengths.
+fn budget_value(quantity: &str, v: f64) -> String {
+    if quantity == "theta_p" {
+        format!("{:.2}\"", v * ARCSEC_PER_RAD)
+    } else {
+        format!("{:.2} µm", v * 1e3)
+    }
+}
+
+/// The budget section, first: the lines, then per case each line's percentile against its
+/// limit, the verdict, and the allowable σ meeting every line with the line that binds; per
+/// σ-series the same from its lines through the origin (see [`crate::budget`]).
+fn budget(b: &crate::report::BudgetReport, confidence: f64) -> String {
+    let mut s = String::new();
+    let lines: Vec<String> = b
+        .lines
+        .iter()
+        .map(|l| format!("{} ≤ {}", l.of, budget_value(l.quantity, l.limit.0)))
+        .collect();
+    let _ = writeln!(
+        s,
+        "budget at the {}th percentile: {}",
+        b.percentile.0,
+        lines.join(", ")
+    );
+    let sigma = |f: &Figure| match (f.get(), f.interval()) {
+        (Some(v), Some((lo, hi))) => format!(
+            "{v:.4e} mm [{lo:.4e}, {hi:.4e}] ({:.0} % CI)",
+            confidence * 100.0
+        ),
+        (Some(v), None) => format!("{v:.4e} mm"),
+        _ => format!("- ({})", f.reason.as_deref().unwrap_or("undefined")),
+    };
+    let binds = |line: Option<&str>, share: Option<crate::report::Real>| match line {
+        Some(l) => format!(
+            "binds: {l}{}",
+            share.map_or(String::new(), |r| format!(
+                " (in {:.0} % of the bootstrap replicates)",
+                r.0 * 100.0
+            ))
+        ),
+        None => "binds: -".into(),
+    };
+    for c in &b.cases {
+        let verdicts: Vec<String> = c
+            .lines
+            .iter()
+            .map(|l| {
+                let v = l
+                    .value
+                    .get()
+                    .map_or("-".into(), |v| budget_value(l.quantity, v));
+                let word = match (l.passes, l.clear) {
+                    (Some(true), Some(false)) => "passes (within its interval)",
+                    (Some(true), _) => "passes",
+                    (Some(false), Some(false)) => "FAILS (within its interval)",
+                    (Some(false), _) => "FAILS",
+                    (None, _) => "undefined",
+                };
+                format!("{} {v} {word}", l.quantity)
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "  {}: {}; {}",
+            c.case,
+            match c.passes {
+                Some(true) => "PASSES",
+                Some(false) => "FAILS",
+                None => "undefined",
+            },
+            verdicts.join(", ")
+        );
+        let _ = writeln!(
+            s,
+            "    allowable σ meeting every line: {}; {}",
+            sigma(&c.allowable_sigma),
+            binds(c.binding, c.binding_share)
+        );
+    }
+    for ser in &b.series {
+        let _ = writeln!(
+            s,
+            "  σ-series [{}]: allowable σ meeting every line {}; {}{}",
+            ser.name,
+            sigma(&ser.allowable_sigma),
+            binds(ser.binding, ser.binding_share),
+            if ser.extrapolated {
+                "  [extrapolated beyond the σ range]"
+            } else {
+                ""
+            }
+        );
+    }
+    s.push('\n');
     s
 }
 

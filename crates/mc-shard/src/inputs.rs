@@ -11,7 +11,7 @@
 //! | `index` | global sample index (the shard lines' `index`) | |
 //! | `case` | case name | |
 //! | `sample` | index within the case | |
-//! | `length_error:ID` | member ID's drawn length error (natural minus nominal length), one column per member | mm |
+//! | `length_error:ID` | member ID's drawn length error (natural minus nominal length; its own part plus its production lot's shared part where its group has one, see `truss_job::lot`), one column per member | mm |
 //! | `clearance:ID` | joint ID's drawn clearance, one column per joint of a case that draws clearances | mm |
 //!
 //! Members and joints appear in model order; when the cases chosen have different models,

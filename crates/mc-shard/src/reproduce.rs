@@ -3,7 +3,10 @@
 //!
 //! ## Detail (JSON)
 //!
-//! `line` (the shard's line, byte for byte, without its newline), `length_errors` (mm per
+//! `line` (the shard's line, byte for byte, without its newline), when it converged
+//! `measured` (its `theta_p` \[rad\], `tan_theta_x`, `tan_theta_y`, and where the top
+//! surface sits against the bottom: `decenter_x`, `decenter_y`, `decenter`, `despace` \[mm\],
+//! see `truss_core::measure`), `length_errors` (mm per
 //! member id, model order, as drawn), `clearances` (mm per joint id, when the case draws
 //! backlash clearances), `iterations` (per Newton iteration: out-of-balance
 //! force \[N\], step \[mm\], line-search α, whether the tangent was factorised afresh, the slack
@@ -18,9 +21,22 @@ use serde::Serialize;
 use truss_core::SolveOptions;
 use truss_core::output::{EquilibriumById, IterationLine, Ordered, UNITS, Units};
 
+/// What a converged sample measured, as its line holds it.
+#[derive(Serialize)]
+struct Measured {
+    theta_p: f64,
+    tan_theta_x: f64,
+    tan_theta_y: f64,
+    #[serde(flatten)]
+    placement: truss_core::Placement,
+}
+
 #[derive(Serialize)]
 struct Detail<'a> {
     line: &'a str,
+    /// θ_P, the tangents \[rad, -\], decenter and despace \[mm\], when it converged.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    measured: Option<Measured>,
     units: Units,
     length_errors: Ordered<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -49,8 +65,23 @@ pub fn reproduce(job: &Job, c: usize, k: u64, detail: bool) -> String {
     let solver = worker.solver(c).expect("the worker solved this case");
     let member_id = |m: usize| model.members()[m].id.clone();
     let converged = sample.angles().is_some();
+    let measured = match (sample.angles(), sample.placement()) {
+        (Some(a), Some(p)) => Some(Measured {
+            theta_p: a.theta_p,
+            tan_theta_x: a.tan_theta_x,
+            tan_theta_y: a.tan_theta_y,
+            placement: truss_core::Placement {
+                decenter_x: p.decenter_x,
+                decenter_y: p.decenter_y,
+                decenter: p.decenter,
+                despace: p.despace,
+            },
+        }),
+        _ => None,
+    };
     let detail = Detail {
         line: line.trim_end(),
+        measured,
         units: UNITS,
         length_errors: Ordered(
             worker

@@ -46,8 +46,8 @@ pub enum Opened {
     Complete {
         /// The file.
         path: PathBuf,
-        /// Its verified contents.
-        scan: ShardScan,
+        /// Its verified contents (boxed: a header is far larger than a writer).
+        scan: Box<ShardScan>,
     },
     /// A writer positioned at the next sample to compute.
     Writer(ShardWriter),
@@ -121,7 +121,10 @@ impl ShardWriter {
             return Err(ShardError::HeaderMismatch { path });
         }
         if matches!(scan.tail, Tail::Complete(_)) {
-            return Ok(Opened::Complete { path, scan });
+            return Ok(Opened::Complete {
+                path,
+                scan: Box::new(scan),
+            });
         }
         if scan.begin.checkpoint_every.is_none() {
             return Err(ShardError::OldFormat {
@@ -261,6 +264,17 @@ pub fn begin(job: &crate::job::Job, range: ShardRange) -> Begin {
         case_infos(job),
     )
     .with_checkpoints(CHECKPOINT_EVERY)
+    .with_budget(budget(job))
+}
+
+/// The job's alignment budget as a shard header carries it (rad, mm).
+pub fn budget(job: &crate::job::Job) -> Option<shard_record::Budget> {
+    job.budget.map(|b| shard_record::Budget {
+        percentile: b.percentile,
+        theta_p: b.theta_p,
+        decenter: b.decenter,
+        despace: b.despace,
+    })
 }
 
 /// The job's cases as a shard header lists them.

@@ -21,13 +21,23 @@
 //!    `job_samples`, `cases`: every case of the job (not only those in this range) with its
 //!    `name`, the global index of its first sample `start`, its `samples` count and `parameters`,
 //!    named numbers that describe the case for sweeps (for example `sigma` in mm, `stages`),
-//!    and `checkpoint_every` (N, 1 ≤ N ≤ [`MAX_CHECKPOINT_EVERY`]; mc-shard writes
-//!    [`CHECKPOINT_EVERY`]).
+//!    `checkpoint_every` (N, 1 ≤ N ≤ [`MAX_CHECKPOINT_EVERY`]; mc-shard writes
+//!    [`CHECKPOINT_EVERY`]), and, when the job states an alignment budget, `budget`
+//!    ([`Budget`]: `percentile` in %, and one or more of `theta_p` \[rad\], `decenter` \[mm\]
+//!    and `despace` \[mm, of |despace|\], the limits each quantity's percentile must stay
+//!    within).
 //! 2. One `sample` line ([`Sample`]) for each global index of the range, in increasing order
 //!    with no gaps: `index` (global), `case` (name), `sample` (index within the case),
 //!    `status` (`"converged"` or `"failed"`), `iterations` (Newton iterations), and
 //!    - when converged: `theta_p`, `tan_theta_x`, `tan_theta_y` (rad and dimensionless, paper
-//!      eqs. 2, 8, 9), `residual` (final out-of-balance force, N), optionally `slack_cables`
+//!      eqs. 2, 8, 9), `decenter_x`, `decenter_y`, `decenter` and `despace` (mm: the top
+//!      surface centroid's displacement relative to the bottom's, in the bottom's frame:
+//!      its two components in the bottom plane, their magnitude, and its component along
+//!      the bottom's normal, signed; `δ = (u₁ + u₂ + u₃)/3 − Σ s_k/m` over the top surface's
+//!      nodes and the supported ones, `decenter_x = δ·e_x`, `decenter_y = δ·e_y`,
+//!      `decenter = √(decenter_x² + decenter_y²)`, `despace = δ·n_b`: see
+//!      `truss_core::measure`; written by numerics version 8 and later, absent from older
+//!      shards), `residual` (final out-of-balance force, N), optionally `slack_cables`
 //!      (how many tension-only members ended slack), `loose_joints` (backlash joints whose
 //!      virtual cable ended slack) and `floating` (`true` when some stage's tilt is held by
 //!      pretension alone, not by the members that bear; written for models whose bars do
@@ -61,7 +71,7 @@
 //!
 //! ```text
 //! {"record":"begin","format":"truss-mc-shard","format_version":2,"program":"mc-shard","program_version":"0.1.0","job_id":"6f1e…","range":{"start":0,"end":2},"job_samples":2,"cases":[{"name":"sigma-0.0063","start":0,"samples":2,"parameters":{"sigma":0.0063,"stages":5.0}}],"checkpoint_every":100}
-//! {"record":"sample","index":0,"case":"sigma-0.0063","sample":0,"status":"converged","iterations":3,"theta_p":4.1e-5,"tan_theta_x":-2.2e-5,"tan_theta_y":3.5e-5,"residual":2.1e-11,"slack_cables":4}
+//! {"record":"sample","index":0,"case":"sigma-0.0063","sample":0,"status":"converged","iterations":3,"theta_p":4.1e-5,"tan_theta_x":-2.2e-5,"tan_theta_y":3.5e-5,"decenter_x":0.0041,"decenter_y":-0.0023,"decenter":0.0047,"despace":0.0012,"residual":2.1e-11,"slack_cables":4}
 //! {"record":"sample","index":1,"case":"sigma-0.0063","sample":1,"status":"failed","iterations":60,"reason":"Newton did not converge in 60 iterations (residual 3.2e-4 N)"}
 //! {"record":"end","samples":2,"failed":1,"sha256":"9b0c…","begin_sha256":"41d7…"}
 //! ```
@@ -114,7 +124,8 @@ pub use range::{ShardRange, ShardRangeError};
 /// to put cases on a curve. The job crate writes them (a pipeline test checks that it writes
 /// no other key).
 pub mod parameters {
-    /// The largest standard deviation of the case's length-error distributions \[mm\].
+    /// The largest standard deviation of the case's length errors, a group's own and lot
+    /// parts together \[mm\].
     pub const SIGMA: &str = "sigma";
     /// The prism's stage count.
     pub const STAGES: &str = "stages";
@@ -129,8 +140,12 @@ pub mod parameters {
     /// The cables' compression stiffness over their tension stiffness, written only where it
     /// is not the default 0 (the limit; cases differing in it form their own series).
     pub const CABLE_COMPRESSION_RATIO: &str = "cable_compression_ratio";
+    /// The largest share of a member's length-error variance held by its production lot's
+    /// shared part, `σ_lot²/(σ_lot² + σ_part²)`, written only for cases whose groups have
+    /// lots (cases differing in it form their own series).
+    pub const LOT_SHARE: &str = "lot_share";
     /// Every key, in the order above.
-    pub const ALL: [&str; 7] = [
+    pub const ALL: [&str; 8] = [
         SIGMA,
         STAGES,
         UNIFORM,
@@ -138,6 +153,7 @@ pub mod parameters {
         BACKLASH,
         JOINT_COMPRESSION_RATIO,
         CABLE_COMPRESSION_RATIO,
+        LOT_SHARE,
     ];
 }
 pub use scan::{ScanError, ShardScan, Tail, parse_record, read_line, read_shard, scan_shard};
@@ -215,6 +231,68 @@ pub struct Begin {
     /// version 1).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub checkpoint_every: Option<u64>,
+    /// The job's alignment budget, if it states one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget: Option<Budget>,
+}
+
+/// A job's alignment budget: each quantity's `percentile`-th percentile must stay within its
+/// limit (a line per quantity; at least one).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Budget {
+    /// The percentile every line is read at, in % (0 < p < 100).
+    pub percentile: f64,
+    /// θ_P's limit \[rad\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta_p: Option<f64>,
+    /// `decenter`'s limit \[mm\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decenter: Option<f64>,
+    /// The limit of `|despace|` \[mm\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub despace: Option<f64>,
+}
+
+impl Budget {
+    /// The lines in the order θ_P, decenter, despace: (quantity name, limit).
+    pub fn lines(&self) -> Vec<(&'static str, f64)> {
+        [
+            ("theta_p", self.theta_p),
+            ("decenter", self.decenter),
+            ("despace", self.despace),
+        ]
+        .into_iter()
+        .filter_map(|(q, l)| Some((q, l?)))
+        .collect()
+    }
+
+    /// Checks the budget: a percentile in (0, 100), at least one line, every limit finite
+    /// and positive (θ_P's below π/2 rad).
+    pub fn check(&self) -> Result<(), String> {
+        if !(self.percentile > 0.0 && self.percentile < 100.0) {
+            return Err(format!(
+                "budget percentile {} is not in (0, 100)",
+                self.percentile
+            ));
+        }
+        if self.lines().is_empty() {
+            return Err("a budget needs at least one line".into());
+        }
+        for (q, l) in self.lines() {
+            let most = if q == "theta_p" {
+                std::f64::consts::FRAC_PI_2
+            } else {
+                f64::INFINITY
+            };
+            if !(l > 0.0 && l < most) {
+                return Err(format!(
+                    "budget line {q}: limit {l} is not a positive number"
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// One case of a job, as the header describes it.
@@ -273,6 +351,18 @@ pub struct Sample {
     /// tan θ_y of the top surface (paper eq. 9) \[-\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tan_theta_y: Option<f64>,
+    /// The top centroid's shift along the bottom frame's first in-plane axis \[mm\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decenter_x: Option<f64>,
+    /// The top centroid's shift along the bottom frame's second in-plane axis \[mm\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decenter_y: Option<f64>,
+    /// `√(decenter_x² + decenter_y²)` \[mm\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decenter: Option<f64>,
+    /// The top centroid's displacement along the bottom's normal, signed \[mm\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub despace: Option<f64>,
     /// Final out-of-balance force, max norm over free DOFs \[N\].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub residual: Option<f64>,
@@ -294,6 +384,19 @@ pub struct Sample {
     /// Why the solve failed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+}
+
+/// Where a converged sample's top surface sits against the bottom (mm).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placement {
+    /// `decenter_x` \[mm\].
+    pub decenter_x: f64,
+    /// `decenter_y` \[mm\].
+    pub decenter_y: f64,
+    /// `decenter` \[mm\].
+    pub decenter: f64,
+    /// `despace` \[mm\].
+    pub despace: f64,
 }
 
 /// The angles of a converged sample.
@@ -329,6 +432,30 @@ impl Sample {
         }
     }
 
+    /// The placement, if the sample converged and all four fields are present and finite
+    /// (absent from the lines of numerics versions before 8).
+    pub fn placement(&self) -> Option<Placement> {
+        match (
+            self.status,
+            self.decenter_x,
+            self.decenter_y,
+            self.decenter,
+            self.despace,
+        ) {
+            (Status::Converged, Some(x), Some(y), Some(d), Some(z))
+                if x.is_finite() && y.is_finite() && d.is_finite() && z.is_finite() =>
+            {
+                Some(Placement {
+                    decenter_x: x,
+                    decenter_y: y,
+                    decenter: d,
+                    despace: z,
+                })
+            }
+            _ => None,
+        }
+    }
+
     /// Refuses a converged sample whose θ_P is not an angle between the surfaces, in
     /// \[0, π/2\] rad (the tangents are finite: [`Sample::angles`]). Its digests may well
     /// verify (a line rewritten with fresh ones): a θ_P of 1e308 would otherwise wreck every
@@ -345,9 +472,19 @@ impl Sample {
     }
 
     /// Checks that the fields present agree with `status`: a converged sample carries three
-    /// finite angles with θ_P ≥ 0, and a holding force, where it has one, finite and ≥ 0; a
-    /// failed one carries a reason.
+    /// finite angles with θ_P ≥ 0, a holding force, where it has one, finite and ≥ 0, and
+    /// the four placement fields all or none, finite, with `decenter` ≥ 0; a failed one
+    /// carries a reason.
     pub fn check(&self) -> Result<(), String> {
+        let placement_fields = [
+            self.decenter_x,
+            self.decenter_y,
+            self.decenter,
+            self.despace,
+        ]
+        .iter()
+        .filter(|f| f.is_some())
+        .count();
         match self.status {
             Status::Converged => match self.angles() {
                 Some(_)
@@ -356,6 +493,15 @@ impl Sample {
                         .is_some_and(|f| !(f.is_finite() && f >= 0.0)) =>
                 {
                     Err("holding_force must be a finite number of newtons ≥ 0".into())
+                }
+                Some(_) if placement_fields != 0 && placement_fields != 4 => {
+                    Err("decenter_x, decenter_y, decenter and despace come all four or none".into())
+                }
+                Some(_)
+                    if placement_fields == 4
+                        && self.placement().is_none_or(|p| p.decenter < 0.0) =>
+                {
+                    Err("decenter_x, decenter_y, despace must be finite mm and decenter ≥ 0".into())
                 }
                 Some(a) if a.theta_p >= 0.0 => Ok(()),
                 Some(_) => Err("theta_p is negative".into()),
@@ -514,7 +660,14 @@ impl Begin {
             job_samples,
             cases,
             checkpoint_every: None,
+            budget: None,
         }
+    }
+
+    /// This header with the job's alignment budget.
+    pub fn with_budget(mut self, budget: Option<Budget>) -> Self {
+        self.budget = budget;
+        self
     }
 
     /// This header in the current format version ([`FORMAT_VERSION`]) with a checkpoint
@@ -526,12 +679,14 @@ impl Begin {
     }
 
     /// Whether `self` describes the same job and shard as `other`: job id, range, sample
-    /// count and cases with their parameters (not the writer, its version, or the format).
+    /// count, cases with their parameters and the budget (not the writer, its version, or
+    /// the format).
     pub fn same_shard(&self, other: &Begin) -> bool {
         self.job_id == other.job_id
             && self.range == other.range
             && self.job_samples == other.job_samples
             && self.cases == other.cases
+            && self.budget == other.budget
     }
 
     /// Checks the header's own consistency: format name and version, job id shape, the
@@ -571,6 +726,9 @@ impl Begin {
                 "job_id {:?} is not 64 lower-case hex digits",
                 self.job_id
             ));
+        }
+        if let Some(b) = &self.budget {
+            b.check()?;
         }
         if self.range.start > self.range.end || self.range.end > self.job_samples {
             return Err(format!(

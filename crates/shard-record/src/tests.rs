@@ -44,6 +44,10 @@ fn sample(index: u64, theta: f64) -> Sample {
         theta_p: Some(theta),
         tan_theta_x: Some(-theta / 2.0),
         tan_theta_y: Some(theta / 3.0),
+        decenter_x: Some(3.0 * theta),
+        decenter_y: Some(-4.0 * theta),
+        decenter: Some(5.0 * theta),
+        despace: Some(-theta),
         residual: Some(1e-12),
         slack_cables: Some(2),
         loose_joints: None,
@@ -235,5 +239,94 @@ proptest! {
         let min = parts.iter().map(|r| r.len()).min().unwrap();
         let max = parts.iter().map(|r| r.len()).max().unwrap();
         prop_assert!(max - min <= 1);
+    }
+}
+
+/// The four placement fields come all or none, finite, with decenter ≥ 0; a sample without
+/// them (a shard of numerics 7 or earlier) still checks, with no placement.
+#[test]
+fn placement_fields_are_checked() {
+    let good = sample(0, 1e-5);
+    good.check().unwrap();
+    assert_eq!(good.placement().unwrap().decenter, 5e-5);
+    let without = Sample {
+        decenter_x: None,
+        decenter_y: None,
+        decenter: None,
+        despace: None,
+        ..good.clone()
+    };
+    without.check().unwrap();
+    assert!(without.placement().is_none());
+    let partial = Sample {
+        despace: None,
+        ..good.clone()
+    };
+    assert!(partial.check().unwrap_err().contains("all four or none"));
+    let negative = Sample {
+        decenter: Some(-1e-5),
+        ..good.clone()
+    };
+    assert!(negative.check().unwrap_err().contains("decenter ≥ 0"));
+    let infinite = Sample {
+        decenter_x: Some(f64::INFINITY),
+        ..good
+    };
+    assert!(infinite.check().is_err());
+}
+
+/// A budget round-trips in the begin line, is checked with the header, and is part of what
+/// makes two headers the same shard.
+#[test]
+fn budgets_ride_in_the_begin_line() {
+    let budget = Budget {
+        percentile: 95.0,
+        theta_p: Some(9.6963e-5),
+        decenter: Some(0.05),
+        despace: None,
+    };
+    let b = begin(ShardRange::new(0, 8)).with_budget(Some(budget));
+    b.check().unwrap();
+    let line = to_line(&Record::Begin(b.clone()));
+    assert!(
+        line.contains(r#""budget":{"percentile":95.0,"theta_p":0.000096963,"decenter":0.05}"#),
+        "{line}"
+    );
+    match parse_record(line.trim_end().as_bytes()).unwrap() {
+        Record::Begin(back) => assert_eq!(back, b),
+        other => panic!("{other:?}"),
+    }
+    assert!(!b.same_shard(&begin(ShardRange::new(0, 8))));
+    assert_eq!(
+        budget.lines(),
+        vec![("theta_p", 9.6963e-5), ("decenter", 0.05)]
+    );
+    for bad in [
+        Budget {
+            percentile: 100.0,
+            ..budget
+        },
+        Budget {
+            decenter: Some(0.0),
+            ..budget
+        },
+        Budget {
+            theta_p: Some(f64::NAN),
+            ..budget
+        },
+        Budget {
+            theta_p: None,
+            decenter: None,
+            despace: None,
+            ..budget
+        },
+    ] {
+        assert!(
+            begin(ShardRange::new(0, 8))
+                .with_budget(Some(bad))
+                .check()
+                .is_err(),
+            "{bad:?}"
+        );
     }
 }

@@ -6,6 +6,7 @@
 //! {
 //!   "converged": true, "iterations": 5, "factorisations": 2, "residual": 2.1e-13,
 //!   "theta_p": 2.94e-5, "tan_theta_x": -2.55e-5, "tan_theta_y": -1.47e-5,
+//!   "decenter_x": 0.0402, "decenter_y": 0.0232, "decenter": 0.0464, "despace": 0.0033,
 //!   "units": {"length": "mm", "force": "N", "angle": "rad"},
 //!   "displacements": {"n1.0": [0.0, 0.0, 0.0094], …},
 //!   "forces": {"batten.0.0": -0.31, …},
@@ -20,7 +21,9 @@
 //! member's free play, one of the positions the statics leaves open).
 //!
 //! Displacements are in mm per node id, forces in N per member id (tension positive), both
-//! in model order. The angles are absent when the model names no top surface. A failed
+//! in model order. `decenter_x`, `decenter_y`, `decenter` and `despace` (mm) say where the top
+//! surface's centroid sits against the bottom's frame (see `truss_core::measure`). The angles
+//! and these four are absent when the model names no top surface. A failed
 //! solve prints `"converged": false` with `"error"`, and exits with code 7 (failed samples).
 
 use crate::CliError;
@@ -29,7 +32,7 @@ use serde::Serialize;
 use std::io::Write;
 use std::path::PathBuf;
 use truss_core::output::{EquilibriumById, IterationLine, UNITS, Units};
-use truss_core::{Model, SolveOptions, Solver};
+use truss_core::{Model, Placement, SolveOptions, Solver};
 
 /// Options of `truss solve`.
 #[derive(Debug, Args)]
@@ -70,6 +73,10 @@ pub struct SolveOutput {
     /// tan θ_y.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub tan_theta_y: Option<f64>,
+    /// The top surface's decenter and despace \[mm\] (`decenter_x`, `decenter_y`,
+    /// `decenter`, `despace`; see `truss_core::measure`).
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    pub placement: Option<Placement>,
     /// Units.
     pub units: Units,
     /// The equilibrium by id: displacements, forces, slack cables, joints.
@@ -141,6 +148,7 @@ pub fn run(args: &SolveArgs, out: &mut dyn Write) -> Result<(), CliError> {
                 theta_p: d.map(|d| d.theta_p),
                 tan_theta_x: d.map(|d| d.tan_theta_x),
                 tan_theta_y: d.map(|d| d.tan_theta_y),
+                placement: truss_core::output::placement(&model, &solver),
                 units: UNITS,
                 equilibrium: Some(EquilibriumById::of(&model, &solver)),
                 iteration_log: log,
@@ -155,6 +163,7 @@ pub fn run(args: &SolveArgs, out: &mut dyn Write) -> Result<(), CliError> {
             theta_p: None,
             tan_theta_x: None,
             tan_theta_y: None,
+            placement: None,
             units: UNITS,
             equilibrium: None,
             iteration_log: log,

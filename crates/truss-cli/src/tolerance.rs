@@ -104,6 +104,32 @@ pub fn run(args: &ToleranceArgs, out: &mut dyn Write) -> Result<(), CliError> {
         t.uniform_sigma,
         t.cost_ratio()
     )?;
+    if let Some(b) = &t.budget {
+        for (quantity, limit, p, passes) in &b.lines {
+            writeln!(
+                out,
+                "budget {quantity}{}: {:.4e} [{:.4e}, {:.4e}], limit {limit:.4e}: {}",
+                b.percentile,
+                p.theta,
+                p.interval.0,
+                p.interval.1,
+                if *passes { "passes" } else { "FAILS" }
+            )?;
+        }
+        let sigmas: Vec<String> = t
+            .groups
+            .iter()
+            .zip(&b.sigmas)
+            .map(|(g, s)| format!("{} {s:.4e} mm", g.name))
+            .collect();
+        writeln!(
+            out,
+            "budget: every line met at {:.4} x the allocated sigma ({}); binds: {}",
+            b.scale,
+            sigmas.join(", "),
+            b.binding
+        )?;
+    }
     for f in &t.files {
         writeln!(out, "wrote {}", f.display())?;
     }

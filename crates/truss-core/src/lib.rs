@@ -64,6 +64,14 @@
 //! angle of 1e-5 rad), with `tan θ_x = −n_tx/n_tz` and `tan θ_y = −n_ty/n_tz` (eqs. 6, 8, 9).
 //! See [`measure`].
 //!
+//! ## Decenter and despace
+//!
+//! The top centroid's displacement against the bottom's (the supported nodes'),
+//! `δ = (u₁ + u₂ + u₃)/3 − Σ s_k/m` \[mm\], in the bottom's frame: `decenter_x = δ·e_x`,
+//! `decenter_y = δ·e_y` (the shift in the bottom plane, `e_x`, `e_y` perpendicular to `n_b`),
+//! `decenter = √(decenter_x² + decenter_y²)`, and `despace = δ·n_b` (along the normal,
+//! signed). See [`measure::placement`] and [`output::placement`].
+//!
 //! ## Reproducibility
 //!
 //! The solver uses only IEEE-754 arithmetic in a fixed order, a block-banded Cholesky of
@@ -89,7 +97,7 @@ pub mod solver;
 mod structure;
 
 pub use errors::{InputRefusal, ModelError, SolveError, readable};
-pub use measure::{Distortion, distortion};
+pub use measure::{Distortion, Placement, distortion, placement};
 pub use model::{Behaviour, Joint, Member, Model, Node, TopSurface};
 pub use model_file::ModelFile;
 pub use solver::{Equilibrium, IterationRecord, SolveOptions, SolveReport, Solver};

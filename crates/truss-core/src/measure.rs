@@ -15,8 +15,45 @@
 //! displacements are not rounded against the 380 mm coordinates.
 //!
 //! `atan2` is the pure-Rust `libm` implementation, so θ_P has the same bits on every machine.
+//!
+//! ## Decenter and despace
+//!
+//! The image of a telescope whose optical bench this is also moves when the top surface
+//! shifts sideways against the bottom's axis (decenter) and when the distance between them
+//! changes (despace). With the top surface's three nodes' displacements `u₁, u₂, u₃` and the
+//! supported nodes' (every node with a fixed direction: the bottom) `s₁ … s_m`, the top
+//! centroid's displacement relative to the bottom's is
+//!
+//! ```text
+//! δ = (u₁ + u₂ + u₃)/3 − (s₁ + … + s_m)/m                  (0 for the second term when m = 0) [mm]
+//! decenter_x = δ·e_x,   decenter_y = δ·e_y                  the shift in the bottom plane [mm]
+//! decenter   = √(decenter_x² + decenter_y²)                                              [mm]
+//! despace    = δ·n_b                                        along the bottom's normal, signed:
+//!                                                           positive when the top moves away [mm]
+//! ```
+//!
+//! The frame is the bottom's: its normal `n_b` is the reference normal θ_P is measured
+//! against, `e_x` is the model's x axis made perpendicular to it,
+//! `e_x = (x̂ − (x̂·n_b) n_b)/|…|` (the y axis instead where `|x̂·n_b| > 0.9`), and
+//! `e_y = n_b × e_x`; for `n_b = ẑ` (the paper's prism) `e_x = x̂` and `e_y = ŷ`. Its origin
+//! follows the supported nodes' centroid, so that a support that lets a node slide moves
+//! the frame with it; it does not turn with them, as θ_P's `n_b` does not. For the prism,
+//! whose bottom nodes are fixed, the second term is 0 and δ is the top centroid's own
+//! displacement. Only displacements enter (never the 380 mm coordinates), so the
+//! micrometres keep their digits. Under small errors δ is linear in them: decenter_x and
+//! decenter_y are nearly normal with a common spread where the truss is symmetric under a
+//! rotation about its axis (the prism's 120°), so decenter is nearly Rayleigh, the paper's
+//! eq. 28 argument for θ_P applied to the centroid's two components; despace is nearly
+//! normal.
+//!
+//! Both are measured from the model's coordinates, as θ_P is, so they include what the
+//! error-free structure already does under its pretension and effects: the prism's
+//! pretensioned diagonals compress its longerons, so that with no length error at all the
+//! top sits lower by 0.94 µm (5 stages, Table 1) or 5.58 µm (30 stages), by symmetry with
+//! no decenter and no tilt. That offset is in every sample's despace and in its mean.
 
 use crate::element::{add, dot, norm, sub};
+use serde::Serialize;
 
 /// The tilt of a surface against a reference normal.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,6 +66,62 @@ pub struct Distortion {
     pub tan_theta_y: f64,
     /// The unit normal of the deformed surface.
     pub normal: [f64; 3],
+}
+
+/// Where the top surface's centroid sits against the bottom's frame (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Placement {
+    /// The centroid's shift along the bottom frame's `e_x` \[mm\].
+    pub decenter_x: f64,
+    /// The centroid's shift along the bottom frame's `e_y` \[mm\].
+    pub decenter_y: f64,
+    /// `√(decenter_x² + decenter_y²)` \[mm\].
+    pub decenter: f64,
+    /// The centroid's displacement along the bottom's normal `n_b`, signed \[mm\].
+    pub despace: f64,
+}
+
+/// The bottom frame's in-plane axes `(e_x, e_y)` for its unit normal `n_b` (see the module
+/// doc): `e_x` the x axis made perpendicular to `n_b` (the y axis where `|x̂·n_b| > 0.9`),
+/// `e_y = n_b × e_x`.
+pub fn in_plane_axes(n_b: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let axis = if n_b[0].abs() > 0.9 {
+        [0.0, 1.0, 0.0]
+    } else {
+        [1.0, 0.0, 0.0]
+    };
+    let along = dot(axis, n_b);
+    let v = [
+        axis[0] - along * n_b[0],
+        axis[1] - along * n_b[1],
+        axis[2] - along * n_b[2],
+    ];
+    let l = norm(v);
+    let e_x = [v[0] / l, v[1] / l, v[2] / l];
+    (e_x, cross(n_b, e_x))
+}
+
+/// The placement of the surface whose three nodes are displaced by `top` against the frame
+/// of the bottom, whose supported nodes are displaced by `bottom` (both \[mm\]; `bottom` may
+/// be empty), with unit normal `n_b` (see the module doc).
+pub fn placement(top: [[f64; 3]; 3], bottom: &[[f64; 3]], n_b: [f64; 3]) -> Placement {
+    let centroid = |points: &[[f64; 3]]| {
+        let mut c = [0.0; 3];
+        for p in points {
+            c = add(c, *p);
+        }
+        let n = points.len().max(1) as f64;
+        [c[0] / n, c[1] / n, c[2] / n]
+    };
+    let delta = sub(centroid(&top), centroid(bottom));
+    let (e_x, e_y) = in_plane_axes(n_b);
+    let (decenter_x, decenter_y) = (dot(delta, e_x), dot(delta, e_y));
+    Placement {
+        decenter_x,
+        decenter_y,
+        decenter: decenter_x.hypot(decenter_y),
+        despace: dot(delta, n_b),
+    }
 }
 
 /// Cross product.
@@ -96,6 +189,49 @@ pub fn theta_gradient(x: [[f64; 3]; 3], u: [[f64; 3]; 3], n_b: [f64; 3]) -> Opti
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// By hand: a top centroid displaced by (3, −4, 2) µm over a fixed bottom has decenter
+    /// (3, −4), 5 µm, and despace 2 µm; a bottom that slides by the same vector moves the
+    /// frame with it (nothing left); a tilted reference normal keeps the frame orthonormal,
+    /// and δ's components in it have δ's length.
+    #[test]
+    fn placement_by_hand() {
+        let d = [0.003, -0.004, 0.002];
+        // Three nodes whose mean is d, none equal to it.
+        let top = [
+            [0.001, -0.004, 0.005],
+            [0.004, -0.006, 0.0],
+            [0.004, -0.002, 0.001],
+        ];
+        let p = placement(top, &[], [0.0, 0.0, 1.0]);
+        assert!((p.decenter_x - d[0]).abs() < 1e-18, "{p:?}");
+        assert!((p.decenter_y - d[1]).abs() < 1e-18, "{p:?}");
+        assert!((p.decenter - 0.005).abs() < 1e-17, "{p:?}");
+        assert!((p.despace - d[2]).abs() < 1e-18, "{p:?}");
+        let moved = placement(top, &[d, d], [0.0, 0.0, 1.0]);
+        assert!(
+            moved.decenter < 1e-18 && moved.despace.abs() < 1e-18,
+            "{moved:?}"
+        );
+        let nb = {
+            let v: [f64; 3] = [0.3, -0.2, 1.0];
+            let l = norm(v);
+            [v[0] / l, v[1] / l, v[2] / l]
+        };
+        let (ex, ey) = in_plane_axes(nb);
+        for (a, b) in [(ex, ex), (ey, ey), (nb, nb)] {
+            assert!((dot(a, b) - 1.0).abs() < 1e-15);
+        }
+        for (a, b) in [(ex, ey), (ex, nb), (ey, nb)] {
+            assert!(dot(a, b).abs() < 1e-15);
+        }
+        let t = placement(top, &[], nb);
+        let length = (t.decenter * t.decenter + t.despace * t.despace).sqrt();
+        assert!((length - norm(d)).abs() < 1e-17, "{t:?}");
+        // A normal along x takes the y axis for e_x.
+        let (ex, _) = in_plane_axes([1.0, 0.0, 0.0]);
+        assert_eq!(ex, [0.0, 1.0, 0.0]);
+    }
 
     /// [`theta_gradient`] against central differences of [`distortion`] on a tilted,
     /// displaced triangle and a reference normal off the axes.

@@ -1,9 +1,11 @@
 //! An equilibrium as the tools print it, by id: every node's displacement \[mm\], every
 //! member's axial force \[N, tension positive\], the slack cables, each backlash joint's state,
-//! and the Newton iterations. `truss solve` and `mc-shard reproduce --detail` both print
-//! these types, so they cannot drift apart.
+//! and the Newton iterations; and where the top surface sits against the bottom
+//! ([`placement`]: decenter and despace). `truss solve` and `mc-shard reproduce --detail`
+//! both print these types, so they cannot drift apart.
 
 use crate::joint::JointSummary;
+use crate::measure::Placement;
 use crate::solver::IterationRecord;
 use crate::{Model, Solver};
 use serde::Serialize;
@@ -77,6 +79,23 @@ impl EquilibriumById {
             joints: (!model.joints().is_empty()).then(|| Ordered(solver.joint_summaries())),
         }
     }
+}
+
+/// The top surface's decenter and despace against the bottom's frame at the last
+/// equilibrium of `solver`, a solver of `model`: the bottom is the model's supported nodes
+/// (every node with a fixed direction), the frame's normal the top surface's reference
+/// normal (see [`crate::measure`]); `None` where the model names no top surface.
+pub fn placement(model: &Model, solver: &Solver) -> Option<Placement> {
+    let top = model.top_surface()?;
+    let bottom: Vec<[f64; 3]> = (0..model.nodes().len())
+        .filter(|&i| model.fixed(i).contains(&true))
+        .map(|i| solver.displacement(i))
+        .collect();
+    Some(crate::measure::placement(
+        top.nodes.map(|i| solver.displacement(i)),
+        &bottom,
+        top.reference_normal,
+    ))
 }
 
 /// One Newton iteration, with member ids.

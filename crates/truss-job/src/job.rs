@@ -25,8 +25,10 @@
 //! | `cases[].samples` | ≥ 1 |
 //! | `cases[].model` | optional: this case's own model, same forms as `model` |
 //! | `cases[].length_errors` | per member group, a distribution of the length error (natural length minus nominal, mm): `{"normal": {"sigma": s}}` (optional `"mean"`), `{"uniform": {"low": a, "high": b}}`, `{"constant": {"value": v}}`, `{"truncated_normal": {"sigma": s, "limit": t}}` (optional `"mean"`: a normal whose parts beyond mean ± t are scrapped at inspection; see [`crate::distribution::TruncatedNormal`]). Groups not named get none. |
+//! | `cases[].length_errors.G.lot` | optional, inside a group's distribution: a part of the error shared by each production lot of the group, `{"by": "level" | [["id", …], …], <distribution>}`, drawn once per lot and sample and added to each member's own draw; see [`crate::lot`] |
 //! | `cases[].backlash` | optional: `{"clearance": distribution}`, each joint's clearance (mm, ≥ 0), drawn per joint and sample; needs a model with joints (`{"prism": {"stages": 5, "backlash": true}}`) |
 //! | `cases[].effects` | optional deterministic effects: `gravity` (self-weight) and `thermal_gradient` (a linear temperature field); see [`crate::effects`] |
+//! | `budget` | optional: the alignment budget every case is held to, `{"theta_p": {"arcsec": 20}, "decenter": {"mm": 0.05}, "despace": {"mm": 0.03}, "percentile": 95}` (any one or more lines); see [`crate::budget`] |
 //!
 //! Unknown fields are refused. Every fault is reported with its JSON path
 //! (`cases[2].length_errors.longron: the model has no group "longron" …`).
@@ -57,13 +59,16 @@
 //! The SHA-256 (hex) of the job's canonical form: the seed, and per case its name, sample
 //! count, distributions, and the *content* of its model as validated (every member written
 //! out, so a model file's path, whitespace and key order do not matter, but any change of a
-//! number does), with the versions of the job format and of the numerics. Keys are in a
+//! number does), the budget in rad and mm when there is one, with the versions of the job
+//! format and of the numerics. Keys are in a
 //! fixed order and numbers in shortest round-trip form. Shards carry the id; merging refuses
 //! to mix ids.
 
+use crate::budget::{Budget, BudgetSpec};
 use crate::distribution::DistributionSpec;
 use crate::effects::{Applied, EffectsSpec};
 use crate::errors::JobError;
+use crate::lot::{self, CaseLot, LengthErrors};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -75,7 +80,7 @@ use truss_core::{Model, Structure};
 
 /// Version of the numerics: bumped whenever the solver or the sampling would give different
 /// numbers for the same job, so that the job id changes and old and new shards never mix.
-pub const NUMERICS_VERSION: u32 = 8;
+pub const NUMERICS_VERSION: u32 = 9;
 
 /// The most samples a case may have, 10⁸. At 10⁸ samples the 95th percentile's relative
 /// standard error is about 10⁻⁴, far finer than any input of the model is known; and the
@@ -89,14 +94,21 @@ pub const MAX_JOB_SAMPLES: u64 = 1_000_000_000;
 /// A job file as written: read with [`JobSpec::from_json`], written with
 /// [`JobSpec::to_json`], validated into a [`Job`] by [`Job::new`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, bound(deserialize = "M: Deserialize<'de>"))]
-pub struct JobSpec<M = ModelSpec> {
+#[serde(
+    deny_unknown_fields,
+    bound(deserialize = "M: Deserialize<'de>, B: Deserialize<'de>")
+)]
+pub struct JobSpec<M = ModelSpec, B = BudgetSpec> {
     /// The default model of every case.
     pub model: M,
     /// The seed of all random draws.
     pub seed: u64,
     /// The cases, in order.
     pub cases: Vec<CaseSpec<M>>,
+    /// The alignment budget every case is held to, if the job states one (see
+    /// [`crate::budget`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub budget: Option<B>,
 }
 
 /// One case as written.
@@ -110,49 +122,16 @@ pub struct CaseSpec<M = ModelSpec> {
     /// This case's own model, if any.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<M>,
-    /// Length-error distribution per member group \[mm\].
-    #[serde(
-        default,
-        skip_serializing_if = "BTreeMap::is_empty",
-        deserialize_with = "distinct_groups"
-    )]
-    pub length_errors: BTreeMap<String, DistributionSpec>,
+    /// Length-error distribution per member group \[mm\], with its shared lot part where
+    /// it has one (see [`crate::lot`]).
+    #[serde(default, skip_serializing_if = "LengthErrors::is_empty")]
+    pub length_errors: LengthErrors,
     /// Deterministic effects: self-weight, a temperature field (see [`crate::effects`]).
     #[serde(default, skip_serializing_if = "EffectsSpec::is_empty")]
     pub effects: EffectsSpec,
     /// Joint clearances drawn per joint and sample; needs a model with joints.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub backlash: Option<CaseBacklash>,
-}
-
-/// Reads `length_errors`, refusing a group named twice (which a plain map would take as its
-/// last value, silently).
-fn distinct_groups<'de, D: serde::Deserializer<'de>>(
-    d: D,
-) -> Result<BTreeMap<String, DistributionSpec>, D::Error> {
-    struct Groups;
-    impl<'de> serde::de::Visitor<'de> for Groups {
-        type Value = BTreeMap<String, DistributionSpec>;
-        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-            f.write_str("a map from member group to distribution")
-        }
-        fn visit_map<A: serde::de::MapAccess<'de>>(
-            self,
-            mut a: A,
-        ) -> Result<Self::Value, A::Error> {
-            let mut groups = BTreeMap::new();
-            while let Some(group) = a.next_key::<String>()? {
-                let dist: DistributionSpec = a.next_value()?;
-                if groups.insert(group.clone(), dist).is_some() {
-                    return Err(serde::de::Error::custom(format!(
-                        "group {group:?} is given twice: give it one distribution"
-                    )));
-                }
-            }
-            Ok(groups)
-        }
-    }
-    d.deserialize_map(Groups)
 }
 
 /// A model as a job writes it: `{"prism": {...}}` (the paper's prism, any Table 1 value
@@ -260,7 +239,7 @@ impl JobSpec {
     pub fn from_json(text: &str) -> Result<Self, JobError> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let de = &mut serde_json::Deserializer::from_str(text);
-        let raw: JobSpec<serde_json::Value> =
+        let raw: JobSpec<serde_json::Value, serde_json::Value> =
             serde_path_to_error::deserialize(de).map_err(|e| {
                 let path = e.path().to_string();
                 let inner = e.into_inner();
@@ -292,6 +271,10 @@ impl JobSpec {
             model: ModelSpec::parse(&raw.model, "model")?,
             seed: raw.seed,
             cases,
+            budget: raw
+                .budget
+                .map(|b| BudgetSpec::parse(&b, "budget"))
+                .transpose()?,
         })
     }
 
@@ -325,10 +308,15 @@ pub struct Case {
     pub model: Arc<Model>,
     /// Its model compiled for solving.
     pub structure: Arc<Structure>,
-    /// The distributions by group name.
-    pub length_errors: BTreeMap<String, DistributionSpec>,
-    /// The distribution of each member's length error, in model order.
+    /// The distributions by group name, with their lots.
+    pub length_errors: LengthErrors,
+    /// The distribution of each member's own length error, in model order.
     pub member_errors: Vec<Option<DistributionSpec>>,
+    /// The groups' lots, in group order (see [`crate::lot`]).
+    pub lots: Vec<CaseLot>,
+    /// Each member's lot, numbered over all of `lots`' lots in order; `None` for a member
+    /// whose group has no lot part.
+    pub member_lot: Vec<Option<usize>>,
     /// Named numbers describing the case, for sweeps (`sigma`, `stages`, …).
     pub parameters: BTreeMap<String, f64>,
     /// The effects as given.
@@ -346,6 +334,8 @@ pub struct Job {
     pub seed: u64,
     /// The cases, in order.
     pub cases: Vec<Case>,
+    /// The alignment budget in canonical units (rad, mm), if the job states one.
+    pub budget: Option<Budget>,
     /// SHA-256 (hex) of the canonical form.
     pub id: String,
     /// Where the job file is, if it came from one.
@@ -414,6 +404,21 @@ impl Job {
                 }
                 dist.check().map_err(|m| JobError::at(&path, &m))?;
             }
+            let mut lots = Vec::new();
+            for (group, l) in &c.length_errors.lots {
+                let path = at(&format!("length_errors.{group}.lot"));
+                l.distribution
+                    .check()
+                    .map_err(|m| JobError::at(&path, &m))?;
+                let key = lot::lot_key(spec.seed, &c.name, group);
+                lots.push(lot::resolve(l, group, &model, stages, key, &path)?);
+            }
+            let mut member_lot = vec![None; model.members().len()];
+            for (n, members) in lots.iter().flat_map(|l| &l.lots).enumerate() {
+                for &m in members {
+                    member_lot[m] = Some(n);
+                }
+            }
             c.effects
                 .check()
                 .map_err(|(field, m)| JobError::at(&at(&format!("effects.{field}")), &m))?;
@@ -451,16 +456,31 @@ impl Job {
             let mut parameters = BTreeMap::new();
             let sigma = c
                 .length_errors
-                .values()
-                .map(DistributionSpec::std_dev)
+                .keys()
+                .map(|g| c.length_errors.total_std_dev(g))
                 .fold(0.0, f64::max);
             parameters.insert("sigma".to_string(), sigma);
+            // Cases whose groups share a lot part form their own series, by the largest
+            // share of a member's variance a lot holds; absent without lots.
+            if !lots.is_empty() {
+                let share = lots
+                    .iter()
+                    .map(|l| l.variance_share(&c.length_errors[&l.group]))
+                    .fold(0.0, f64::max);
+                parameters.insert("lot_share".to_string(), share);
+            }
             if let Some(n) = stages {
                 parameters.insert("stages".to_string(), n as f64);
             }
             // A distribution's own mark (the uniform's, the truncated normal's shape), the
             // largest of its groups' values: cases differing in it form their own series.
-            for (key, value) in c.length_errors.values().filter_map(|d| d.series_marker()) {
+            let lot_distributions = c.length_errors.lots.values().map(|l| &l.distribution);
+            for (key, value) in c
+                .length_errors
+                .values()
+                .chain(lot_distributions)
+                .filter_map(|d| d.series_marker())
+            {
                 let kept = parameters.entry(key.to_string()).or_insert(value);
                 *kept = kept.max(value);
             }
@@ -487,6 +507,8 @@ impl Job {
                 structure,
                 length_errors: c.length_errors.clone(),
                 member_errors,
+                lots,
+                member_lot,
                 parameters,
                 effects: c.effects.clone(),
                 applied,
@@ -503,10 +525,12 @@ impl Job {
                 ));
             }
         }
-        let id = job_id(spec.seed, &cases);
+        let budget = spec.budget.as_ref().map(BudgetSpec::budget);
+        let id = job_id(spec.seed, &cases, budget.as_ref());
         Ok(Self {
             seed: spec.seed,
             cases,
+            budget,
             id,
             path: None,
         })
@@ -580,7 +604,7 @@ pub fn check_case_name(name: &str) -> Result<(), String> {
 /// field's JSON path.
 fn check_reach(
     model: &Model,
-    length_errors: &BTreeMap<String, DistributionSpec>,
+    length_errors: &LengthErrors,
     applied: &Applied,
     at: &dyn Fn(&str) -> String,
 ) -> Result<(), JobError> {
@@ -589,8 +613,15 @@ fn check_reach(
         let max = model.max_length_error(m);
         let thermal = applied.length_changes.get(m).map_or(0.0, |x| x.abs());
         let dist = length_errors.get(&member.group);
-        let reach = dist.map_or(0.0, DistributionSpec::reach);
-        let what = dist.map_or_else(String::new, DistributionSpec::reach_in_words);
+        let lot = length_errors
+            .lots
+            .get(&member.group)
+            .map(|l| &l.distribution);
+        let reach = dist.map_or(0.0, DistributionSpec::reach) + lot.map_or(0.0, |l| l.reach());
+        let what = dist.map_or_else(String::new, DistributionSpec::reach_in_words)
+            + &lot.map_or_else(String::new, |l| {
+                format!(", plus its lot part's {}", l.reach_in_words())
+            });
         let limit = format!(
             "more than {percent}% of member {:?}'s natural length {} mm ({max} mm): a \
              length error beyond the elastic range, where the model means nothing (see \
@@ -708,13 +739,15 @@ struct Canonical<'a> {
     numerics_version: u32,
     seed: u64,
     cases: Vec<CanonicalCase<'a>>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    budget: Option<&'a Budget>,
 }
 
 #[derive(Serialize)]
 struct CanonicalCase<'a> {
     name: &'a str,
     samples: u64,
-    length_errors: &'a BTreeMap<String, DistributionSpec>,
+    length_errors: &'a LengthErrors,
     effects: &'a EffectsSpec,
     #[serde(skip_serializing_if = "Option::is_none")]
     backlash: Option<CaseBacklash>,
@@ -722,7 +755,7 @@ struct CanonicalCase<'a> {
 }
 
 /// The job id: SHA-256 of the canonical form.
-fn job_id(seed: u64, cases: &[Case]) -> String {
+fn job_id(seed: u64, cases: &[Case], budget: Option<&Budget>) -> String {
     let canonical = Canonical {
         format: "truss-mc-job",
         format_version: 1,
@@ -739,6 +772,7 @@ fn job_id(seed: u64, cases: &[Case]) -> String {
                 model: c.model.to_file(),
             })
             .collect(),
+        budget,
     };
     let text = serde_json::to_string(&canonical).expect("the canonical form always serialises");
     Sha256::digest(text.as_bytes())

@@ -14,11 +14,13 @@
 //! the tolerance study (`truss-tolerance`).
 //! It depends on nothing of ours but `truss-core`, and knows no file format but the job's.
 
+pub mod budget;
 pub mod distribution;
 pub mod effects;
 pub mod engine;
 pub mod errors;
 pub mod job;
+pub mod lot;
 pub mod sampler;
 pub mod solve;
 

@@ -15,8 +15,11 @@
 //! without one leaves its two words unused, so that adding a distribution to one group never
 //! changes another group's draws); then, if the case draws backlash clearances, two words
 //! for each joint of the model, in model order. [`crate::distribution`] says how two words
-//! become a number. So a sample's draws depend on the seed, the case name, `k` and the model, and on
-//! nothing else: not the shard split, the thread count, the other cases, or the machine.
+//! become a number. A group with a production lot's shared part draws it from its own
+//! stream ([`crate::lot`]: two words per lot, in lot order), added to each member's own
+//! draw, so adding a lot moves no other draw. So a sample's draws depend on the seed, the
+//! case name, `k` and the model, and on nothing else: not the shard split, the thread count,
+//! the other cases, or the machine.
 
 use crate::job::Case;
 use rand_chacha::ChaCha20Rng;
@@ -60,6 +63,21 @@ pub fn draw_sample(
     errors: &mut Vec<f64>,
     clearances: &mut Vec<f64>,
 ) {
+    let mut lots = Vec::new();
+    draw_sample_with_lots(key, case, k, errors, clearances, &mut lots);
+}
+
+/// [`draw_sample`], keeping each lot's shared part \[mm\] in `lots` (numbered over the
+/// case's lots in order, as [`Case::member_lot`] numbers them; empty without lots). The
+/// length errors are the members' own draws plus their lots' parts.
+pub fn draw_sample_with_lots(
+    key: &[u8; 32],
+    case: &Case,
+    k: u64,
+    errors: &mut Vec<f64>,
+    clearances: &mut Vec<f64>,
+    lots: &mut Vec<f64>,
+) {
     let mut rng = sample_stream(key, k);
     errors.clear();
     errors.extend(case.member_errors.iter().map(|dist| {
@@ -72,5 +90,20 @@ pub fn draw_sample(
             let (w1, w2) = (rng.next_u64(), rng.next_u64());
             b.clearance.from_words(w1, w2)
         }));
+    }
+    lots.clear();
+    for lot in &case.lots {
+        let mut rng = sample_stream(&lot.key, k);
+        lots.extend(lot.lots.iter().map(|_| {
+            let (w1, w2) = (rng.next_u64(), rng.next_u64());
+            lot.distribution.from_words(w1, w2)
+        }));
+    }
+    if !lots.is_empty() {
+        for (e, l) in errors.iter_mut().zip(&case.member_lot) {
+            if let Some(l) = l {
+                *e += lots[*l];
+            }
+        }
     }
 }

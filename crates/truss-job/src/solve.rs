@@ -1,11 +1,11 @@
 //! The per-sample solve: draw a sample's length errors and clearances, apply the case's
-//! effects, solve, and measure the top surface. Everything that runs samples (the shard
+//! effects, solve, and measure the top surface (its tilt, decenter and despace). Everything that runs samples (the shard
 //! runner, `reproduce`, the diagnosis) goes through [`SampleSolver`], so they see the same
 //! numbers; the runner turns a [`SampleResult`] into its wire record.
 
 use crate::job::Job;
-use crate::sampler::{draw_sample, stream_key};
-use truss_core::measure::Distortion;
+use crate::sampler::{draw_sample_with_lots, stream_key};
+use truss_core::measure::{Distortion, Placement};
 use truss_core::solver::Perturbation;
 use truss_core::solver::lanes::{Kernels, finish};
 use truss_core::{SolveError, SolveOptions, Solver};
@@ -15,6 +15,9 @@ use truss_core::{SolveError, SolveOptions, Solver};
 pub struct Converged {
     /// The top surface's tilt (θ_P \[rad\], tan θ_x, tan θ_y).
     pub distortion: Distortion,
+    /// Where the top surface's centroid sits against the bottom's frame: decenter and
+    /// despace \[mm\] (see [`truss_core::measure`]).
+    pub placement: Placement,
     /// Final out-of-balance force, max over free DOFs \[N\].
     pub residual: f64,
     /// Number of the model's cables that ended slack.
@@ -60,6 +63,7 @@ pub struct SampleSolver<'j> {
     solvers: Vec<Option<Solver>>,
     errors: Vec<f64>,
     clearances: Vec<f64>,
+    lots: Vec<f64>,
     options: SolveOptions,
 }
 
@@ -81,6 +85,7 @@ impl<'j> SampleSolver<'j> {
             solvers: job.cases.iter().map(|_| None).collect(),
             errors: Vec::new(),
             clearances: Vec::new(),
+            lots: Vec::new(),
             options,
         }
     }
@@ -108,12 +113,13 @@ impl<'j> SampleSolver<'j> {
     pub async fn solve_in(&mut self, index: u64, kernels: Kernels<'_>) -> SampleResult {
         let (c, k) = self.job.case_of(index).expect("index within the job");
         let case = &self.job.cases[c];
-        draw_sample(
+        draw_sample_with_lots(
             &self.keys[c],
             case,
             k,
             &mut self.errors,
             &mut self.clearances,
+            &mut self.lots,
         );
         for (e, t) in self.errors.iter_mut().zip(&case.applied.length_changes) {
             *e += t;
@@ -135,17 +141,25 @@ impl<'j> SampleSolver<'j> {
         let (iterations, outcome) = match result {
             Ok(report) => (
                 report.iterations,
-                match solver.distortion() {
-                    Some(d) if d.theta_p.is_finite() => Outcome::Converged(Converged {
+                match (
+                    solver.distortion(),
+                    truss_core::output::placement(&case.model, solver),
+                ) {
+                    (Some(d), Some(p)) if d.theta_p.is_finite() => Outcome::Converged(Converged {
                         distortion: d,
+                        placement: p,
                         residual: report.residual,
                         slack_cables: report.slack_cables,
                         loose_joints: has_joints.then_some(report.loose_joints),
                         floating: (!case.structure.tilt_framed()).then_some(report.floating),
                         holding_force: report.holding_force,
                     }),
-                    Some(_) => Outcome::Failed("the top surface's angles are not finite".into()),
-                    None => Outcome::Failed("the model names no top surface to measure".into()),
+                    (Some(_), _) => {
+                        Outcome::Failed("the top surface's angles are not finite".into())
+                    }
+                    (None, _) => {
+                        Outcome::Failed("the model names no top surface to measure".into())
+                    }
                 },
             ),
             Err(e) => (
@@ -180,6 +194,13 @@ impl<'j> SampleSolver<'j> {
     /// thermal length change.
     pub fn last_errors(&self) -> &[f64] {
         &self.errors
+    }
+
+    /// The shared parts of its lots the last sample drew \[mm\], numbered as
+    /// [`crate::job::Case::member_lot`] numbers them (empty when its case has no lots);
+    /// [`SampleSolver::last_errors`] includes them.
+    pub fn last_lots(&self) -> &[f64] {
+        &self.lots
     }
 
     /// The joint clearances the last sample drew \[mm\], model order (empty when its case

@@ -4,7 +4,8 @@
 //!
 //! The fields the format defines today have fixed kinds (so a column's type never depends
 //! on the data): `index`, `sample`, `iterations` integers; `theta_p`, `tan_theta_x`,
-//! `tan_theta_y`, `residual` (rad, -, -, N) and the optional counts `slack_cables`,
+//! `tan_theta_y`, `decenter_x`, `decenter_y`, `decenter`, `despace`, `residual` (rad, -, -,
+//! mm ×4, N) and the optional counts `slack_cables`,
 //! `loose_joints` floats, NaN where a record has none (a failed sample); `case`, `status`,
 //! `reason` text, empty where absent. Any other field takes the kind of its first value
 //! (integer, float, boolean or text; an integer column meeting a fraction becomes float,
@@ -98,7 +99,7 @@ struct Column {
 }
 
 /// The fields of a sample record today, in wire order, with their fixed kinds.
-const KNOWN: [(&str, Values); 12] = [
+const KNOWN: [(&str, Values); 16] = [
     ("index", Values::Int(Vec::new())),
     ("case", Values::Text(Vec::new())),
     ("sample", Values::Int(Vec::new())),
@@ -107,6 +108,10 @@ const KNOWN: [(&str, Values); 12] = [
     ("theta_p", Values::Float(Vec::new())),
     ("tan_theta_x", Values::Float(Vec::new())),
     ("tan_theta_y", Values::Float(Vec::new())),
+    ("decenter_x", Values::Float(Vec::new())),
+    ("decenter_y", Values::Float(Vec::new())),
+    ("decenter", Values::Float(Vec::new())),
+    ("despace", Values::Float(Vec::new())),
     ("residual", Values::Float(Vec::new())),
     ("slack_cables", Values::Float(Vec::new())),
     ("loose_joints", Values::Float(Vec::new())),

@@ -88,7 +88,8 @@ impl PyModel {
     /// Solves the equilibrium with the given member length errors (`[(member id, mm)]`,
     /// natural minus nominal length); raises `SolveFailedError` when it does not converge.
     /// Returns the numbers of `truss solve`: `theta_p` \[rad\], `tan_theta_x`,
-    /// `tan_theta_y` (None without a top surface), `iterations`, `factorisations`,
+    /// `tan_theta_y`, `decenter_x`, `decenter_y`, `decenter`, `despace` \[mm\] (see
+    /// `truss_core::measure`; all None without a top surface), `iterations`, `factorisations`,
     /// `residual` \[N\], `node_ids` with `displacements` (f64 bytes, 3 per node, mm),
     /// `member_ids` with `forces` (f64 bytes, N, tension positive), `slack_cables`, and
     /// `joint_ids` with `joint_offsets` (3 per joint, mm), `joint_contact` (N) and
@@ -126,6 +127,11 @@ impl PyModel {
         out.set_item("theta_p", d.map(|d| d.theta_p))?;
         out.set_item("tan_theta_x", d.map(|d| d.tan_theta_x))?;
         out.set_item("tan_theta_y", d.map(|d| d.tan_theta_y))?;
+        let p = truss_core::output::placement(model, &solver);
+        out.set_item("decenter_x", p.map(|p| p.decenter_x))?;
+        out.set_item("decenter_y", p.map(|p| p.decenter_y))?;
+        out.set_item("decenter", p.map(|p| p.decenter))?;
+        out.set_item("despace", p.map(|p| p.despace))?;
         out.set_item("iterations", report.iterations)?;
         out.set_item("factorisations", report.factorisations)?;
         out.set_item("residual", report.residual)?;

@@ -41,6 +41,9 @@ pub enum Stream {
     Bootstrap = 0x626f_6f74,
     /// Goodness-of-fit null samples, counter = position in the simulated sample.
     GofNull = 0x676f_6621,
+    /// Goodness-of-fit null samples of the normal law, counter = twice the position in the
+    /// simulated sample (and one more, the two uniforms of a Box–Muller draw).
+    GofNormalNull = 0x676f_664e,
     /// Synthetic data for tests and benchmarks.
     Synthetic = 0x7379_6e74,
 }

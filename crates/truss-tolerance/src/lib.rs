@@ -10,6 +10,9 @@
 //!    `K = Σ_g w_g n_g / σ_g` (n_g members, weight w_g, default 1; `--fix` pins a group).
 //! 3. **Verification** ([`verify`]): the allocated case is run (in-process, 20,000 samples by
 //!    default) and its θ_Pq with a 95 % interval is checked against the target.
+//! 4. **Budget** ([`study`]): where the job states an alignment budget (θ_P, decenter,
+//!    despace), the allocation is held to every line and the common factor on its σ that
+//!    meets them all is found, naming the line that binds.
 //!
 //! The sensitivity run has 4,000 samples by default (at least 1,000 and ten per member
 //! with an error). Every run draws sample `k` of the case as the job does (its seed, the case

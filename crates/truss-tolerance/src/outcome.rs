@@ -65,6 +65,8 @@ pub struct Tolerance {
     pub isotropy: f64,
     /// Whether the last run verifies.
     pub verified: bool,
+    /// The allocation against the job's alignment budget, if the job states one.
+    pub budget: Option<BudgetCheck>,
     /// Files written.
     pub files: Vec<PathBuf>,
 }
@@ -79,4 +81,25 @@ impl Tolerance {
     pub fn cost_ratio(&self) -> f64 {
         self.cost.0 / self.cost.1
     }
+}
+
+/// The allocation against the job's alignment budget (see `crate::study`): each line's
+/// percentile at the allocated σ, on the last verification run's samples.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BudgetCheck {
+    /// The budget's percentile, in %.
+    pub percentile: f64,
+    /// Per line: the quantity (`theta_p`, `decenter`, `despace`), its limit (rad, mm), its
+    /// percentile with the 95 % BCa interval (of θ_P, decenter, |despace|), and whether the
+    /// interval's upper end is within the limit.
+    pub lines: Vec<(&'static str, f64, Percentile, bool)>,
+    /// The common factor `c` on every group's σ that meets every line, `min over lines of
+    /// limit/percentile` corrected by runs (below 1: some line fails at the allocation).
+    pub scale: f64,
+    /// The line attaining the minimum.
+    pub binding: &'static str,
+    /// The allocated σ times `c`, per group \[mm\]: the allocation meeting every line.
+    pub sigmas: Vec<f64>,
+    /// The lines at the last run's σ (the allocation's own when `c` needed no run).
+    pub scaled: Vec<(&'static str, f64, Percentile, bool)>,
 }

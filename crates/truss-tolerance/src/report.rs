@@ -18,6 +18,7 @@
 //! | `verified` | the last run: `{"theta_p", "interval", "samples", "passed"}` |
 //! | `runs` | every verification run: `{"sigma": {group: σ}, "theta_p", "interval", "model_theta_p"}` |
 //! | `isotropy` | λ₂/λ₁ of the tilt's model covariance at the allocation (1: Rayleigh) |
+//! | `budget` | `null`, or where the job states an alignment budget, the allocation against it (see [`crate::study`]): `{"percentile", "lines": [{"quantity", "limit" (rad, mm), "value", "interval", "passes"}], "scale" (c: min limit/value, corrected by runs), "binding", "sigma": {group: c·σ}, "at_sigma": the lines at c·σ}` |
 //!
 //! Intervals are 95 %: Poisson bootstrap, percentile method (B = 200) for shares, BCa
 //! (B = 2000) for θ_Pq.
@@ -91,6 +92,27 @@ pub fn json(t: &Tolerance) -> Value {
         })
         .collect();
     let (_, last, _) = t.verified_run();
+    let budget = t.budget.as_ref().map_or(Value::Null, |b| {
+        let lines_of = |lines: &[(&str, f64, crate::verify::Percentile, bool)]| -> Vec<Value> {
+            lines
+                .iter()
+                .map(|(quantity, limit, q, passes)| {
+                    json!({"quantity": quantity, "limit": num(*limit), "value": num(q.theta),
+                           "interval": pair(q.interval), "passes": passes})
+                })
+                .collect()
+        };
+        let lines = lines_of(&b.lines);
+        let scaled = lines_of(&b.scaled);
+        let sigma: Map<String, Value> = t
+            .groups
+            .iter()
+            .zip(&b.sigmas)
+            .map(|(g, s)| (g.name.clone(), num(*s)))
+            .collect();
+        json!({"percentile": num(b.percentile), "lines": lines, "scale": num(b.scale),
+               "binding": b.binding, "sigma": sigma, "at_sigma": scaled})
+    });
     json!({
         "format": "truss-tolerance",
         "version": 1,
@@ -115,6 +137,7 @@ pub fn json(t: &Tolerance) -> Value {
                      "samples": last.samples, "passed": t.verified},
         "runs": runs,
         "isotropy": num(t.isotropy),
+        "budget": budget,
     })
 }
 
@@ -148,6 +171,46 @@ pub fn markdown(t: &Tolerance) -> String {
             "**does not verify**"
         }
     );
+    if let Some(b) = &t.budget {
+        let _ = writeln!(s, "**Budget** at the {}th percentile:\n", b.percentile);
+        let _ = writeln!(
+            s,
+            "| line | limit | value [95 % CI] | passes |\n|---|---|---|---|"
+        );
+        for (quantity, limit, p, passes) in &b.lines {
+            let _ = writeln!(
+                s,
+                "| {quantity} | {limit:.4e} | {:.4e} [{:.4e}, {:.4e}] | {} |",
+                p.theta,
+                p.interval.0,
+                p.interval.1,
+                if *passes { "yes" } else { "**no**" }
+            );
+        }
+        let sigmas: Vec<String> = t
+            .groups
+            .iter()
+            .zip(&b.sigmas)
+            .map(|(g, s)| format!("{} {s:.4e} mm", g.name))
+            .collect();
+        let _ = writeln!(
+            s,
+            "\nEvery line met at {:.4} × the allocated σ ({}); binds: {}.\n",
+            b.scale,
+            sigmas.join(", "),
+            b.binding
+        );
+        let at: Vec<String> = b
+            .scaled
+            .iter()
+            .map(|(quantity, limit, p, _)| format!("{quantity} {:.4}", p.theta / limit))
+            .collect();
+        let _ = writeln!(
+            s,
+            "There, each line's percentile over its limit: {}.\n",
+            at.join(", ")
+        );
+    }
     let _ = writeln!(s, "## Groups\n");
     let _ = writeln!(
         s,

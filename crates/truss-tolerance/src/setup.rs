@@ -116,6 +116,17 @@ impl Study {
                  errors, which the allocation rests on; study the case without backlash",
             ));
         }
+        if let Some(group) = validated.length_errors.lots.keys().next() {
+            return Err(ToleranceError::NotScalable {
+                case: case.to_string(),
+                group: group.clone(),
+                reason: "its length error has a production lot's shared part (\"lot\"): the \
+                         study's variance model takes every member's error as independent and \
+                         scales it with its group's σ, which a shared part breaks; study the \
+                         case without the lot"
+                    .into(),
+            });
+        }
         if validated.length_errors.is_empty() {
             return Err(ToleranceError::NoLengthErrors {
                 case: case.to_string(),
@@ -245,7 +256,8 @@ impl Study {
     pub fn case_with(&self, sigmas: &[f64], samples: u64) -> CaseSpec {
         let mut case = self.case().clone();
         case.samples = samples;
-        case.length_errors = self
+        // The groups' own parts scaled (a case with lots is refused by `Study::new`).
+        case.length_errors.parts = self
             .groups
             .iter()
             .zip(sigmas)
@@ -286,6 +298,7 @@ impl Study {
             model: self.spec.model.clone(),
             seed: self.spec.seed,
             cases: vec![self.case_with(sigmas, samples)],
+            budget: self.spec.budget,
         };
         Ok(Job::new(&spec, &self.base)?)
     }

@@ -19,6 +19,10 @@ pub struct Run {
     pub tilt: Vec<[f64; 2]>,
     /// Per sample θ_P \[rad\].
     pub theta_p: Vec<f64>,
+    /// Per sample decenter \[mm\] (see `truss_core::measure`).
+    pub decenter: Vec<f64>,
+    /// Per sample despace, signed \[mm\].
+    pub despace: Vec<f64>,
 }
 
 impl Run {
@@ -55,6 +59,7 @@ pub fn run_case(
             let e = solver.last_errors();
             Ok((
                 c.distortion,
+                c.placement,
                 columns.iter().map(|&i| e[i]).collect::<Vec<_>>(),
             ))
         }
@@ -67,9 +72,11 @@ pub fn run_case(
     let mut failed: Vec<(u64, String)> = Vec::new();
     for sample in solved {
         match sample {
-            Ok((d, errors)) => {
+            Ok((d, p, errors)) => {
                 run.tilt.push([d.tan_theta_x, d.tan_theta_y]);
                 run.theta_p.push(d.theta_p);
+                run.decenter.push(p.decenter);
+                run.despace.push(p.despace);
                 run.errors.extend(errors);
             }
             Err(f) => failed.push(f),

@@ -1,10 +1,30 @@
 //! The whole study: sensitivity run, allocation, verification with one homogeneity rescale,
-//! the uniform σ for comparison, and the output files (see the crate doc for the method).
+//! the uniform σ for comparison, the job's alignment budget, and the output files (see the
+//! crate doc for the method).
+//!
+//! ## The budget
+//!
+//! Where the job states a budget (`truss_job::budget`), the allocation is also held to every
+//! line: a run at the allocated σ (the last verification run's job, so its samples) gives
+//! each line's percentile `q` at the budget's percentile (θ_P, decenter, |despace|, with
+//! their 95 % BCa intervals; a line passes when the interval's upper end is within its
+//! limit), and by homogeneity the common factor
+//!
+//! ```text
+//! c = min over lines of limit / q,      σ_g ← c · σ_g for every group
+//! ```
+//!
+//! meets them all, the line attaining the minimum binding. As for θ_P, homogeneity is only
+//! approximate (the pretension, the slack set), so a run at `c·σ` is made and `c`
+//! corrected by the secant of `ln(min limit/q)` against `ln c` through the last two runs
+//! (the allocation's at `c = 1` first), up to [`BUDGET_RUNS`] runs in all, until the binding
+//! line is at or below its limit by at most [`BUDGET_BAND`] (`1 ≤ min limit/q ≤ 1.02`); the last run's lines are reported beside the allocation's. The σ ratios stay
+//! θ_P's optimum; `c` is reported, not applied to `allocated-job.json`.
 
 use crate::allocate::{self, AllocationError, GroupModel};
 use crate::errors::ToleranceError;
 use crate::options::{Options, bad};
-use crate::outcome::{GroupResult, Tolerance};
+use crate::outcome::{BudgetCheck, GroupResult, Tolerance};
 use crate::sensitivity::sensitivity;
 use crate::setup::Study;
 use crate::simulate::run_case;
@@ -18,6 +38,13 @@ pub const MARGIN: f64 = 3e-3;
 
 /// Least share of the variance a free group must have to be allocated.
 pub const LEAST_SHARE: f64 = 1e-9;
+
+/// Budget runs at most: the allocation's, then rescaled ones (see the module doc).
+pub const BUDGET_RUNS: usize = 5;
+
+/// How far below its limit the binding line may end, as a fraction of the limit's ratio:
+/// the rescale stops when `1 ≤ min limit/q ≤ 1 + BUDGET_BAND`.
+pub const BUDGET_BAND: f64 = 0.02;
 
 /// Verification runs at most (the first, then rescaled ones).
 const MAX_RUNS: usize = 3;
@@ -223,6 +250,71 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
     let uniform_cost = allocate::cost(&models, &u_sigmas);
     let cost = (allocate::cost(&models, &last_sigmas), uniform_cost);
 
+    // 5. The job's alignment budget, if it states one: every line at the allocation, on the
+    // samples of the last verification run (the same job, so the same draws).
+    let budget = match study.spec.budget.as_ref().map(|b| b.budget()) {
+        None => None,
+        Some(b) => {
+            let lines_at = |stage: &'static str, sigmas: &[f64]| {
+                say(o.quiet, &format!("{stage} run: {} samples", o.samples));
+                let job = study.job_with(sigmas, o.samples as u64)?;
+                let r = run_case(&job, &[], threads, stage)?;
+                let despace: Vec<f64> = r.despace.iter().map(|d| d.abs()).collect();
+                let mut lines = Vec::new();
+                for (quantity, limit) in b.lines() {
+                    let values = match quantity {
+                        "theta_p" => &r.theta_p,
+                        "decenter" => &r.decenter,
+                        _ => &despace,
+                    };
+                    let q = percentile(values, b.percentile / 100.0, seed, threads)?;
+                    lines.push((quantity, limit, q, q.interval.1 <= limit));
+                }
+                Ok::<_, ToleranceError>(lines)
+            };
+            let least = |lines: &[(&'static str, f64, Percentile, bool)]| {
+                lines
+                    .iter()
+                    .map(|(quantity, limit, q, _)| (limit / q.theta, *quantity))
+                    .fold((f64::INFINITY, ""), |a, b| if b.0 < a.0 { b } else { a })
+            };
+            let lines = lines_at("budget", &last_sigmas)?;
+            let (first, binding) = least(&lines);
+            // The rescale by homogeneity, checked by a run and corrected by the secant of
+            // ln(least ratio) against ln c through the last two runs, up to BUDGET_RUNS runs
+            // in all, until the binding line is within BUDGET_BAND below its limit.
+            let (mut before, mut scale) =
+                ((0.0f64, first.ln() - (0.5 * BUDGET_BAND).ln_1p()), first);
+            let mut scaled = lines.clone();
+            for _ in 1..BUDGET_RUNS {
+                let sigmas: Vec<f64> = last_sigmas.iter().map(|s| s * scale).collect();
+                scaled = lines_at("budget rescale", &sigmas)?;
+                let (r, _) = least(&scaled);
+                if (1.0..=1.0 + BUDGET_BAND).contains(&r) {
+                    break;
+                }
+                // Aim at the middle of the band.
+                let now = (scale.ln(), r.ln() - (0.5 * BUDGET_BAND).ln_1p());
+                let slope = (now.1 - before.1) / (now.0 - before.0);
+                let next = if slope.is_finite() && slope < 0.0 {
+                    now.0 - now.1 / slope
+                } else {
+                    now.0 + now.1
+                };
+                before = now;
+                scale = next.exp();
+            }
+            Some(BudgetCheck {
+                percentile: b.percentile,
+                lines,
+                scale,
+                binding,
+                sigmas: last_sigmas.iter().map(|s| s * scale).collect(),
+                scaled,
+            })
+        }
+    };
+
     let groups = study
         .groups
         .iter()
@@ -261,6 +353,7 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
         runs,
         isotropy,
         verified: last.verifies(target),
+        budget,
         files: Vec::new(),
     })
 }

@@ -1,7 +1,8 @@
-//! The workspace's cross-crate tests, one binary: the pipeline, golden reproducibility,
-//! the dependency graph, circles of imports between files, the release builds' shared
-//! features, the README's commands, and the cron round script.
+//! The workspace's cross-crate tests, one binary: the pipeline, the alignment budget, golden
+//! reproducibility, the dependency graph, circles of imports between files, the release
+//! builds' shared features, the README's commands, and the cron round script.
 
+mod budget;
 mod circles;
 mod cron;
 mod features;

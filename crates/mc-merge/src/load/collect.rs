@@ -8,7 +8,7 @@
 
 use super::store::{Conflict, Dataset, LoadOptions, Rec, ShardWriter, Store, check_coverage};
 use crate::errors::MergeError;
-use shard_record::{CaseInfo, Sample};
+use shard_record::{Budget, CaseInfo, Sample};
 
 /// Collects the samples of one job from memory.
 pub struct Collector {
@@ -17,6 +17,7 @@ pub struct Collector {
     store: Store,
     writer: ShardWriter,
     added: u64,
+    budget: Option<Budget>,
 }
 
 impl Collector {
@@ -34,7 +35,15 @@ impl Collector {
             store: Store::new(cases),
             writer,
             added: 0,
+            budget: None,
         }
+    }
+
+    /// The job's alignment budget (as a shard's begin line carries it), for the report's
+    /// budget section.
+    pub fn with_budget(mut self, budget: Option<Budget>) -> Self {
+        self.budget = budget;
+        self
     }
 
     /// Adds a sample and its shard line's bytes (`sample.to_line()`; the copy of an index
@@ -66,6 +75,7 @@ impl Collector {
     /// unless `options` tolerate them.
     pub fn finish(self, options: LoadOptions) -> Result<Dataset, MergeError> {
         let data = Dataset {
+            budget: self.budget,
             job_id: self.job_id,
             job_samples: self.job_samples,
             cases: self.store.into_cases(),

@@ -22,9 +22,11 @@
 //! ## Memory
 //!
 //! Per sample only what the statistics need is kept, in dense per-case columns indexed by the
-//! sample's position in its case: a state byte, θ_P, tan θ_x, tan θ_y, a loose-joint byte and,
-//! until verification ends, the fingerprint and the number of the file that held it: 38 bytes
-//! per sample (26 after). A case's columns are allocated when its first sample is read. The
+//! sample's position in its case: a state byte, θ_P, tan θ_x, tan θ_y, decenter_x, decenter_y,
+//! despace, a loose-joint and a floating byte, the holding force and, until verification
+//! ends, the fingerprint and the number of the file that held it: 76 bytes per sample (64
+//! after). `decenter` is not kept: it is `decenter_x.hypot(decenter_y)`, the writer's own
+//! definition (`truss_core::measure`), recomputed when asked for. A case's columns are allocated when its first sample is read. The
 //! parsed sample lines are not kept.
 //!
 //! ## Threads
@@ -135,6 +137,8 @@ fn compare_headers(reference: &Reference, path: &Path, begin: &Begin) -> Result<
         ))
     } else if begin.cases != r.cases {
         Some("the cases (names, ranges or parameters)".to_string())
+    } else if begin.budget != r.budget {
+        Some("the budget".to_string())
     } else {
         None
     };
@@ -351,7 +355,9 @@ pub fn load(files: &[PathBuf], options: LoadOptions) -> Result<Dataset, MergeErr
     }
 
     let cases = store.into_cases();
+    let budget = reference.begin.budget;
     let data = Dataset {
+        budget,
         job_id: reference.begin.job_id,
         job_samples: reference.begin.job_samples,
         cases,

@@ -5,7 +5,7 @@
 
 use crate::errors::{FailedCase, MergeError, MissingRange};
 use crate::rng::mix64;
-use shard_record::{CaseInfo, Sample, ShardRange};
+use shard_record::{Budget, CaseInfo, Sample, ShardRange};
 use std::path::PathBuf;
 
 /// How many failure reasons (the lowest indices) to keep per case.
@@ -49,6 +49,25 @@ pub struct Point {
     pub tan_y: f64,
     /// The holding force \[N\] (NaN where the sample does not record it).
     pub holding: f64,
+    /// decenter_x \[mm\] (NaN where the sample does not record it: a shard of numerics
+    /// version 7 or earlier).
+    pub decenter_x: f64,
+    /// decenter_y \[mm\] (NaN where not recorded).
+    pub decenter_y: f64,
+    /// despace \[mm\] (NaN where not recorded).
+    pub despace: f64,
+}
+
+impl Point {
+    /// `√(decenter_x² + decenter_y²)` \[mm\] (NaN where not recorded).
+    pub fn decenter(&self) -> f64 {
+        self.decenter_x.hypot(self.decenter_y)
+    }
+
+    /// Whether the sample records its decenter and despace.
+    pub fn placed(&self) -> bool {
+        !(self.decenter_x.is_nan() || self.decenter_y.is_nan() || self.despace.is_nan())
+    }
 }
 
 #[derive(Debug, Default)]
@@ -64,6 +83,10 @@ struct Columns {
     floating: Vec<u8>,
     /// The holding force \[N\]; NaN: not recorded.
     holding: Vec<f64>,
+    /// decenter_x, decenter_y, despace \[mm\]; NaN: not recorded.
+    decenter_x: Vec<f64>,
+    decenter_y: Vec<f64>,
+    despace: Vec<f64>,
 }
 
 fn zeroed<T: Clone>(n: usize, v: T) -> Result<Vec<T>, String> {
@@ -85,6 +108,9 @@ impl Columns {
             loose: zeroed(n, 0)?,
             floating: zeroed(n, 0)?,
             holding: zeroed(n, f64::NAN)?,
+            decenter_x: zeroed(n, f64::NAN)?,
+            decenter_y: zeroed(n, f64::NAN)?,
+            despace: zeroed(n, f64::NAN)?,
         })
     }
 }
@@ -128,6 +154,9 @@ impl CaseData {
                     tan_x: c.tan_x[k],
                     tan_y: c.tan_y[k],
                     holding: c.holding[k],
+                    decenter_x: c.decenter_x[k],
+                    decenter_y: c.decenter_y[k],
+                    despace: c.despace[k],
                 })
         })
     }
@@ -214,6 +243,8 @@ pub struct Dataset {
     pub files: Vec<PathBuf>,
     /// The programs that wrote the files, as their headers name them, in order.
     pub writers: Vec<ShardWriter>,
+    /// The job's alignment budget, as the headers carry it.
+    pub budget: Option<Budget>,
 }
 
 /// A program that wrote shard files of the dataset, as the files' begin lines name it.
@@ -290,6 +321,8 @@ pub(super) struct Rec {
     floating: u8,
     /// The holding force \[N\]; NaN: not recorded.
     holding: f64,
+    /// decenter_x, decenter_y, despace \[mm\]; NaN: not recorded.
+    placement: [f64; 3],
     /// `Some` for a failed sample.
     reason: Option<Box<str>>,
 }
@@ -315,6 +348,9 @@ impl Rec {
                 Some(true) => 2,
             },
             holding: s.holding_force.unwrap_or(f64::NAN),
+            placement: s
+                .placement()
+                .map_or([f64::NAN; 3], |p| [p.decenter_x, p.decenter_y, p.despace]),
             reason: match a {
                 Some(_) => None,
                 None => Some(s.reason.clone().unwrap_or_default().into_boxed_str()),
@@ -392,6 +428,7 @@ impl Store {
         cols.loose[k] = r.loose;
         cols.floating[k] = r.floating;
         cols.holding[k] = r.holding;
+        [cols.decenter_x[k], cols.decenter_y[k], cols.despace[k]] = r.placement;
         match r.reason {
             None => cols.state[k] = CONVERGED,
             Some(why) => {

@@ -34,6 +34,7 @@ pub fn compose(report: &Report, writers: &[ShardWriter], files: &BTreeSet<String
     doc.text(
         "Percentiles of the distortion angle θ_P between the truss's top and bottom surfaces with their confidence intervals, the paper's Rayleigh law, the floating stages, the sweeps over σ and the allowable σ for the pointing target, from the verified shards of one job. Every number is also in report.json beside this file, at full precision; this report is written from the same results.",
     );
+    super::budget::budget_section(&mut doc, report);
     answer_section(&mut doc, report);
     run_section(&mut doc, report, writers);
     let contents_at = doc.blocks.len();

@@ -36,6 +36,7 @@
 //! temporary file renamed into place, never through a link, and listed in mc-merge's
 //! manifest ([`run_dir::OutputDir`]).
 
+pub mod budget;
 pub mod compose;
 pub mod document;
 pub mod floating;

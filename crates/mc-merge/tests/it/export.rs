@@ -66,7 +66,7 @@ fn csv_export_has_one_row_per_sample_with_the_shard_bytes() {
     let mut rows = text.lines();
     assert_eq!(
         rows.next().unwrap(),
-        "index,case,sample,status,theta_p,tan_theta_x,tan_theta_y,iterations,slack_cables,loose_joints,holding_force"
+        "index,case,sample,status,theta_p,tan_theta_x,tan_theta_y,decenter_x,decenter_y,decenter,despace,iterations,slack_cables,loose_joints,holding_force"
     );
     let rows: Vec<&str> = rows.collect();
     let lines = shard_lines(&files);
@@ -95,7 +95,15 @@ fn csv_export_has_one_row_per_sample_with_the_shard_bytes() {
     assert_eq!(objects.len(), 400);
     for (o, line) in objects.iter().zip(&lines) {
         let l: serde_json::Value = serde_json::from_str(line).unwrap();
-        for key in ["index", "case", "theta_p", "tan_theta_x", "tan_theta_y"] {
+        for key in [
+            "index",
+            "case",
+            "theta_p",
+            "tan_theta_x",
+            "tan_theta_y",
+            "decenter",
+            "despace",
+        ] {
             assert_eq!(o[key], l[key], "{key}");
         }
     }

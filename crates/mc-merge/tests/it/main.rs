@@ -2,6 +2,7 @@
 //! readable reports and the report directory.
 
 mod authorship;
+mod budget;
 mod cli;
 mod collect;
 mod common;

@@ -1,5 +1,6 @@
 //! `docs/report.schema.json`, the standalone JSON Schema of `report.json` for readers who do
-//! not read Rust, checked against real reports: a complete job with σ and stages sweeps, and a
+//! not read Rust, checked against real reports: a complete job with σ and stages sweeps and a
+//! budget, and a
 //! partial one with failed samples excluded and degenerate cases (0, 1, 2 samples, all angles
 //! zero), where figures are null with reasons. The check is `schema-check`'s (shared with
 //! mc-shard's shard-record schema test), which refuses any keyword it does not check, so the
@@ -34,7 +35,7 @@ fn report(job: &SynthJob, drop_shard: Option<usize>, allow: bool) -> Value {
 
 #[test]
 fn real_reports_match_the_schema() {
-    let sweeps = SynthJob::new(
+    let mut sweeps = SynthJob::new(
         5,
         vec![
             SynthCase::rayleigh("s1", 300, 2e-5, &[("sigma", 0.0033), ("stages", 5.0)]),
@@ -42,7 +43,15 @@ fn real_reports_match_the_schema() {
             SynthCase::rayleigh("s3", 300, 3e-5, &[("sigma", 0.0066), ("stages", 2.0)]),
         ],
     );
+    sweeps.budget = Some(shard_record::Budget {
+        percentile: 97.5,
+        theta_p: Some(9.7e-5),
+        decenter: Some(0.05),
+        despace: Some(0.03),
+    });
     let complete = report(&sweeps, None, false);
+    assert_eq!(complete["budget"]["cases"].as_array().unwrap().len(), 3);
+    assert!(complete["cases"][0]["decenter"]["law"]["sigma"].is_object());
     assert_eq!(
         complete["sweep"]["sigma_series"].as_array().unwrap().len(),
         1

@@ -146,11 +146,11 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "4da50f118d9997ff94295fc88e3aefbfd82bd0436fa55310711bfd09112d975d"
+        "a220e10d9ee3623c8c8a9801341b72685c617deb6c2228c3fc2de9c8f26efd6b"
     );
     assert_eq!(
         digest,
-        "ca97300a9e386c6937cf524581fa3cca86d1d63050801d2f0140e0bde687536e"
+        "fb65ca48ad806ec005f28d55fd34a8fee19de18b2375eb359f3bd60364e9f2f9"
     );
 }
 

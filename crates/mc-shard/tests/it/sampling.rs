@@ -205,3 +205,53 @@ fn truncated_normal_jobs_draw_and_run() {
     let begin = std::fs::read_to_string(shard).unwrap();
     assert!(begin.contains(r#""truncated_normal":2.0"#), "{begin}");
 }
+
+/// A job with lot-shared length errors: `inputs` writes the summed errors, so the battens of
+/// one level, which have no scatter of their own (σ_part = 0), share one value per sample,
+/// different from the next level's, and those are the sampler's draws bit for bit.
+#[test]
+fn inputs_write_the_lots_shared_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = r#"{"model": {"prism": {"stages": 2}}, "seed": 5, "cases": [
+        {"name": "lots", "samples": 10, "length_errors": {
+            "batten": {"normal": {"sigma": 0}, "lot": {"by": "level", "normal": {"sigma": 0.003}}},
+            "longeron": {"normal": {"sigma": 0.0063}}}}]}"#;
+    let path = crate::common::write(dir.path(), "job.json", text);
+    let csv = dir.path().join("inputs.csv");
+    let o = crate::binary::mc_shard(&[
+        "inputs",
+        "--job",
+        path.to_str().unwrap(),
+        "-o",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let job = mc_shard::Job::read(&path).unwrap();
+    let case = &job.cases[0];
+    let key = stream_key(job.seed, &case.name);
+    let table = std::fs::read_to_string(&csv).unwrap();
+    let rows: Vec<Vec<&str>> = table.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 11);
+    let column = |id: &str| {
+        rows[0]
+            .iter()
+            .position(|h| *h == format!("length_error:{id}"))
+            .unwrap()
+    };
+    let mut errors = Vec::new();
+    for (k, row) in rows[1..].iter().enumerate() {
+        mc_shard::sampler::draw_length_errors(&key, case, k as u64, &mut errors);
+        for level in 0..3 {
+            let first = row[column(&format!("batten.{level}.0"))];
+            for j in 1..3 {
+                assert_eq!(row[column(&format!("batten.{level}.{j}"))], first);
+            }
+            let m = case
+                .model
+                .member_index(&format!("batten.{level}.0"))
+                .unwrap();
+            assert_eq!(first.parse::<f64>().unwrap().to_bits(), errors[m].to_bits());
+        }
+        assert_ne!(row[column("batten.0.0")], row[column("batten.1.0")]);
+    }
+}

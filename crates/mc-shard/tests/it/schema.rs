@@ -1,6 +1,7 @@
 //! The standalone JSON Schema of shard records (`docs/shard-record.schema.json`) matches
 //! what mc-shard writes: every line of real shards (converged samples with and without
-//! backlash joints, a failed sample, checkpoints, a stop checkpoint, begin and end lines)
+//! backlash joints, a failed sample, checkpoints, a stop checkpoint, begin (with a budget)
+//! and end lines)
 //! validates, and lines that break the format do not.
 //!
 //! The check is `schema-check`'s, shared with mc-merge's report schema test.
@@ -21,10 +22,15 @@ fn schema() -> Value {
 fn real_shard_lines_validate_against_the_schema() {
     let root = schema();
     let dir = tempfile::tempdir().unwrap();
-    let text = small_job(120).replace(
-        r#"{"name": "uniform", "samples": 120,"#,
-        r#"{"name": "uniform", "samples": 120, "model": {"prism": {"stages": 2, "backlash": true}},"#,
-    );
+    let text = small_job(120)
+        .replace(
+            r#"{"name": "uniform", "samples": 120,"#,
+            r#"{"name": "uniform", "samples": 120, "model": {"prism": {"stages": 2, "backlash": true}},"#,
+        )
+        .replace(
+            r#""seed": 7,"#,
+            r#""seed": 7, "budget": {"theta_p": {"arcsec": 20}, "decenter": {"um": 50}, "despace": {"mm": 0.03}},"#,
+        );
     assert_ne!(text, small_job(120));
     let job = write(dir.path(), "job.json", &text);
     let run = |out: &std::path::Path, extra: &[&str]| {
@@ -57,6 +63,7 @@ fn real_shard_lines_validate_against_the_schema() {
                 s.residual,
                 s.slack_cables,
             ) = (None, None, None, None, None);
+            (s.decenter_x, s.decenter_y, s.decenter, s.despace) = (None, None, None, None);
             s.reason = Some("Newton did not converge in 60 iterations".into());
         }
     });
@@ -93,6 +100,18 @@ fn real_shard_lines_validate_against_the_schema() {
         );
         kinds.insert(kind);
     }
+    // The begin line carries the budget in rad and mm; converged lines their placement.
+    assert!(
+        lines[0].contains(r#""budget":{"percentile":95.0,"theta_p":"#),
+        "{}",
+        lines[0]
+    );
+    assert!(
+        lines[0].contains(r#""decenter":0.05,"despace":0.03}"#),
+        "{}",
+        lines[0]
+    );
+    assert!(lines[1].contains(r#""decenter_x":"#) && lines[1].contains(r#""despace":"#));
     // begin, end, checkpoint; converged with and without loose_joints; failed.
     assert_eq!(kinds.len(), 6, "{kinds:?}");
     // Lines of the backlash case say whether a stage floats.

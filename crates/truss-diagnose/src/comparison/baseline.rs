@@ -152,6 +152,7 @@ impl Baseline {
                 samples,
                 ..self.case_spec(edit)
             }],
+            budget: self.spec.budget,
         };
         Ok(Job::new(&spec, Path::new("."))?)
     }

@@ -57,6 +57,10 @@ fn groups_that_cannot_be_scaled_are_refused() {
             "biased-truncated",
             r#"{"longeron": {"truncated_normal": {"mean": 0.01, "sigma": 0.01, "limit": 0.02}}}"#,
         ),
+        (
+            "lot",
+            r#"{"longeron": {"normal": {"sigma": 0.01}, "lot": {"by": "level", "normal": {"sigma": 0.005}}}}"#,
+        ),
     ];
     let path = job(&dir, 1, &cases);
     for (case, _) in cases {
@@ -66,6 +70,12 @@ fn groups_that_cannot_be_scaled_are_refused() {
             "{case}: {e}"
         );
         assert!(!e.is_usage());
+        if case == "lot" {
+            assert!(
+                e.to_string().contains("production lot's shared part"),
+                "{e}"
+            );
+        }
     }
 }
 

@@ -69,6 +69,8 @@ pub struct SynthJob {
     pub seed: u64,
     /// The cases.
     pub cases: Vec<SynthCase>,
+    /// The alignment budget the begin lines carry, if any.
+    pub budget: Option<shard_record::Budget>,
 }
 
 impl SynthJob {
@@ -78,6 +80,7 @@ impl SynthJob {
             job_id: format!("{:016x}", rng::mix64(seed)).repeat(4),
             seed,
             cases,
+            budget: None,
         }
     }
 
@@ -132,6 +135,14 @@ impl SynthJob {
                 (r * a.cos(), r * a.sin())
             }
         };
+        // Decenter from the same draws, 1000 mm per unit tangent (so Rayleigh where θ_P
+        // is), and a despace N(0, (700 σ_t mm)²) from a stream of its own.
+        let zkey = rng::replicate_key(self.seed, Stream::Synthetic, 1);
+        let z = rng::box_muller(
+            rng::open01(rng::bits(zkey, 2 * index)),
+            rng::open01(rng::bits(zkey, 2 * index + 1)),
+        );
+        let (dx, dy) = (1000.0 * tx, 1000.0 * ty);
         Sample {
             index,
             case: case.name.clone(),
@@ -145,6 +156,10 @@ impl SynthJob {
             theta_p: (!failed).then(|| (tx * tx + ty * ty).sqrt().atan()),
             tan_theta_x: (!failed).then_some(tx),
             tan_theta_y: (!failed).then_some(ty),
+            decenter_x: (!failed).then_some(dx),
+            decenter_y: (!failed).then_some(dy),
+            decenter: (!failed).then_some(dx.hypot(dy)),
+            despace: (!failed).then_some(700.0 * case.sigma_t * z),
             residual: (!failed).then_some(1e-11),
             slack_cables: (!failed).then_some((index % 5) as u32),
             loose_joints: (case.loose && !failed).then_some((k % 4) as u32),
@@ -173,6 +188,7 @@ impl SynthJob {
             self.samples(),
             self.case_infos(),
         )
+        .with_budget(self.budget)
     }
 
     /// The bytes of a complete shard of `range`.
