@@ -120,12 +120,9 @@ impl Solver {
         self.iterate(p, true, kernels).await
     }
 
-    /// Steps 2–5 of the module doc from the current point (a warm start): `u` as it is,
-    /// evaluated, and model steps from there.
-    pub(super) async fn newton_warm(
-        &mut self,
-        kernels: Kernels<'_>,
-    ) -> Result<SolveReport, SolveError> {
+    /// Evaluates the current point `u` into the solver's state: the residual, the members'
+    /// states and the slack set.
+    pub(super) async fn evaluate_current(&mut self, kernels: Kernels<'_>) -> Evaluation {
         let structure = Arc::clone(&self.structure);
         let eval = kernels
             .evaluate(Evaluate {
@@ -140,6 +137,17 @@ impl Solver {
             })
             .await;
         self.update_slack();
+        eval
+    }
+
+    /// Steps 2–5 of the module doc from the current point (a warm start): `u` as it is,
+    /// evaluated, and model steps from there.
+    pub(super) async fn newton_warm(
+        &mut self,
+        kernels: Kernels<'_>,
+    ) -> Result<SolveReport, SolveError> {
+        let structure = Arc::clone(&self.structure);
+        let eval = self.evaluate_current(kernels).await;
         self.chord_secant = f64::NAN;
         self.step.damping = 0.0;
         self.step.plain_step = false;
@@ -255,19 +263,7 @@ impl Solver {
                 Mode::Tangent
             }
         };
-        let eval = kernels
-            .evaluate(Evaluate {
-                structure: &structure,
-                key: self.sample_key,
-                members: &mut self.sample.members,
-                tension: &mut self.sample.tension,
-                loads: &mut self.sample.loads,
-                u: &mut self.work.u,
-                r: &mut self.work.r,
-                states: &mut self.work.states,
-            })
-            .await;
-        self.update_slack();
+        let eval = self.evaluate_current(kernels).await;
         Progress {
             iterations,
             factorisations,

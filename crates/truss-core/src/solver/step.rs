@@ -235,16 +235,7 @@ impl Solver {
                 if !c.is_cable {
                     continue;
                 }
-                let st = &self.work.states[m];
-                let dv = [
-                    self.work.d[c.link.dofs[3]] - self.work.d[c.link.dofs[0]],
-                    self.work.d[c.link.dofs[4]] - self.work.d[c.link.dofs[1]],
-                    self.work.d[c.link.dofs[5]] - self.work.d[c.link.dofs[2]],
-                ];
-                let e = st.elongation
-                    + st.direction[0] * dv[0]
-                    + st.direction[1] * dv[1]
-                    + st.direction[2] * dv[2];
+                let e = self.predicted_elongation(m, &self.work.d);
                 let slack =
                     c.sense * e < 0.0 && c.compression_ratio < 1.0 && !self.factor.locked[m];
                 // A member predicted within the noise of its kink keeps its state: a floating
@@ -323,10 +314,22 @@ impl Solver {
     /// With `self.work.scratch` a direction of negative curvature `v` of `K(S)`, finds the slack
     /// cable of `S` that engages first along `±v` (the sign that lowers the energy first,
     /// else the other), makes it taut and locked in `S`, and returns true; false if no slack
-    /// cable engages. Only a cable whose stiffness once taut outweighs the direction's
-    /// negative curvature (`k·rate² > −curvature`, N/mm per unit of `v`) counts: pass
-    /// infinity to count every cable.
+    /// cable engages. See [`Solver::first_to_engage`] for `curvature`.
     fn engage_first_cable(&mut self, curvature: f64) -> bool {
+        let Some(m) = self.first_to_engage(curvature) else {
+            return false;
+        };
+        self.factor.factor_slack[m] = false;
+        self.factor.locked[m] = true;
+        true
+    }
+
+    /// With `self.work.scratch` a direction `v` in which the model falls, the slack cable of
+    /// the model's set `S` that engages first along `±v` (the sign that lowers the energy
+    /// first, else the other). Only a cable whose stiffness once taut outweighs the
+    /// direction's negative curvature (`k·rate² > −curvature`, N/mm per unit of `v`) counts:
+    /// pass infinity to count every cable.
+    pub(super) fn first_to_engage(&self, curvature: f64) -> Option<usize> {
         let n = self.structure.free;
         let v = &self.work.scratch;
         let descent = if dot_n(&self.work.r[..n], &v[..n]) > 0.0 {
@@ -341,16 +344,7 @@ impl Solver {
                     continue;
                 }
                 let st = &self.work.states[m];
-                let dv = [
-                    v[c.link.dofs[3]] - v[c.link.dofs[0]],
-                    v[c.link.dofs[4]] - v[c.link.dofs[1]],
-                    v[c.link.dofs[5]] - v[c.link.dofs[2]],
-                ];
-                let rate = sign
-                    * c.sense
-                    * (st.direction[0] * dv[0] + st.direction[1] * dv[1] + st.direction[2] * dv[2]);
-                // Only a member whose stiffness, once it bears, outweighs the direction's
-                // negative curvature holds it.
+                let rate = sign * c.sense * self.elongation_rate(m, v);
                 let k = self.sample.tension[m] * (1.0 - self.sample.members[m].compression_ratio);
                 if rate > 0.0 && k * rate * rate > -curvature {
                     let at = (-c.sense * st.elongation).max(0.0) / rate;
@@ -359,13 +353,35 @@ impl Solver {
                     }
                 }
             }
-            if let Some((_, m)) = first {
-                self.factor.factor_slack[m] = false;
-                self.factor.locked[m] = true;
-                return true;
+            if first.is_some() {
+                return first.map(|(_, m)| m);
             }
         }
-        false
+        None
+    }
+
+    /// Member `m`'s elongation after the step `d` to first order \[mm\]: the current one plus
+    /// its direction dotted with its ends' relative step (summed in that order).
+    #[inline]
+    pub(super) fn predicted_elongation(&self, m: usize, d: &[f64]) -> f64 {
+        let (dofs, st) = (&self.structure.members[m].link.dofs, &self.work.states[m]);
+        st.elongation
+            + st.direction[0] * (d[dofs[3]] - d[dofs[0]])
+            + st.direction[1] * (d[dofs[4]] - d[dofs[1]])
+            + st.direction[2] * (d[dofs[5]] - d[dofs[2]])
+    }
+
+    /// The first-order change of member `m`'s elongation along the displacement `v` \[mm per
+    /// unit of `v`\]: its direction dotted with its ends' relative displacement.
+    #[inline]
+    pub(super) fn elongation_rate(&self, m: usize, v: &[f64]) -> f64 {
+        let (dofs, n) = (
+            &self.structure.members[m].link.dofs,
+            &self.work.states[m].direction,
+        );
+        n[0] * (v[dofs[3]] - v[dofs[0]])
+            + n[1] * (v[dofs[4]] - v[dofs[1]])
+            + n[2] * (v[dofs[5]] - v[dofs[2]])
     }
 
     /// Assembles into `self.factor.k` the model stiffness `K(S)` of the module doc at the current

@@ -67,25 +67,6 @@ impl Solver {
         self.sample_key.1 += 1;
     }
 
-    /// Evaluates the current point into the solver's state.
-    pub(super) async fn evaluate_current(&mut self, kernels: Kernels<'_>) -> Evaluation {
-        let structure = Arc::clone(&self.structure);
-        let e = kernels
-            .evaluate(super::super::lanes::Evaluate {
-                structure: &structure,
-                key: self.sample_key,
-                members: &mut self.sample.members,
-                tension: &mut self.sample.tension,
-                loads: &mut self.sample.loads,
-                u: &mut self.work.u,
-                r: &mut self.work.r,
-                states: &mut self.work.states,
-            })
-            .await;
-        self.update_slack();
-        e
-    }
-
     /// Whether member `m` is one-sided with nothing on its slack side at the current ratio.
     fn exactly_one_sided(&self, m: usize) -> bool {
         self.structure.members[m].is_cable && self.sample.members[m].compression_ratio == 0.0
@@ -172,7 +153,7 @@ impl Solver {
                             .k
                             .failed_pivot_direction(failure.index, &mut self.work.scratch);
                         self.work.scratch[n] = 0.0;
-                        if let Some(m) = self.first_engaging() {
+                        if let Some(m) = self.first_to_engage(f64::INFINITY) {
                             self.factor.factor_slack[m] = false;
                             locked[m] = true;
                             any = true;
@@ -192,18 +173,11 @@ impl Solver {
                     break;
                 }
                 let mut switched = false;
-                let d = &self.work.d;
                 for (m, c) in s.members.iter().enumerate() {
                     if !c.is_cable || locked[m] {
                         continue;
                     }
-                    let st = &self.work.states[m];
-                    let dofs = &c.link.dofs;
-                    let e = st.elongation
-                        + st.direction[0] * (d[dofs[3]] - d[dofs[0]])
-                        + st.direction[1] * (d[dofs[4]] - d[dofs[1]])
-                        + st.direction[2] * (d[dofs[5]] - d[dofs[2]]);
-                    let se = c.sense * e;
+                    let se = c.sense * self.predicted_elongation(m, &self.work.d);
                     let bearing = !self.factor.factor_slack[m];
                     if (se > kink && !bearing) || (se < -kink && bearing) {
                         self.factor.factor_slack[m] = bearing;
@@ -242,19 +216,12 @@ impl Solver {
             }
             if watch {
                 // The step's predicted states.
-                let d = &self.work.d;
                 let crosses = (0..mm).any(|m| {
                     let c = &s.members[m];
                     if !c.is_cable || start[m] == 0 {
                         return false;
                     }
-                    let st = &self.work.states[m];
-                    let dofs = &c.link.dofs;
-                    let e = st.elongation
-                        + st.direction[0] * (d[dofs[3]] - d[dofs[0]])
-                        + st.direction[1] * (d[dofs[4]] - d[dofs[1]])
-                        + st.direction[2] * (d[dofs[5]] - d[dofs[2]]);
-                    let se = c.sense * e;
+                    let se = c.sense * self.predicted_elongation(m, &self.work.d);
                     se.abs() > kink && (se > 0.0) != (start[m] > 0)
                 });
                 if crosses {
@@ -326,44 +293,6 @@ impl Solver {
             )
             .await;
         self.factor.k.set_pivot_tolerance(PIVOT_TOLERANCE);
-    }
-
-    /// With `self.work.scratch` a direction `v` in which the model falls, the slack
-    /// one-sided member of the model that engages first along `±v` (the sign that lowers
-    /// the energy first, else the other).
-    fn first_engaging(&self) -> Option<usize> {
-        let n = self.structure.free;
-        let v = &self.work.scratch;
-        let descent = if dot_n(&self.work.r[..n], &v[..n]) > 0.0 {
-            -1.0
-        } else {
-            1.0
-        };
-        for sign in [descent, -descent] {
-            let mut first: Option<(f64, usize)> = None;
-            for (m, c) in self.structure.members.iter().enumerate() {
-                if !(c.is_cable && self.factor.factor_slack[m]) {
-                    continue;
-                }
-                let st = &self.work.states[m];
-                let dofs = &c.link.dofs;
-                let rate = sign
-                    * c.sense
-                    * (st.direction[0] * (v[dofs[3]] - v[dofs[0]])
-                        + st.direction[1] * (v[dofs[4]] - v[dofs[1]])
-                        + st.direction[2] * (v[dofs[5]] - v[dofs[2]]));
-                if rate > 0.0 {
-                    let at = (-c.sense * st.elongation).max(0.0) / rate;
-                    if first.is_none_or(|(best, _)| at < best) {
-                        first = Some((at, m));
-                    }
-                }
-            }
-            if let Some((_, m)) = first {
-                return Some(m);
-            }
-        }
-        None
     }
 
     /// Step 3 of the module doc into `self.work.d`, with the factorisation of
