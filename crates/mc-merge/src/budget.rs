@@ -31,7 +31,7 @@
 use crate::analysis::{CaseAnalysis, Levels, replicate_interval};
 use crate::report::*;
 use crate::settings::Settings;
-use crate::sweep::{fit_through_origin, series_over};
+use crate::sweep::{fit_through_origin, outside_range, series_over};
 use shard_record::Budget;
 use shard_record::parameters::SIGMA;
 use std::collections::BTreeMap;
@@ -248,12 +248,7 @@ fn series_budget(
         .collect();
     let (allowable_sigma, binding, binding_share) =
         allowable(lines, &slopes, &rows, 1.0, confidence);
-    let (lo, hi) = x
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(*v), b.max(*v))
-        });
-    let extrapolated = allowable_sigma.get().is_some_and(|v| v < lo || v > hi);
+    let extrapolated = outside_range(&allowable_sigma, &x);
     BudgetSeries {
         name: if fixed.is_empty() {
             "all cases".into()

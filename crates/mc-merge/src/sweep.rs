@@ -150,6 +150,16 @@ pub fn series_over(params: &[&BTreeMap<String, f64>], param: &str) -> Vec<Series
         .collect()
 }
 
+/// Whether the σ `sigma` (mm; false where null) lies outside the range of the series' σs `x`.
+pub(crate) fn outside_range(sigma: &Figure, x: &[f64]) -> bool {
+    let (lo, hi) = x
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(*v), b.max(*v))
+        });
+    sigma.get().is_some_and(|v| v < lo || v > hi)
+}
+
 fn series_name(fixed: &BTreeMap<String, f64>) -> String {
     if fixed.is_empty() {
         "all cases".into()
@@ -281,12 +291,7 @@ fn sigma_series(
     };
     let through_origin = allow(origin, &origin_reps);
     let with_intercept = allow(inter, &inter_reps);
-    let (lo, hi) = x
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-            (a.min(*v), b.max(*v))
-        });
-    let extrapolated = through_origin.get().is_some_and(|v| v < lo || v > hi);
+    let extrapolated = outside_range(&through_origin, &x);
     SigmaSeries {
         name: series_name(&s.fixed),
         fixed: reals(&s.fixed),
