@@ -3,14 +3,23 @@
 #
 # Usage: scripts/test.sh           (scripts/test.sh --help prints this)
 #
-# Everything is compiled once, in the `ci` profile (Cargo.toml: optimised like release, with
-# debug assertions and overflow checks on, so the tests catch what a debug build catches),
-# into target/ci; every step below runs what that one build made.
-# 1. Build: every test target of the workspace and the binaries.
-# 2. cargo test --workspace --profile ci -- --include-ignored: unit, verification, property and
-#    CLI tests of every crate and the cross-crate pipeline (tests/), and in the same run the
-#    slow statistical checks that a plain `cargo test` ignores (the README's, step 5, apart).
-# 3. The Python package: built into target/py-venv with `maturin develop --profile ci` (the
+# Everything is compiled once, into target/ci: the release profile with debug assertions and
+# overflow checks on (CARGO_PROFILE_RELEASE_DEBUG_ASSERTIONS, _OVERFLOW_CHECKS), so the tests
+# catch what a debug build catches, and the workspace's own crates compiled through
+# clippy-driver (RUSTC_WORKSPACE_WRAPPER, with clippy's -D warnings: the lints are checked by
+# the same compilation, as `cargo clippy --all-targets -- -D warnings` checks them). Every
+# step below runs what that one build made.
+# 1. Build: every target of the workspace (tests, benchmarks and examples included, as
+#    clippy's --all-targets) and the binaries, clippy's lints failing it on any warning; then
+#    `cargo doc` with rustdoc's -D warnings (its dependencies checked once, its build scripts
+#    and procedural macros those of this build).
+# 2. The tests: unit, verification, property and CLI tests of every crate and the cross-crate
+#    pipeline (tests/), and in the same run the slow statistical checks that a plain
+#    `cargo test` ignores (the README's, step 5, apart), by cargo-nextest (each test its own
+#    process, both cores busy; `cargo test --workspace --release -- --include-ignored` where
+#    cargo-nextest is not installed). No crate has doc tests (tests/tests/it/doc_examples.rs
+#    keeps it so; each library sets doctest = false).
+# 3. The Python package: built into target/py-venv with `maturin develop --release` (the
 #    feature unifier crates/workspace-hack gives its dependencies the binaries' features, so
 #    only PyO3 and the extension are compiled) and its pytest tests, which compare its
 #    numbers with the binaries' bytes.
@@ -26,23 +35,20 @@
 #      screenshot is not blank, the page prints.
 # 5. The README as pasted (tests/tests/it/readme.rs, readme_runs_as_pasted): every ```sh and
 #    ```python block of README.md, in order, in a clean shell in a copy of the repository
-#    (target/readme-test/clone), with the paper's job cut to 2,000 samples a case: its own
-#    release build (`cargo build --release`, kept in the copy's target/ between runs), its
-#    own virtual environment and `pip install .` (maturin and NumPy, and pandas for its
-#    snippet, from PyPI), the Monte Carlo, the merge, the diagnosis, the tolerance study and
-#    the browser check of the quick start's report.
+#    (target/readme-test/clone), with the paper's job cut to 2,000 samples a case. The copy's
+#    target/release starts as a copy of this build's (target/ci/release) and its shell gets
+#    this build's settings, so the README's `cargo build --release` finds it built and its
+#    `pip install .` compiles only PyO3 and the extension; then its own virtual environment
+#    and `pip install .` (maturin and NumPy, and pandas for its snippet, from PyPI), the
+#    Monte Carlo, the merge, the diagnosis, the tolerance study and the browser check of the
+#    quick start's report.
 # Installs first, when something is missing, by scripts/setup.sh (as root or with sudo):
 # Debian's slurmctld, slurmd, slurm-client, munge, librsvg2-bin, fonts-dejavu-core and
 # chromium through apt-get, and the Python virtual environment target/py-venv with maturin,
 # pytest and numpy (and OpenTURNS where PyPI has a wheel) from PyPI; step 5 fetches maturin,
 # NumPy and pandas from PyPI into the copy's own environment. Crates come from crates.io as
 # cargo builds (Cargo.lock pins them).
-# Takes about 45 minutes from a clean clone on 2 cores (43 min 51 s measured on a machine
-# busy with other builds: step 1, 18 min; steps 2 and 3, 7 min, the Slurm check beside
-# them; step 4, 15 s; step 5, 18 min, most of it the copy's release build), and about
-# 13 minutes once built (measured part by part: step 1 finding nothing to build, 1 min;
-# steps 2 and 3, 8½ min; step 4, 15 s; step 5, 3½ min, its copy rebuilding only what
-# changed).
+# Takes about TIME_COLD from a clean clone on 2 cores, and about TIME_WARM once built.
 # `scripts/test.sh --help` prints this and runs nothing.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -60,15 +66,29 @@ phase() { echo "test: $1 (at ${SECONDS} s)" >&2; }
 
 command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && command -v chromium >/dev/null && [ -e /usr/share/fonts/truetype/dejavu/DejaVuSans.ttf ] && [ -x target/py-venv/bin/maturin ] || scripts/setup.sh
 
-phase "build: every test target and binary, in the ci profile"
-cargo test --workspace --profile ci --no-run --quiet
-cargo build --profile ci --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-mc
-BIN="$REPO/target/ci"
+# The one build's settings, for every cargo below (and the README's copy, step 5).
+export CARGO_TARGET_DIR="$REPO/target/ci"
+export CARGO_PROFILE_RELEASE_DEBUG_ASSERTIONS=true CARGO_PROFILE_RELEASE_OVERFLOW_CHECKS=true
+clippy_driver="$(rustup which clippy-driver 2>/dev/null || command -v clippy-driver)" || {
+    echo "test.sh: no clippy-driver: install clippy (rustup component add clippy)" >&2
+    exit 1
+}
+export RUSTC_WORKSPACE_WRAPPER="$clippy_driver"
+# cargo-clippy's way of passing `-- -D warnings` to clippy-driver.
+export CLIPPY_ARGS="-D__CLIPPY_HACKERY__warnings__CLIPPY_HACKERY__"
+
+phase "build: every target and binary, clippy's lints with it (-D warnings)"
+cargo test --workspace --all-targets --release --no-run --quiet
+cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-mc
+BIN="$CARGO_TARGET_DIR/release"
 export TRUSS_MC_BIN_DIR="$BIN" MC_SHARD="$BIN/mc-shard" MC_MERGE="$BIN/mc-merge" TRUSS_MC="$BIN/truss-mc"
+
+phase "cargo doc (rustdoc -D warnings)"
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --release --quiet
 
 # The Slurm check mostly waits on the scheduler (a minute, little of it CPU): it runs beside
 # the test suite, its output kept in a log that is printed if it fails, and waited for below.
-SLURM_LOG="$REPO/target/ci/slurm-e2e.log"
+SLURM_LOG="$CARGO_TARGET_DIR/slurm-e2e.log"
 phase "Slurm end to end: started in the background beside the tests (log: ${SLURM_LOG#"$REPO"/})"
 scripts/slurm/e2e-test.sh > "$SLURM_LOG" 2>&1 &
 slurm=$!
@@ -76,14 +96,21 @@ slurm_started=$SECONDS
 # Whatever fails first, the cluster the check started is stopped by the check itself: wait for it.
 trap 'wait "$slurm" 2>/dev/null || true' EXIT
 
-phase "cargo test --workspace, default and slow tiers"
-cargo test --workspace --profile ci --quiet -- --include-ignored --skip readme_runs_as_pasted
+if command -v cargo-nextest >/dev/null; then
+    phase "tests, default and slow tiers (cargo nextest)"
+    cargo nextest run --workspace --release --run-ignored all --no-fail-fast \
+        --status-level fail --final-status-level slow --hide-progress-bar \
+        -E 'not test(=readme::readme_runs_as_pasted)'
+else
+    phase "tests, default and slow tiers (cargo test: no cargo-nextest here)"
+    cargo test --workspace --release --quiet -- --include-ignored --skip readme_runs_as_pasted
+fi
 
-phase "Python package: maturin develop --profile ci, then pytest"
+phase "Python package: maturin develop --release, then pytest"
 (
     # shellcheck disable=SC1091
     . target/py-venv/bin/activate
-    maturin develop --profile ci --quiet
+    maturin develop --release --quiet
     python -m pytest python/tests -q
 )
 
@@ -102,7 +129,7 @@ scripts/smoke-test.sh
 phase "report.html in a browser"
 scripts/browser-test.sh
 
-phase "the README as pasted, in a copy of the repository (its own release build and Python package)"
-cargo test --profile ci --quiet -p pipeline-tests --test it readme_runs_as_pasted -- --ignored
+phase "the README as pasted, in a copy of the repository (its target/release a copy of this build's)"
+TRUSS_README_BUILD="$BIN" cargo test --release --quiet -p pipeline-tests --test it readme_runs_as_pasted -- --ignored
 
 phase "all passed"

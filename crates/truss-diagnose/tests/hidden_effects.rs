@@ -12,7 +12,7 @@
 //! Two tiers here. The default run's checks are small (40–60 specimens, N = 300 simulated
 //! samples, the true effect tried against one or two others; the small backlash and
 //! two-effect checks, some 20 s each in the debug build, are `#[ignore]`d with the slow tier).
-//! The `#[ignore]`d ones (run by scripts/test.sh in its optimised `ci` build) try every
+//! The `#[ignore]`d ones (run by scripts/test.sh in its one optimised build) try every
 //! candidate but backlash, or the effect's rivals, on 50–200 specimens, and the null-data
 //! false-positive rate over 20 seeds at 100 specimens (at 30:
 //! `ONLY=null-fpr scripts/diagnose-check.sh`), and (in `hidden_effects/stepwise.rs`) two

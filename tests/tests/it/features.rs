@@ -1,6 +1,7 @@
-//! The builds that `scripts/test.sh` makes one after another in its `ci` profile share their
-//! compiled third-party crates: every test target of the workspace, the binaries and the
-//! Python extension give each third-party crate the same features, so cargo compiles it
+//! The builds that `scripts/test.sh` makes one after another into its one build directory
+//! (`target/ci`) share their compiled third-party crates: every test target of the
+//! workspace, the binaries and the Python extension give each third-party crate the same
+//! features, so cargo compiles it
 //! once. The feature unifier `workspace-hack`
 //! (cargo-hakari's) makes it so; this test reads `cargo tree` and fails, naming the crate and
 //! the features, when a dependency change needs `cargo hakari generate` again. Without it,

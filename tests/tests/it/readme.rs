@@ -4,9 +4,11 @@
 //! [`readme_runs_as_pasted`] (slow, ignored by a plain `cargo test`; `scripts/test.sh` runs
 //! it) copies the repository's files as a clone would have them (`git ls-files`: tracked
 //! and new files, nothing ignored) into `target/readme-test/clone` (its `target/` is kept
-//! from the last run, as a build cache, and nothing else), and runs one `bash` there with
-//! an empty environment but `HOME`, `LANG=C.UTF-8` and a `PATH` of the system's directories
-//! and the user's cargo: the only set-up is what the README itself says (its own `PATH`
+//! from the last run, as a build cache, and nothing else; or, under `scripts/test.sh`, its
+//! `target/release` is a copy of the test command's own build: [`seed_release_build`]), and
+//! runs one `bash` there with an empty environment but `HOME`, `LANG=C.UTF-8`, a `PATH` of
+//! the system's directories and the user's cargo, and that build's settings when it was
+//! given: the only set-up is what the README itself says (its own `PATH`
 //! line, its own virtual environment). Each ```sh block is pasted as it is; each ```python
 //! block is given to the `python` that shell finds at that point. The one change to the
 //! clone: `jobs/paper-3.1.json` holds the paper's job with 2,000 samples per case instead
@@ -258,7 +260,7 @@ fn test_command_help_runs_nothing() {
     let said = out.split_whitespace().collect::<Vec<_>>().join(" ");
     for step in [
         "1. Build",
-        "2. cargo test",
+        "2. The tests",
         "3. The Python",
         "4. The end-to-end",
         "5. The README",
@@ -438,6 +440,52 @@ fn section(log: &str, line: usize) -> &str {
     &body[..body.find("=== README.md:").unwrap_or(body.len())]
 }
 
+/// The build settings `scripts/test.sh` compiles with (the release profile with debug
+/// assertions on, the workspace through clippy-driver): cargo's fingerprints include them, so
+/// a copy given the build must be given them too.
+const BUILD_SETTINGS: [&str; 4] = [
+    "CARGO_PROFILE_RELEASE_DEBUG_ASSERTIONS",
+    "CARGO_PROFILE_RELEASE_OVERFLOW_CHECKS",
+    "RUSTC_WORKSPACE_WRAPPER",
+    "CLIPPY_ARGS",
+];
+
+/// When `TRUSS_README_BUILD` names a release build of this repository (`scripts/test.sh`
+/// gives its own, `target/ci/release`), the copy's `target/release` becomes a copy of it, and
+/// the settings it was built with ([`BUILD_SETTINGS`], those set here) are returned for the
+/// copy's shell: cargo's fingerprints hold a workspace crate's path relative to the workspace
+/// and its files' times, which the copy keeps, so the README's `cargo build --release` finds
+/// every crate built and compiles nothing that this build compiled (a file changed since
+/// would be rebuilt, as in any checkout). Without it the copy builds for itself, as a fresh
+/// clone does. A copy, not links: the copy's cargo rewrites some of its files.
+fn seed_release_build(clone: &Path) -> Vec<(String, std::ffi::OsString)> {
+    let Some(build) = std::env::var_os("TRUSS_README_BUILD") else {
+        return Vec::new();
+    };
+    let build = PathBuf::from(build);
+    assert!(
+        build.join(".fingerprint").is_dir(),
+        "TRUSS_README_BUILD={}: not a cargo build directory",
+        build.display()
+    );
+    let release = clone.join("target/release");
+    if release.exists() {
+        std::fs::remove_dir_all(&release).unwrap();
+    }
+    std::fs::create_dir_all(clone.join("target")).unwrap();
+    let status = Command::new("cp")
+        .args(["-a", "--reflink=auto"])
+        .arg(&build)
+        .arg(&release)
+        .status()
+        .expect("cp runs");
+    assert!(status.success(), "copying {} failed", build.display());
+    BUILD_SETTINGS
+        .iter()
+        .filter_map(|k| Some((k.to_string(), std::env::var_os(k)?)))
+        .collect()
+}
+
 /// The README's blocks, in order, in a clean shell in a fresh copy of the repository (see
 /// the module doc).
 #[test]
@@ -445,6 +493,7 @@ fn section(log: &str, line: usize) -> &str {
 fn readme_runs_as_pasted() {
     let blocks = blocks();
     let clone = fresh_clone();
+    let settings = seed_release_build(&clone);
     let before = files_under(&clone, &["target"]);
     let (text, lines) = script(&blocks);
     let dir = root().join("target/readme-test");
@@ -464,6 +513,7 @@ fn readme_runs_as_pasted() {
         .env("HOME", std::env::var_os("HOME").unwrap_or_default())
         .env("LANG", "C.UTF-8")
         .env("PATH", path)
+        .envs(settings)
         .stdin(std::process::Stdio::null())
         .stdout(stdout)
         .stderr(stderr)
