@@ -126,6 +126,23 @@ fn a_one_sided_lot_has_the_share_a_direct_monte_carlo_gives() {
     for (sigmas, _, _) in &t.runs {
         assert_eq!(sigmas[2], 0.006);
     }
+    // tolerance.json and tolerance.md name the lot part as one.
+    let out = dir.path().join("out");
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("tolerance.json")).unwrap())
+            .unwrap();
+    let g = &doc["groups"]["longeron.lot"];
+    assert_eq!(
+        (g["lot"].as_bool(), g["fixed"].as_bool()),
+        (Some(true), Some(true))
+    );
+    assert_eq!(doc["groups"]["longeron"]["lot"], false);
+    assert_eq!(g["share"].as_f64(), Some(share));
+    let md = std::fs::read_to_string(out.join("tolerance.md")).unwrap();
+    assert!(
+        md.contains("| longeron.lot | 3 |") && md.contains("lot part, held at its σ"),
+        "{md}"
+    );
     // The lot's covariance per unit σ_L² is what the share says: S_lot σ_L² / (Var t / 2).
     let from_sensitivity = lot.sensitivity * 0.006 * 0.006 / (0.5 * t.sensitivity.fit.total);
     assert!((from_sensitivity / share - 1.0).abs() < 1e-9);
