@@ -147,3 +147,24 @@ fn a_one_sided_lot_has_the_share_a_direct_monte_carlo_gives() {
     let from_sensitivity = lot.sensitivity * 0.006 * 0.006 / (0.5 * t.sensitivity.fit.total);
     assert!((from_sensitivity / share - 1.0).abs() < 1e-9);
 }
+
+/// A lot spread symmetrically: `"by": "level"` makes each stage's three longerons one lot, so
+/// a lot's draw changes the stage's height evenly (despace) and tilts nothing; its share is
+/// near 0 however large σ_L, and the allocation is the own parts'.
+#[test]
+fn a_lot_around_the_axis_adds_no_tilt() {
+    let t = study(
+        r#"{"batten": {"normal": {"sigma": 0.002}}, "longeron": {"normal": {"sigma": 0.002}, "lot": {"by": "level", "normal": {"sigma": 0.006}}}}"#,
+        4000,
+    );
+    let lot = &t.groups[2];
+    assert_eq!((lot.name.as_str(), lot.members), ("longeron.lot", 2));
+    let (share, (_, hi)) = lot.share;
+    assert!(share < 0.01 && hi < 0.02, "{share}, up to {hi}");
+    assert!(
+        t.groups[1].share.0 > 0.9,
+        "the longerons' own parts: {:?}",
+        t.groups[1].share
+    );
+    assert!(t.verified);
+}
