@@ -143,3 +143,31 @@ def test_the_defaults_are_mc_merges(sweep, tmp_path: Path) -> None:
     out = tmp_path / "report"
     tool("mc-merge", str(shards), "--out", str(out), "--quiet")
     assert truss_mc.read_shards(shards).summary().text == (out / "report.json").read_text()
+
+
+# The σ-series of SWEEP_JOB's first two cases, held to a three-line alignment budget (as
+# jobs/budget-5.json states it, tightened so that the small truss fails one line).
+BUDGET_JOB = {
+    "model": {"prism": {"stages": 2}},
+    "seed": 11,
+    "budget": {"theta_p": {"arcsec": 20}, "decenter": {"um": 20}, "despace": {"mm": 0.03}, "percentile": 95},
+    "cases": SWEEP_JOB["cases"][:2],
+}
+
+
+def test_a_job_with_a_budget_gives_the_merges_report_with_its_budget(tmp_path: Path) -> None:
+    job = tmp_path / "job.json"
+    job.write_text(json.dumps(BUDGET_JOB))
+    shards = tmp_path / "shards"
+    tool("mc-shard", "run", "--job", str(job), "--out", str(shards), "--quiet")
+    report = tmp_path / "report"
+    console = tool("mc-merge", str(shards), "--out", str(report), *FAST).stdout
+    written = (report / "report.json").read_text()
+    budget = json.loads(written)["budget"]
+    assert [line["quantity"] for line in budget["lines"]] == ["theta_p", "decenter", "despace"], budget
+    # In-process and read back, the summary holds the same budget section, to the byte.
+    summary = truss_mc.Job.from_file(job).run(threads=2).summary(**settings())
+    assert summary.data["budget"] == budget
+    assert summary.text == written
+    assert console.endswith(f"{summary.answer.text}\nreport: {report / 'report.html'}\n"), console
+    assert truss_mc.read_shards(shards).summary(threads=1, **settings()).text == written

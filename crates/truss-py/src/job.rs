@@ -181,6 +181,7 @@ impl PyJob {
                 &job.id,
                 job.samples(),
                 &case_infos(&job),
+                mc_shard::shard::budget(&job),
                 "truss_mc",
                 env!("CARGO_PKG_VERSION"),
             );

@@ -77,6 +77,7 @@ fn read(files: &[PathBuf], partial: bool) -> Result<Read, Failure> {
                 &b.job_id,
                 b.job_samples,
                 &b.cases,
+                b.budget,
                 &b.program,
                 &b.program_version,
             ));

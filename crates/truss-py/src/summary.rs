@@ -10,7 +10,7 @@ use crate::errors::{Failure, Kind};
 use mc_merge::load::{Collector, Dataset, LoadOptions, ShardWriter, check_coverage};
 use mc_merge::{MergeError, Settings};
 use pyo3::prelude::*;
-use shard_record::{CaseInfo, Sample};
+use shard_record::{Budget, CaseInfo, Sample};
 use std::sync::Arc;
 
 impl From<MergeError> for Failure {
@@ -33,11 +33,13 @@ pub struct Collecting {
 
 impl Collecting {
     /// A collection for the job `job_id` of `job_samples` samples in `cases`, whose samples
-    /// `program` (version `version`) computed.
+    /// `program` (version `version`) computed, held to the job's alignment `budget` (as a
+    /// shard's begin line carries it: the report's budget section).
     pub fn new(
         job_id: &str,
         job_samples: u64,
         cases: &[CaseInfo],
+        budget: Option<Budget>,
         program: &str,
         version: &str,
     ) -> Self {
@@ -48,7 +50,7 @@ impl Collecting {
             files: 0,
         };
         Self {
-            collector: Collector::new(job_id, job_samples, cases, writer),
+            collector: Collector::new(job_id, job_samples, cases, writer).with_budget(budget),
         }
     }
 

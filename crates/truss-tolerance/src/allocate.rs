@@ -29,6 +29,13 @@
 //! and `k` is found by bisection so that `θ_Pq(Σ_fixed + k² Σ_free) = θ*` (`θ_Pq` increases with
 //! `k`). For the prism, whose groups are invariant under its 120° rotation, Σ is isotropic
 //! and the two coincide.
+//!
+//! ## Production lots
+//!
+//! A group's lot part is a group of the model too (`C_lot = Σ_L B_L B_Lᵀ`,
+//! [`crate::sensitivity`]), held at its σ like a fixed group, so it uses up its part of the
+//! budget first; it costs nothing here (`shared`: the cost counts the groups one machines),
+//! and the uniform σ's comparison keeps it at its σ too.
 
 use crate::percentile::{Covariance, theta_quantile};
 
@@ -43,6 +50,9 @@ pub struct GroupModel {
     pub weight: f64,
     /// Pinned σ \[mm\], if fixed.
     pub fixed: Option<f64>,
+    /// A production lot's shared part (fixed at its σ, no cost, kept in the uniform σ's
+    /// comparison).
+    pub shared: bool,
 }
 
 impl GroupModel {
@@ -78,11 +88,12 @@ pub fn model_theta(groups: &[GroupModel], sigmas: &[f64], q: f64) -> f64 {
     theta_quantile(&covariance(groups, sigmas), q)
 }
 
-/// The cost `Σ_g w_g n_g / σ_g` (infinite if a σ is 0).
+/// The cost `Σ_g w_g n_g / σ_g` over the groups not `shared` (infinite if a σ is 0).
 pub fn cost(groups: &[GroupModel], sigmas: &[f64]) -> f64 {
     groups
         .iter()
         .zip(sigmas)
+        .filter(|(g, _)| !g.shared)
         .map(|(g, s)| g.weight * g.members as f64 / s)
         .sum()
 }
@@ -129,10 +140,48 @@ pub fn allocate(groups: &[GroupModel], target: f64, q: f64) -> Result<Vec<f64>, 
     Ok(at(0.5 * (lo + hi)))
 }
 
-/// The common σ \[mm\] of every group with model θ_Pq = `target` \[rad\] (fixes ignored):
-/// `θ_Pq` is homogeneous in σ, so σ_u = tan θ* / r_q(Σ_g C_g).
+/// The common σ \[mm\] of every group not `shared` with model θ_Pq = `target` \[rad\]
+/// (fixes ignored; the shared lot parts at their σ): `θ_Pq` is homogeneous in σ, so
+/// σ_u = tan θ* / r_q(Σ_g C_g) where the lot parts add nothing, else by bisection on
+/// `θ_Pq(Σ_lots + σ_u² Σ_g C_g) = θ*` (0 where the lots alone reach the target).
 pub fn uniform(groups: &[GroupModel], target: f64, q: f64) -> f64 {
-    let ones = vec![1.0; groups.len()];
-    let r = crate::percentile::norm_quantile(&covariance(groups, &ones), q);
-    target.tan() / r
+    // Each sum over its own groups only (a 0 · ∞ of an extreme C_g would be NaN).
+    let sum = |shared: bool| {
+        let (g, s): (Vec<GroupModel>, Vec<f64>) = groups
+            .iter()
+            .filter(|g| g.shared == shared)
+            .map(|g| (*g, if shared { g.fixed.unwrap_or(0.0) } else { 1.0 }))
+            .unzip();
+        covariance(&g, &s)
+    };
+    let free = sum(false);
+    if !groups
+        .iter()
+        .any(|g| g.shared && g.fixed.is_some_and(|s| s > 0.0))
+    {
+        let r = crate::percentile::norm_quantile(&free, q);
+        return target.tan() / r;
+    }
+    let fixed = sum(true);
+    let at = |k: f64| {
+        let c: Covariance = std::array::from_fn(|j| fixed[j] + k * k * free[j]);
+        theta_quantile(&c, q)
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    while at(hi) < target {
+        lo = hi;
+        hi *= 2.0;
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if at(mid) < target {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= 1e-15 * hi {
+            break;
+        }
+    }
+    0.5 * (lo + hi)
 }

@@ -75,6 +75,13 @@
 //! `--fix`ed. The regression's cost grows with the square of the number of members with
 //! errors; it suits models of up to a few hundred.
 //!
+//! **Production lots.** A group's lot part (members of a lot share one draw) is a group of
+//! the study of its own, `GROUP.lot`, held at its σ like a `--fix`ed group: its share of the
+//! tilt's variance and its covariance come from the members' regression coefficients summed
+//! over each lot ([`sensitivity`]), and the allocation spends what is left of the target on
+//! the own parts ([`allocate`]). Its own part must have σ > 0 like any group's (the
+//! regression needs the members' errors to differ within a lot).
+//!
 //! ## Output (in `--out DIR`)
 //!
 //! `allocated-job.json` (the input job, the case's σ replaced by the allocation),

@@ -26,8 +26,10 @@ pub struct GroupResult {
     pub members: usize,
     /// Cost weight.
     pub weight: f64,
-    /// Pinned by `--fix`.
+    /// Pinned by `--fix`, or a lot part (held at its σ).
     pub fixed: bool,
+    /// A production lot's shared part (`GROUP.lot`; see [`crate::setup`]).
+    pub lot: bool,
 }
 
 /// The study's result.

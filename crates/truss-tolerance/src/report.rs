@@ -8,7 +8,7 @@
 //! | `format`, `version` | `"truss-tolerance"`, 1 |
 //! | `job_id`, `case` | the input job's id and the case studied |
 //! | `target_rad`, `target_arcsec`, `percentile` | θ* and the percentile q (in %) |
-//! | `groups` | map group → `{"sigma", "share", "share_interval": [lo, hi], "members", "fixed", "input_sigma", "weight", "sensitivity" (S_g, mm⁻²), "dtheta_dsigma" (∂θ_Pq/∂σ_g at the input σ, rad/mm)}` |
+//! | `groups` | map group → `{"sigma", "share", "share_interval": [lo, hi], "members" (a lot part: its lots), "fixed", "lot" (a production lot's shared part, `GROUP.lot`, held at its σ), "input_sigma", "weight", "sensitivity" (S_g, mm⁻²), "dtheta_dsigma" (∂θ_Pq/∂σ_g at the input σ, rad/mm)}` |
 //! | `members` | per member with a length error: `{"id", "group", "share", "share_interval", "share_x", "share_y"}` |
 //! | `nonlinear_share`, `nonlinear_interval` | the variance share no linear model explains |
 //! | `input` | θ_Pq at the input σ: `{"theta_p", "interval", "samples", "model_theta_p"}` |
@@ -54,6 +54,7 @@ pub fn json(t: &Tolerance) -> Value {
                 "share_interval": pair(g.share.1),
                 "members": g.members,
                 "fixed": g.fixed,
+                "lot": g.lot,
                 "input_sigma": num(g.input_sigma),
                 "weight": num(g.weight),
                 "sensitivity": num(g.sensitivity),
@@ -229,7 +230,11 @@ pub fn markdown(t: &Tolerance) -> String {
             g.derivative,
             g.weight,
             g.sigma,
-            if g.fixed { "fixed" } else { "" }
+            match (g.lot, g.fixed) {
+                (true, _) => "lot part, held at its σ",
+                (false, true) => "fixed",
+                (false, false) => "",
+            }
         );
     }
     let nl = &t.sensitivity.nonlinear;

@@ -30,6 +30,23 @@
 //! `β_i β_iᵀ` with `β_i = b_i / σ_i` \[mm⁻¹\] to the tilt's covariance, which is what the
 //! allocation ([`crate::allocate`]) uses.
 //!
+//! ## Production lots
+//!
+//! Where a group's members share a lot part, `e_i = p_i + s_L` (`Var p_i = σ_i²`, `Var s_L
+//! = σ_L²`, all independent), the regressors are correlated within a lot, and the regression
+//! still estimates the linear model `t ≈ a + Σ_i β_i e_i` (σ_i is the own part's σ, so
+//! `z_i = e_i/σ_i` and `b_i = β_i σ_i`). Its variance splits into the own parts' and the lots':
+//!
+//! ```text
+//! Var t = Σ_i β_i β_iᵀ σ_i²  +  Σ_L B_L B_Lᵀ σ_L²,      B_L = Σ_{i ∈ L} β_i   [mm⁻¹]
+//! share_i = |b_i|² / (Var tan θ_x + Var tan θ_y),   share_lot = σ_L² Σ_L |B_L|² / (…)
+//! ```
+//!
+//! so a member's share is its own part's, and each group's lot part is a group of its own
+//! (`GROUP.lot`, [`crate::setup`]) with covariance `Σ_L B_L B_Lᵀ` per unit σ_L², whatever
+//! σ_L is (0 included: the β come from the own parts' scatter). A lot on one side of the
+//! truss adds to the tilt (its members' β add up); a lot spread symmetrically cancels.
+//!
 //! ## Intervals
 //!
 //! Poisson bootstrap (`truss_stats::bootstrap`, weights keyed by the job seed and the sample
@@ -56,6 +73,10 @@ pub struct Fit {
     pub share_y: Vec<f64>,
     /// Per member `β_i β_iᵀ` \[mm⁻²\] (the tilt's covariance per unit σ_i²).
     pub covariance: Vec<Covariance>,
+    /// Per member `β_i = (∂tan θ_x/∂e_i, ∂tan θ_y/∂e_i)` \[mm⁻¹\].
+    pub beta: Vec<[f64; 2]>,
+    /// The tilt's variances `Var tan θ_x + Var tan θ_y` \[-\], the shares' denominator.
+    pub total: f64,
     /// The tilt's sample variances (Var tan θ_x, Var tan θ_y) \[-\].
     pub variance: [f64; 2],
     /// The residual share `(SSR_x + SSR_y) / (SST_x + SST_y)` = 1 − R²: the variance the
@@ -173,6 +194,7 @@ pub fn fit(run: &Run, sigma: &[f64], weights: Option<&[u8]>) -> Option<Fit> {
     }
     let mut f = Fit {
         variance: [var_x, var_y],
+        total,
         residual: ssr / (total * w_total),
         ..Fit::default()
     };
@@ -185,17 +207,56 @@ pub fn fit(run: &Run, sigma: &[f64], weights: Option<&[u8]>) -> Option<Fit> {
             .push(if var_y > 0.0 { b_y * b_y / var_y } else { 0.0 });
         let (px, py) = (b_x / sigma[j], b_y / sigma[j]);
         f.covariance.push([px * px, px * py, py * py]);
+        f.beta.push([px, py]);
     }
     Some(f)
 }
 
+/// A group's lots as the regression's columns: the group index its lot part has in the
+/// study, the columns (indices into the run's columns) of each lot's members, and the lot
+/// part's σ_L \[mm\].
+#[derive(Debug, Clone, PartialEq)]
+pub struct LotColumns {
+    /// The lot part's group index.
+    pub group: usize,
+    /// Per lot, its members' columns.
+    pub lots: Vec<Vec<usize>>,
+    /// σ_L \[mm\].
+    pub sigma: f64,
+}
+
+impl LotColumns {
+    /// `Σ_L B_L B_Lᵀ` \[mm⁻²\] of `fit` (see the module doc): the tilt's covariance per
+    /// unit σ_L².
+    pub fn covariance(&self, fit: &Fit) -> Covariance {
+        let mut c = [0.0; 3];
+        for lot in &self.lots {
+            let (bx, by) = lot.iter().fold((0.0, 0.0), |(x, y), &j| {
+                (x + fit.beta[j][0], y + fit.beta[j][1])
+            });
+            c[0] += bx * bx;
+            c[1] += bx * by;
+            c[2] += by * by;
+        }
+        c
+    }
+
+    /// The lot part's share of `Var tan θ_x + Var tan θ_y`, `σ_L² tr(Σ_L B_L B_Lᵀ) / total`.
+    pub fn share(&self, fit: &Fit) -> f64 {
+        let c = self.covariance(fit);
+        self.sigma * self.sigma * (c[0] + c[2]) / fit.total
+    }
+}
+
 /// Shares of every member and group with bootstrap intervals. `group_of[j]`: the group index
-/// of column `j`; `groups`: their number; `seed`: the bootstrap's seed.
+/// of column `j`; `groups`: their number (lot parts included); `lots`: the lot parts;
+/// `seed`: the bootstrap's seed.
 pub fn sensitivity(
     run: &Run,
     sigma: &[f64],
     group_of: &[usize],
     groups: usize,
+    lots: &[LotColumns],
     seed: u64,
     threads: usize,
 ) -> Result<Sensitivity, ToleranceError> {
@@ -208,10 +269,13 @@ pub fn sensitivity(
             m + 1
         ))
     })?;
-    let group_sums = |share: &[f64]| -> Vec<f64> {
+    let group_sums = |f: &Fit| -> Vec<f64> {
         let mut s = vec![0.0; groups];
-        for (j, v) in share.iter().enumerate() {
+        for (j, v) in f.share.iter().enumerate() {
             s[group_of[j]] += v;
+        }
+        for lot in lots {
+            s[lot.group] = lot.share(f);
         }
         s
     };
@@ -226,7 +290,7 @@ pub fn sensitivity(
         fit(run, sigma, Some(w))
             .map(|f| {
                 let mut v = f.share.clone();
-                v.extend(group_sums(&f.share));
+                v.extend(group_sums(&f));
                 v.push(f.residual);
                 v
             })
@@ -245,7 +309,7 @@ pub fn sensitivity(
         percentile_interval(&v, 0.95).unwrap_or((f64::NAN, f64::NAN))
     };
     let share_interval = (0..m).map(interval).collect();
-    let totals = group_sums(&fit_all.share);
+    let totals = group_sums(&fit_all);
     let group_share = (0..groups).map(|g| (totals[g], interval(m + g))).collect();
     let nonlinear = (fit_all.residual, interval(m + groups));
     Ok(Sensitivity {

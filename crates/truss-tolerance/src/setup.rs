@@ -9,6 +9,15 @@
 //! truncated normal its s and t scaled together. The draws of a sample are `σ·z` with `z`
 //! from the sample's stream (see `truss_job::sampler`), so two runs of the same case at
 //! different σ see the same `z`: common random numbers.
+//!
+//! **Production lots.** A group whose error has a lot part (`"lot"`: member `i` of lot `L`
+//! gets `e_i = p_i + s_L`) adds a group of its own to the study, named `GROUP.lot`, after
+//! the model's groups: its "members" are the group's lots, its σ the lot part's, and it is
+//! held at that σ as `--fix` holds a group (the shared part is the stock's or the batch's,
+//! not a machining tolerance the study allocates; a budget's common factor scales it with
+//! the rest). Its distribution must be scalable as a group's is; its σ may be 0 (then the
+//! study is the study without the lot). The lot draws come from a stream of their own, so
+//! a run at other σ values still sees the same `z` and the same lot draws.
 
 use crate::errors::ToleranceError;
 use std::collections::BTreeMap;
@@ -30,8 +39,18 @@ pub struct Group {
     pub members: usize,
     /// Cost weight `w` (default 1).
     pub weight: f64,
-    /// The σ it is pinned at by `--fix` \[mm\], if any.
+    /// The σ it is pinned at by `--fix` \[mm\], if any (a lot part: its own σ).
     pub fixed: Option<f64>,
+    /// For a lot part (`GROUP.lot`): the model group whose lots it is and the members
+    /// (model indices) of each lot; `None` for a model group.
+    pub lots: Option<(String, Vec<Vec<usize>>)>,
+}
+
+impl Group {
+    /// Whether this is a production lot's shared part, not a model group.
+    pub fn is_lot(&self) -> bool {
+        self.lots.is_some()
+    }
 }
 
 /// The job, the case and its groups.
@@ -116,17 +135,6 @@ impl Study {
                  errors, which the allocation rests on; study the case without backlash",
             ));
         }
-        if let Some(group) = validated.length_errors.lots.keys().next() {
-            return Err(ToleranceError::NotScalable {
-                case: case.to_string(),
-                group: group.clone(),
-                reason: "its length error has a production lot's shared part (\"lot\"): the \
-                         study's variance model takes every member's error as independent and \
-                         scales it with its group's σ, which a shared part breaks; study the \
-                         case without the lot"
-                    .into(),
-            });
-        }
         if validated.length_errors.is_empty() {
             return Err(ToleranceError::NoLengthErrors {
                 case: case.to_string(),
@@ -162,6 +170,7 @@ impl Study {
                 members,
                 weight: 1.0,
                 fixed: None,
+                lots: None,
             });
         }
         let known = groups
@@ -229,6 +238,31 @@ impl Study {
                 message: "every group is fixed: there is nothing left to allocate".into(),
             });
         }
+        // Each lot part, after the model groups, held at its σ.
+        for lot in &validated.lots {
+            let name = format!("{}.lot", lot.group);
+            let not = |reason: String| ToleranceError::NotScalable {
+                case: case.to_string(),
+                group: name.clone(),
+                reason: format!("its production lot's shared part: {reason}"),
+            };
+            if groups.iter().any(|g| g.name == name) {
+                return Err(not(format!(
+                    "the model has a group named {name:?} too; rename it for the study"
+                )));
+            }
+            let d = lot.distribution;
+            d.with_sigma(d.std_dev()).map_err(not)?;
+            groups.push(Group {
+                name,
+                distribution: d,
+                sigma: d.std_dev(),
+                members: lot.lots.len(),
+                weight: 0.0,
+                fixed: Some(d.std_dev()),
+                lots: Some((lot.group.clone(), lot.lots.clone())),
+            });
+        }
         spec.model = spec.model.clone().absolute(&base);
         for c in &mut spec.cases {
             c.model = c.model.take().map(|m| m.absolute(&base));
@@ -256,11 +290,22 @@ impl Study {
     pub fn case_with(&self, sigmas: &[f64], samples: u64) -> CaseSpec {
         let mut case = self.case().clone();
         case.samples = samples;
-        // The groups' own parts scaled (a case with lots is refused by `Study::new`).
+        // The groups' own parts scaled, and the lot parts.
+        for (g, &s) in self.groups.iter().zip(sigmas) {
+            if let Some((group, _)) = &g.lots
+                && let Some(lot) = case.length_errors.lots.get_mut(group)
+            {
+                lot.distribution = g
+                    .distribution
+                    .with_sigma(s)
+                    .expect("checked scalable in Study::new");
+            }
+        }
         case.length_errors.parts = self
             .groups
             .iter()
             .zip(sigmas)
+            .filter(|(g, _)| !g.is_lot())
             .map(|(g, &s)| {
                 let scaled = g.distribution.with_sigma(s);
                 (

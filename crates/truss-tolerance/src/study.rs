@@ -25,7 +25,7 @@ use crate::allocate::{self, AllocationError, GroupModel};
 use crate::errors::ToleranceError;
 use crate::options::{Options, bad};
 use crate::outcome::{BudgetCheck, GroupResult, Tolerance};
-use crate::sensitivity::sensitivity;
+use crate::sensitivity::{LotColumns, sensitivity};
 use crate::setup::Study;
 use crate::simulate::run_case;
 use crate::verify::{Percentile, percentile};
@@ -155,11 +155,30 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
     let sens_job = study.job_with(&input_sigmas, o.sensitivity_samples as u64)?;
     let sens_run = run_case(&sens_job, &columns, threads, "sensitivity")?;
     let column_sigma: Vec<f64> = group_of.iter().map(|&g| input_sigmas[g]).collect();
+    // Each lot part's lots as columns (a group's members all have errors, so all are columns).
+    let column_of = |i: usize| columns.iter().position(|&c| c == i);
+    let lots: Vec<LotColumns> = study
+        .groups
+        .iter()
+        .enumerate()
+        .filter_map(|(g, group)| {
+            let (_, lots) = group.lots.as_ref()?;
+            Some(LotColumns {
+                group: g,
+                lots: lots
+                    .iter()
+                    .map(|lot| lot.iter().filter_map(|&i| column_of(i)).collect())
+                    .collect(),
+                sigma: group.sigma,
+            })
+        })
+        .collect();
     let sens = sensitivity(
         &sens_run,
         &column_sigma,
         &group_of,
         study.groups.len(),
+        &lots,
         seed,
         threads,
     )?;
@@ -174,12 +193,16 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
             members: g.members,
             weight: g.weight,
             fixed: g.fixed,
+            shared: g.is_lot(),
         })
         .collect();
     for (j, &g) in group_of.iter().enumerate() {
         for k in 0..3 {
             models[g].covariance[k] += sens.fit.covariance[j][k];
         }
+    }
+    for lot in &lots {
+        models[lot.group].covariance = lot.covariance(&sens.fit);
     }
     for ((g, m), &(share, _)) in study.groups.iter().zip(&models).zip(&sens.group_share) {
         if m.fixed.is_none() && (share < LEAST_SHARE || m.sensitivity() <= 0.0) {
@@ -192,7 +215,12 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
     let input_model = allocate::model_theta(&models, &input_sigmas, q);
     let calibration = input.theta / input_model;
     let derivative = |g: usize| {
-        let h = 1e-4 * input_sigmas[g];
+        // A lot part of σ 0: θ_Pq is even in σ, so the symmetric difference gives 0.
+        let h = if input_sigmas[g] > 0.0 {
+            1e-4 * input_sigmas[g]
+        } else {
+            1e-7
+        };
         let mut up = input_sigmas.clone();
         let mut down = input_sigmas.clone();
         up[g] += h;
@@ -242,7 +270,16 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
         target,
         &models,
         q,
-        |t| Ok(vec![allocate::uniform(&models, t, q); models.len()]),
+        |t| {
+            let u = allocate::uniform(&models, t, q);
+            Ok(models
+                .iter()
+                .map(|m| match (m.shared, m.fixed) {
+                    (true, Some(s)) => s,
+                    _ => u,
+                })
+                .collect())
+        },
         |s| verify_run("uniform", s),
     )?;
     let (u_sigmas, u_p, _) = uniform_runs.last().expect("one run").clone();
@@ -329,6 +366,7 @@ fn analyse(o: &Options, study: &Study) -> Result<Tolerance, ToleranceError> {
             members: s.members,
             weight: s.weight,
             fixed: s.fixed.is_some(),
+            lot: s.is_lot(),
         })
         .collect();
     let members = columns

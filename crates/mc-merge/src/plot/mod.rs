@@ -8,6 +8,9 @@
 //! - `qq-STEM`: Rayleigh QQ plot with a pointwise band;
 //! - `exceedance-STEM`: 1 − F on a log scale with P99 and P99.9 marked;
 //! - `running-STEM`: the target percentile with its interval against the sample count;
+//! - `placement-STEM`: histograms of decenter with its fitted Rayleigh density and of
+//!   despace with its fitted normal density, their percentiles and the budget's limits, in
+//!   µm (where the samples record them);
 //!
 //! and over the job:
 //!
@@ -22,6 +25,7 @@
 //! diagnosis and the tolerance study.
 
 mod distribution;
+mod placement;
 #[cfg(feature = "png")]
 pub mod png;
 mod series;
@@ -36,7 +40,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 /// The prefixes of the per-case plot files.
-pub const CASE_PLOTS: [&str; 5] = ["theta_p", "tan", "qq", "exceedance", "running"];
+pub const CASE_PLOTS: [&str; 6] = ["theta_p", "tan", "qq", "exceedance", "running", "placement"];
 
 /// The names of the plots over the job.
 pub const JOB_PLOTS: [&str; 2] = ["sigma-sweep", "stages-sweep"];
@@ -156,7 +160,8 @@ pub fn draw_all(
     let mut w = Writer::new(out.path())?;
     let names: Vec<&str> = report.cases.iter().map(|c| c.name.as_str()).collect();
     for ((case, rep), stem) in cases.iter().zip(&report.cases).zip(file_stems(&names)) {
-        let [theta, tan, qq, exceedance, running] = CASE_PLOTS.map(|k| format!("{k}-{stem}"));
+        let [theta, tan, qq, exceedance, running, placement] =
+            CASE_PLOTS.map(|k| format!("{k}-{stem}"));
         w.write(out, &theta, distribution::theta(case, rep, report))?;
         w.write(out, &tan, distribution::tan(case, rep))?;
         w.write(out, &qq, distribution::qq(case, rep, report))?;
@@ -166,6 +171,7 @@ pub fn draw_all(
             distribution::exceedance(case, rep, report),
         )?;
         w.write(out, &running, distribution::running(case, rep, report))?;
+        w.write(out, &placement, placement::placement(case, rep, report))?;
     }
     let [sigma, stages] = JOB_PLOTS;
     w.write(out, sigma, series::sigma(report))?;

@@ -50,7 +50,41 @@ fn target_words(report: &Report, case: &CaseReport) -> String {
     s
 }
 
-/// The five plots of one case whose plot files are named after `stem`, those written.
+/// `0.0223 mm (22.3 µm)`.
+fn length(x: f64) -> String {
+    format!("{x:.4} mm ({:.1} µm)", x * truss_units::MICROMETRE_PER_MM)
+}
+
+/// Decenter's and |despace|'s empirical percentiles at `pct` and their laws' parameters,
+/// in words.
+fn placement_words(case: &CaseReport, pct: f64) -> String {
+    let at = |q: &crate::report::QuantityReport| {
+        q.percentiles
+            .iter()
+            .find(|p| p.percentile.0 == pct)
+            .and_then(|p| p.value)
+            .map_or("not defined".into(), |v| length(v.0))
+    };
+    let fig = |f: &Option<crate::report::Figure>| {
+        f.as_ref()
+            .and_then(|f| f.get())
+            .map_or("not defined".into(), length)
+    };
+    match (&case.decenter, &case.despace) {
+        (Some(d), Some(z)) => format!(
+            "the {} percentile of decenter is {}, the fitted Rayleigh scale {}; of |despace| {}, the normal law's mean {} and standard deviation {}",
+            ordinal(pct),
+            at(d),
+            fig(&d.law.sigma),
+            at(z),
+            fig(&z.law.mean),
+            fig(&z.law.std)
+        ),
+        _ => "the samples do not record decenter and despace".into(),
+    }
+}
+
+/// The six plots of one case whose plot files are named after `stem`, those written.
 pub fn case_plots(
     report: &Report,
     case: &CaseReport,
@@ -65,6 +99,10 @@ pub fn case_plots(
         Some(_) => "is rejected",
         None => "was not tested",
     };
+    let placement_pct = report
+        .budget
+        .as_ref()
+        .map_or(report.sweep.percentile.0, |b| b.percentile.0);
     let sigma_t = case
         .rayleigh
         .sigma_t
@@ -113,6 +151,20 @@ pub fn case_plots(
                 "The {pct} percentile of θ_P over the first n samples of case {name}, n on a log scale, with its distribution-free interval: where it has settled, n is enough."
             ),
             format!("The {pct} percentile of the first n samples with its interval."),
+        ),
+        plot(
+            files,
+            &format!("placement-{stem}"),
+            format!(
+                "Histograms of the decenter of case {name} with the fitted Rayleigh density and of its despace with the fitted normal density; {}{}.",
+                placement_words(case, placement_pct),
+                if report.budget.is_some() {
+                    "; the budget's limits are marked"
+                } else {
+                    ""
+                }
+            ),
+            "Decenter with its fitted Rayleigh density and despace with its fitted normal density (µm), their percentiles and the budget's limits.".into(),
         ),
     ]
     .into_iter()

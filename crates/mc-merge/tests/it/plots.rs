@@ -141,3 +141,103 @@ fn histogram_axis_holds_every_sample_when_the_tail_is_short() {
     assert_eq!(beyond, 1);
     assert!(hi < 5000.0 && hi > 999.0, "{hi}");
 }
+
+/// Runs `mc-merge` on `shards` into `out` with few replicates; panics unless it exits 0.
+fn merge_into(shards: &Path, out: &Path) {
+    let o = Command::new(env!("CARGO_BIN_EXE_mc-merge"))
+        .arg(shards)
+        .args(["-q", "--replicates", "50", "--gof-replicates", "19", "-o"])
+        .arg(out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+/// The decenter and despace plot of a case whose samples record them (synthetic: decenter
+/// Rayleigh(1000 σ_t mm) = Rayleigh(40 µm), despace N(0, (28 µm)²)) under a budget: written
+/// as SVG and PNG, rendering, its legend giving the report's fitted Rayleigh scale in µm and
+/// the budget's limits, listed in report.md, report.html and the directory's manifest. A
+/// case whose samples do not record them (as shards of numerics version 7 or earlier) gets
+/// no such plot, and its other plots are written as before.
+#[test]
+fn decenter_and_despace_are_plotted_with_their_laws_and_the_budget() {
+    let shards = tempfile::tempdir().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let mut job = SynthJob::new(
+        5,
+        vec![
+            SynthCase::rayleigh("placed", 3000, 4e-5, &[("sigma", 0.0063)]),
+            SynthCase::rayleigh("old", 500, 4e-5, &[("sigma", 0.0033)]),
+        ],
+    );
+    job.budget = Some(shard_record::Budget {
+        percentile: 95.0,
+        theta_p: None,
+        decenter: Some(0.1),
+        despace: Some(0.06),
+    });
+    let range = ShardRange {
+        start: 0,
+        end: 3500,
+    };
+    let bytes = job.shard_bytes_with(range, |s| {
+        if s.case == "old" {
+            (s.decenter_x, s.decenter_y, s.decenter, s.despace) = (None, None, None, None);
+        }
+    });
+    SynthJob::write_bytes(shards.path(), &range.file_name(), &bytes);
+    merge_into(shards.path(), out.path());
+    check_every_plot(out.path(), &["placed"], true, false);
+
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.path().join("report.json")).unwrap())
+            .unwrap();
+    let sigma_um = report["cases"][0]["decenter"]["law"]["sigma"]["value"]
+        .as_f64()
+        .unwrap()
+        * 1e3;
+    assert!((sigma_um / 40.0 - 1.0).abs() < 0.05, "σ̂_d = {sigma_um} µm");
+    let svg = std::fs::read_to_string(out.path().join("placement-placed.svg")).unwrap();
+    let shown = truss_plot::style::number(truss_plot::style::round_sig(sigma_um, 4));
+    assert!(
+        svg.contains("left: Rayleigh fit, σ̂") && svg.contains(&format!("= {shown} µm")),
+        "no Rayleigh fit of σ̂ = {shown} µm in the legend"
+    );
+    assert!(svg.contains("right: normal fit, mean "), "no normal fit");
+    assert!(
+        svg.contains("budget: decenter = 100 µm, |despace| = 60 µm"),
+        "no budget limits in the legend"
+    );
+    // The histograms: Rice's 2·3000^(1/3) = 29 bars in each panel (the bars' fill, BAR),
+    // and the legend's swatch.
+    let bars = svg.matches(r##"fill="#96AFD7""##).count();
+    assert_eq!(bars, 2 * 29 + 1, "bars drawn");
+
+    // The case without decenter and despace: no plot, the others written.
+    assert!(!out.path().join("placement-old.svg").exists());
+    assert!(!out.path().join("placement-old.png").exists());
+    assert!(out.path().join("theta_p-old.svg").exists());
+
+    // Listed with the other plots.
+    let md = std::fs::read_to_string(out.path().join("report.md")).unwrap();
+    let html = std::fs::read_to_string(out.path().join("report.html")).unwrap();
+    assert!(md.contains("placement-placed.svg"), "not in report.md");
+    assert!(html.contains("placement-placed.svg"), "not in report.html");
+    assert!(!md.contains("placement-old.svg") && !html.contains("placement-old"));
+    let manifest = std::fs::read_to_string(out.path().join(".mc-merge.manifest")).unwrap();
+    for ext in if cfg!(feature = "png") {
+        &["svg", "png"][..]
+    } else {
+        &["svg"][..]
+    } {
+        assert!(
+            manifest.contains(&format!("placement-placed.{ext}")),
+            "placement-placed.{ext} not in the manifest"
+        );
+    }
+}

@@ -199,7 +199,11 @@ fn check_markdown(out: &Path, report: &serde_json::Value) {
     }
     let linked: BTreeSet<&str> = links.iter().map(String::as_str).collect();
     let svgs = files_with(out, "svg");
-    assert_eq!(svgs.len(), 4 * 5 + 2, "{svgs:?}");
+    assert_eq!(
+        svgs.len(),
+        4 * mc_merge::plot::CASE_PLOTS.len() + 2,
+        "{svgs:?}"
+    );
     for f in svgs.iter().chain(&files_with(out, "png")) {
         assert!(linked.contains(f.as_str()), "{f} not linked");
     }

@@ -12,6 +12,7 @@ fn iso(s: f64, members: usize, weight: f64) -> GroupModel {
         members,
         weight,
         fixed: None,
+        shared: false,
     }
 }
 

@@ -58,8 +58,8 @@ fn groups_that_cannot_be_scaled_are_refused() {
             r#"{"longeron": {"truncated_normal": {"mean": 0.01, "sigma": 0.01, "limit": 0.02}}}"#,
         ),
         (
-            "lot",
-            r#"{"longeron": {"normal": {"sigma": 0.01}, "lot": {"by": "level", "normal": {"sigma": 0.005}}}}"#,
+            "constant-lot",
+            r#"{"longeron": {"normal": {"sigma": 0.01}, "lot": {"by": "level", "constant": {"value": 0.005}}}}"#,
         ),
     ];
     let path = job(&dir, 1, &cases);
@@ -70,9 +70,11 @@ fn groups_that_cannot_be_scaled_are_refused() {
             "{case}: {e}"
         );
         assert!(!e.is_usage());
-        if case == "lot" {
+        if case == "constant-lot" {
+            // A lot part is a group of the study; its distribution must scale as a group's.
+            let text = e.to_string();
             assert!(
-                e.to_string().contains("production lot's shared part"),
+                text.contains("longeron.lot") && text.contains("production lot's shared part"),
                 "{e}"
             );
         }
