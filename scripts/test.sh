@@ -15,10 +15,11 @@
 #    and procedural macros those of this build).
 # 2. The tests: unit, verification, property and CLI tests of every crate and the cross-crate
 #    pipeline (tests/), and in the same run the slow statistical checks that a plain
-#    `cargo test` ignores (the README's, step 5, apart), by cargo-nextest (each test its own
-#    process, both cores busy; `cargo test --workspace --release -- --include-ignored` where
-#    cargo-nextest is not installed). No crate has doc tests (tests/tests/it/doc_examples.rs
-#    keeps it so; each library sets doctest = false).
+#    `cargo test` ignores, by cargo-nextest (each test its own process, both cores busy, the
+#    longest first: .config/nextest.toml), step 5 among them; where cargo-nextest is not
+#    installed, `cargo test --workspace --release -- --include-ignored`, then step 5. No
+#    crate has doc tests (tests/tests/it/doc_examples.rs keeps it so; each library sets
+#    doctest = false).
 # 3. The Python package: built into target/py-venv with `maturin develop --release` (the
 #    feature unifier crates/workspace-hack gives its dependencies the binaries' features, so
 #    only PyO3 and the extension are compiled) and its pytest tests, which compare its
@@ -26,8 +27,8 @@
 # 4. The end-to-end checks with real parts, on target/ci's binaries:
 #    - scripts/slurm/e2e-test.sh: a real single-node Slurm cluster (started and stopped
 #      here): an 8-task job array with a dependent merge, and a cancelled task resubmitted
-#      (started beside step 2, since it mostly waits on the scheduler; its log is printed if
-#      it fails);
+#      (started beside the docs and step 2, since it mostly waits on the scheduler; its log
+#      is printed if it fails);
 #    - scripts/smoke-test.sh: the README's main command on a small job, and its SVG plots
 #      rendered to PNG with rsvg-convert, and mc-merge's own PNGs checked;
 #    - scripts/browser-test.sh: mc-merge's report.html opened in headless Chromium: every
@@ -48,7 +49,10 @@
 # pytest and numpy (and OpenTURNS where PyPI has a wheel) from PyPI; step 5 fetches maturin,
 # NumPy and pandas from PyPI into the copy's own environment. Crates come from crates.io as
 # cargo builds (Cargo.lock pins them).
-# Takes about TIME_COLD from a clean clone on 2 cores, and about TIME_WARM once built.
+# Takes about 14 minutes from a clean clone on 2 cores (831 s measured on a quiet machine: the
+# build 396 s, the docs 60, the tests with the README as pasted 322 (the README 142 of it),
+# Python 35, smoke and browser 12; the Slurm check beside them), and about 7 minutes once
+# built (414 s measured, the tests 346 of it).
 # `scripts/test.sh --help` prints this and runs nothing.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -69,6 +73,13 @@ command -v rsvg-convert >/dev/null && command -v slurmctld >/dev/null && command
 # The one build's settings, for every cargo below (and the README's copy, step 5).
 export CARGO_TARGET_DIR="$REPO/target/ci"
 export CARGO_PROFILE_RELEASE_DEBUG_ASSERTIONS=true CARGO_PROFILE_RELEASE_OVERFLOW_CHECKS=true
+# No line tables (the release profile's "line-tables-only"): a failing test still names its
+# file and line (the panic's location), only a backtrace's frames lose theirs.
+export CARGO_PROFILE_RELEASE_DEBUG=false
+# PyO3's build script looks for Python on PATH unless told, and reruns when PATH changes; the
+# README's clean shell has another PATH, so the interpreter is named here, for both.
+PYO3_PYTHON="$(python3 -c 'import sys; print(sys.executable)')"
+export PYO3_PYTHON
 clippy_driver="$(rustup which clippy-driver 2>/dev/null || command -v clippy-driver)" || {
     echo "test.sh: no clippy-driver: install clippy (rustup component add clippy)" >&2
     exit 1
@@ -83,27 +94,28 @@ cargo build --release --quiet -p mc-shard -p mc-merge -p truss-cli -p truss-mc
 BIN="$CARGO_TARGET_DIR/release"
 export TRUSS_MC_BIN_DIR="$BIN" MC_SHARD="$BIN/mc-shard" MC_MERGE="$BIN/mc-merge" TRUSS_MC="$BIN/truss-mc"
 
-phase "cargo doc (rustdoc -D warnings)"
-RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --release --quiet
-
 # The Slurm check mostly waits on the scheduler (a minute, little of it CPU): it runs beside
-# the test suite, its output kept in a log that is printed if it fails, and waited for below.
+# the docs and the test suite, its output kept in a log that is printed if it fails, and
+# waited for below.
 SLURM_LOG="$CARGO_TARGET_DIR/slurm-e2e.log"
-phase "Slurm end to end: started in the background beside the tests (log: ${SLURM_LOG#"$REPO"/})"
+phase "Slurm end to end: started in the background beside the docs and the tests (log: ${SLURM_LOG#"$REPO"/})"
 scripts/slurm/e2e-test.sh > "$SLURM_LOG" 2>&1 &
 slurm=$!
 slurm_started=$SECONDS
 # Whatever fails first, the cluster the check started is stopped by the check itself: wait for it.
 trap 'wait "$slurm" 2>/dev/null || true' EXIT
 
+phase "cargo doc (rustdoc -D warnings)"
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --release --quiet
+
 if command -v cargo-nextest >/dev/null; then
-    phase "tests, default and slow tiers (cargo nextest)"
-    cargo nextest run --workspace --release --run-ignored all --no-fail-fast \
-        --status-level fail --final-status-level slow --hide-progress-bar \
-        -E 'not test(=readme::readme_runs_as_pasted)'
+    phase "tests, default and slow tiers, and the README as pasted (cargo nextest)"
+    TRUSS_README_BUILD="$BIN" cargo nextest run --workspace --release --profile ci \
+        --run-ignored all --no-fail-fast --hide-progress-bar
 else
     phase "tests, default and slow tiers (cargo test: no cargo-nextest here)"
     cargo test --workspace --release --quiet -- --include-ignored --skip readme_runs_as_pasted
+    readme=1
 fi
 
 phase "Python package: maturin develop --release, then pytest"
@@ -129,7 +141,9 @@ scripts/smoke-test.sh
 phase "report.html in a browser"
 scripts/browser-test.sh
 
-phase "the README as pasted, in a copy of the repository (its target/release a copy of this build's)"
-TRUSS_README_BUILD="$BIN" cargo test --release --quiet -p pipeline-tests --test it readme_runs_as_pasted -- --ignored
+if [[ -n "${readme:-}" ]]; then
+    phase "the README as pasted, in a copy of the repository (its target/release a copy of this build's)"
+    TRUSS_README_BUILD="$BIN" cargo test --release --quiet -p pipeline-tests --test it readme_runs_as_pasted -- --ignored
+fi
 
 phase "all passed"

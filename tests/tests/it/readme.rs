@@ -441,13 +441,16 @@ fn section(log: &str, line: usize) -> &str {
 }
 
 /// The build settings `scripts/test.sh` compiles with (the release profile with debug
-/// assertions on, the workspace through clippy-driver): cargo's fingerprints include them, so
-/// a copy given the build must be given them too.
-const BUILD_SETTINGS: [&str; 4] = [
+/// assertions on and no line tables, the workspace through clippy-driver, the Python PyO3
+/// configures for): cargo's fingerprints include them, so a copy given the build must be
+/// given them too.
+const BUILD_SETTINGS: [&str; 6] = [
     "CARGO_PROFILE_RELEASE_DEBUG_ASSERTIONS",
     "CARGO_PROFILE_RELEASE_OVERFLOW_CHECKS",
+    "CARGO_PROFILE_RELEASE_DEBUG",
     "RUSTC_WORKSPACE_WRAPPER",
     "CLIPPY_ARGS",
+    "PYO3_PYTHON",
 ];
 
 /// When `TRUSS_README_BUILD` names a release build of this repository (`scripts/test.sh`
