@@ -91,6 +91,52 @@ fn verticals<DB: DrawingBackend>(
     Ok(())
 }
 
+/// One panel of the plot: a histogram as a density \[1/µm\] over `x_range` \[µm\], its fitted
+/// law's density curve in the given colour (none when empty), and vertical lines at the
+/// empirical percentiles (solid), the law's (dashed) and the budget's limits (dotted).
+struct Panel<'a> {
+    caption: &'a str,
+    x_desc: &'a str,
+    x_range: (f64, f64),
+    hist: &'a [(f64, f64, f64)],
+    fit: (&'a [(f64, f64)], RGBColor),
+    lines: [Vec<f64>; 3],
+}
+
+/// Draws `p` into `area`, its density axis from 0 to 5 % above the tallest bar or curve.
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    p: &Panel,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    let (curve, colour) = p.fit;
+    let top = p
+        .hist
+        .iter()
+        .map(|b| b.2)
+        .chain(curve.iter().map(|c| c.1))
+        .fold(0.0, f64::max)
+        * 1.05;
+    let top = top.max(1e-12);
+    let mut chart =
+        panel(area, p.caption.into()).build_cartesian_2d(p.x_range.0..p.x_range.1, 0.0..top)?;
+    styled_panel_mesh(&mut chart.configure_mesh())
+        .x_desc(p.x_desc)
+        .y_desc("probability density [1/µm]")
+        .draw()?;
+    chart.draw_series(
+        p.hist
+            .iter()
+            .map(|&(a, b, h)| Rectangle::new([(a, 0.0), (b, h)], BAR.filled())),
+    )?;
+    if !curve.is_empty() {
+        chart.draw_series(LineSeries::new(curve.to_vec(), colour.stroke_width(3)))?;
+    }
+    let [empirical, law, limit] = &p.lines;
+    verticals(&mut chart, empirical, top, palette(2).stroke_width(2), None)?;
+    verticals(&mut chart, law, top, BLACK.stroke_width(2), Some(DASHED))?;
+    verticals(&mut chart, limit, top, BLACK.stroke_width(2), Some(DOTTED))
+}
+
 /// The two-panel plot; `None` where the case does not record decenter and despace or has
 /// fewer than two samples that do.
 pub fn placement(
@@ -209,95 +255,32 @@ pub fn placement(
     let height = TITLE_HEIGHT + PANEL_ROW_HEIGHT;
     let svg = render(PANELS_WIDTH, height, &legend, |_, area| {
         let panels = titled_panels(area, &title, (1, 2))?;
-        // Decenter.
-        let top = d_hist
-            .iter()
-            .map(|b| b.2)
-            .chain(d_curve.iter().map(|c| c.1))
-            .fold(0.0, f64::max)
-            * 1.05;
-        let top = top.max(1e-12);
-        let mut chart = panel(
-            &panels[0],
-            "decenter = |δ projected on the bottom plane|".into(),
-        )
-        .build_cartesian_2d(0.0..d_hi, 0.0..top)?;
-        styled_panel_mesh(&mut chart.configure_mesh())
-            .x_desc("decenter [µm]")
-            .y_desc("probability density [1/µm]")
-            .draw()?;
-        chart.draw_series(
-            d_hist
-                .iter()
-                .map(|&(a, b, h)| Rectangle::new([(a, 0.0), (b, h)], BAR.filled())),
-        )?;
-        if !d_curve.is_empty() {
-            chart.draw_series(LineSeries::new(d_curve.clone(), RED.stroke_width(3)))?;
-        }
-        verticals(
-            &mut chart,
-            &d_emp.into_iter().collect::<Vec<_>>(),
-            top,
-            palette(2).stroke_width(2),
-            None,
-        )?;
-        verticals(
-            &mut chart,
-            &d_law.into_iter().collect::<Vec<_>>(),
-            top,
-            BLACK.stroke_width(2),
-            Some(DASHED),
-        )?;
-        verticals(
-            &mut chart,
-            &d_limit.into_iter().collect::<Vec<_>>(),
-            top,
-            BLACK.stroke_width(2),
-            Some(DOTTED),
-        )?;
-        // Despace.
-        let top = z_hist
-            .iter()
-            .map(|b| b.2)
-            .chain(z_curve.iter().map(|c| c.1))
-            .fold(0.0, f64::max)
-            * 1.05;
-        let top = top.max(1e-12);
-        let mut chart = panel(&panels[1], "despace = δ·n (signed, + apart)".into())
-            .build_cartesian_2d(-z_hi..z_hi, 0.0..top)?;
-        styled_panel_mesh(&mut chart.configure_mesh())
-            .x_desc("despace [µm]")
-            .y_desc("probability density [1/µm]")
-            .draw()?;
-        chart.draw_series(
-            z_hist
-                .iter()
-                .map(|&(a, b, h)| Rectangle::new([(a, 0.0), (b, h)], BAR.filled())),
-        )?;
-        if !z_curve.is_empty() {
-            chart.draw_series(LineSeries::new(z_curve.clone(), SIMULATED.stroke_width(3)))?;
-        }
         let pm = |x: Option<f64>| x.map_or(vec![], |x| vec![-x, x]);
-        verticals(
-            &mut chart,
-            &pm(z_emp),
-            top,
-            palette(2).stroke_width(2),
-            None,
+        draw_panel(
+            &panels[0],
+            &Panel {
+                caption: "decenter = |δ projected on the bottom plane|",
+                x_desc: "decenter [µm]",
+                x_range: (0.0, d_hi),
+                hist: &d_hist,
+                fit: (&d_curve, RED),
+                lines: [
+                    d_emp.into_iter().collect(),
+                    d_law.into_iter().collect(),
+                    d_limit.into_iter().collect(),
+                ],
+            },
         )?;
-        verticals(
-            &mut chart,
-            &pm(z_law),
-            top,
-            BLACK.stroke_width(2),
-            Some(DASHED),
-        )?;
-        verticals(
-            &mut chart,
-            &pm(z_limit),
-            top,
-            BLACK.stroke_width(2),
-            Some(DOTTED),
+        draw_panel(
+            &panels[1],
+            &Panel {
+                caption: "despace = δ·n (signed, + apart)",
+                x_desc: "despace [µm]",
+                x_range: (-z_hi, z_hi),
+                hist: &z_hist,
+                fit: (&z_curve, SIMULATED),
+                lines: [pm(z_emp), pm(z_law), pm(z_limit)],
+            },
         )?;
         Ok(())
     })?;
