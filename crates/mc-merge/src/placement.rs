@@ -62,19 +62,7 @@ pub fn folded_normal_quantile(mean: f64, sd: f64, alpha: f64) -> f64 {
         return mean.abs();
     }
     let cdf = |q: f64| phi((q - mean) / sd) - phi((-q - mean) / sd);
-    let (mut lo, mut hi) = (0.0, mean.abs() + 40.0 * sd);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if cdf(mid) < alpha {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo <= 1e-15 * hi {
-            break;
-        }
-    }
-    0.5 * (lo + hi)
+    truss_stats::bisect::bisect(cdf, alpha, (0.0, mean.abs() + 40.0 * sd))
 }
 
 /// The percentiles of `sample` with their bootstrap.

@@ -10,9 +10,11 @@
 //!   distribution-free order-statistic interval.
 //! - [`bootstrap`]: the Poisson bootstrap of quantiles and statistics, percentile and BCa
 //!   intervals.
+//! - [`bisect`]: where a nondecreasing function reaches a value (bisection, bracketing).
 //! - [`two_sample`]: moments, the two-sample Kolmogorov–Smirnov statistic and its p-value,
 //!   and Holm's step-down adjustment.
 
+pub mod bisect;
 pub mod bootstrap;
 pub mod quantile;
 pub mod rng;

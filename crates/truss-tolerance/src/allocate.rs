@@ -38,6 +38,7 @@
 //! and the uniform σ's comparison keeps it at its σ too.
 
 use crate::percentile::{Covariance, theta_quantile};
+use truss_stats::bisect::{bisect, bracket_from_zero};
 
 /// One group as the allocation sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,23 +122,9 @@ pub fn allocate(groups: &[GroupModel], target: f64, q: f64) -> Result<Vec<f64>, 
             .collect()
     };
     // Bracket k, then bisect: θ_Pq grows with k.
-    let (mut lo, mut hi) = (0.0, 1.0);
-    while model_theta(groups, &at(hi), q) < target {
-        lo = hi;
-        hi *= 2.0;
-    }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if model_theta(groups, &at(mid), q) < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo <= 1e-15 * hi {
-            break;
-        }
-    }
-    Ok(at(0.5 * (lo + hi)))
+    let theta = |k: f64| model_theta(groups, &at(k), q);
+    let k = bisect(theta, target, bracket_from_zero(theta, target));
+    Ok(at(k))
 }
 
 /// The common σ \[mm\] of every group not `shared` with model θ_Pq = `target` \[rad\]
@@ -167,21 +154,5 @@ pub fn uniform(groups: &[GroupModel], target: f64, q: f64) -> f64 {
         let c: Covariance = std::array::from_fn(|j| fixed[j] + k * k * free[j]);
         theta_quantile(&c, q)
     };
-    let (mut lo, mut hi) = (0.0, 1.0);
-    while at(hi) < target {
-        lo = hi;
-        hi *= 2.0;
-    }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if at(mid) < target {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo <= 1e-15 * hi {
-            break;
-        }
-    }
-    0.5 * (lo + hi)
+    bisect(at, target, bracket_from_zero(at, target))
 }

@@ -17,6 +17,8 @@
 //! Then `θ_Pq = atan(r_q)`. `r_q` is positively homogeneous of degree 1 in the scale of `t`:
 //! `r_q(c²Σ) = c·r_q(Σ)`.
 
+use truss_stats::bisect::bisect;
+
 /// A symmetric 2×2 covariance `[[xx, xy], [xy, yy]]` of (tan θ_x, tan θ_y), stored
 /// `[xx, xy, yy]` \[-\].
 pub type Covariance = [f64; 3];
@@ -58,22 +60,11 @@ pub fn norm_quantile(c: &Covariance, q: f64) -> f64 {
     let (l1, l2) = eigenvalues(c);
     let k = rayleigh_factor(q);
     // The quantile lies between the isotropic ones of the smaller and larger eigenvalue.
-    let (mut lo, mut hi) = (l2.sqrt() * k, l1.sqrt() * k);
+    let (lo, hi) = (l2.sqrt() * k, l1.sqrt() * k);
     if hi <= 0.0 {
         return 0.0;
     }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if norm_cdf(c, mid) < q {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo <= 1e-15 * hi {
-            break;
-        }
-    }
-    0.5 * (lo + hi)
+    bisect(|r| norm_cdf(c, r), q, (lo, hi))
 }
 
 /// The `q`-quantile of θ_P \[rad\] for a Gaussian tilt of covariance Σ.
