@@ -108,19 +108,7 @@ fn histogram_counts_the_tail_beyond_its_axis() {
         }
     });
     SynthJob::write_bytes(shards.path(), &range.file_name(), &bytes);
-    let o = Command::new(env!("CARGO_BIN_EXE_mc-merge"))
-        .arg(shards.path())
-        .args(["-q", "--replicates", "50", "--gof-replicates", "19", "-o"])
-        .arg(out.path())
-        .output()
-        .unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(o.stdout.is_empty(), "--quiet printed {:?}", o.stdout);
+    merge_into(shards.path(), out.path());
     let svg = std::fs::read_to_string(out.path().join("theta_p-tail.svg")).unwrap();
     assert!(
         svg.contains("3 of 6000 samples (0.05 %) lie beyond "),
@@ -142,7 +130,8 @@ fn histogram_axis_holds_every_sample_when_the_tail_is_short() {
     assert!(hi < 5000.0 && hi > 999.0, "{hi}");
 }
 
-/// Runs `mc-merge` on `shards` into `out` with few replicates; panics unless it exits 0.
+/// Runs `mc-merge` on `shards` into `out` with few replicates, quietly; panics unless it
+/// exits 0 with nothing on stdout.
 fn merge_into(shards: &Path, out: &Path) {
     let o = Command::new(env!("CARGO_BIN_EXE_mc-merge"))
         .arg(shards)
@@ -156,6 +145,7 @@ fn merge_into(shards: &Path, out: &Path) {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    assert!(o.stdout.is_empty(), "--quiet printed {:?}", o.stdout);
 }
 
 /// The decenter and despace plot of a case whose samples record them (synthetic: decenter
