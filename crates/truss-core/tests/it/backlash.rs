@@ -734,3 +734,30 @@ fn the_default_holds_the_fig16_case_at_its_limit() {
     let po = p95(&mut o);
     assert!(po > 1.03 * pl, "at 1e-4 θ_P95 {po} against {pl}");
 }
+
+/// A model that is a mechanism even with every joint in contact and every cable taut (here
+/// the 3-stage prism with pin joints, its middle stage's diagonals removed: that stage
+/// racks freely) is refused when the model is read, before any sample is drawn, naming a
+/// node of that stage that moves freely; with the diagonals in place the same model compiles (the
+/// stages float in their clearances only at the limit, which the solver handles).
+#[test]
+fn a_mechanism_with_every_joint_bearing_is_refused_before_any_solve() {
+    let options = PrismOptions {
+        backlash: Some(BacklashOptions::default()),
+        ..PrismOptions::with_stages(3)
+    };
+    let whole = Model::new(options.file().unwrap()).unwrap();
+    Solver::new(&whole, SolveOptions::default()).unwrap();
+    let mut file = options.file().unwrap();
+    let before = file.members.len();
+    file.members.retain(|m| !m.id.starts_with("diagonal.1."));
+    assert!(file.members.len() < before, "no diagonal of stage 1 found");
+    let message = match Model::new(file) {
+        Ok(_) => panic!("a racking stage was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        message.contains("mechanism") && message.contains("\"n1."),
+        "{message}"
+    );
+}

@@ -33,6 +33,13 @@
 //!    a tenfold smaller ratio (ordinary Newton, warm-started), then step 2 again; after
 //!    [`LAST_RATIO`], the last attempt at 0 runs to convergence without watching.
 //!
+//! 4. **Where a stage does not converge** (Newton at `ρ₀` from the linearised start, or at a
+//!    tenfold smaller ratio from the last stage: a tall truss whose many panels rack at
+//!    once, such as the 300-stage prism with pin joints), the stage's ratio is reached by
+//!    [`Solver::continue_down`] instead: from [`FALLBACK_RATIO`] (for the anchor) or from
+//!    the last converged stage, in steps of `log₁₀ ρ` that halve where Newton fails. A
+//!    sample whose tenfold stages all converge runs exactly the operations it ran before.
+//!
 //! At `ρ = 0` itself nothing is regularised: a slack cable's compression stiffness is
 //! exactly zero. A watched attempt that does not converge is abandoned as an event is.
 //! Where even the last attempt does not converge (a loaded stage coming to rest against
@@ -57,10 +64,63 @@ use work::{KINK, SOFT_PIVOT};
 /// The first ratio of the continuation: the one the cables of ratio 0 are compiled with.
 const FIRST_RATIO: f64 = crate::structure::LIMIT_RATIO;
 
+/// The anchor where Newton at [`FIRST_RATIO`] does not converge from the linearised start:
+/// stiff enough that no panel racks (its slack members a hundredth of their bearing
+/// stiffness).
+const FALLBACK_RATIO: f64 = 1e-2;
+
+/// The smallest step of [`Solver::continue_down`], in decades of the ratio.
+const MIN_LOG_STEP: f64 = 1.0 / 16.0;
+
 /// The last positive ratio of the continuation.
 const LAST_RATIO: f64 = 1e-12;
 
 impl Solver {
+    /// Continues the converged equilibrium at ratio `from` (the current point) down to
+    /// `to < from`, where the tenfold steps of the module doc do not converge: steps of
+    /// `log₁₀ ρ` that halve where Newton at the next ratio does not converge from the last
+    /// converged point (restored), and grow by half again after a success, down to
+    /// [`MIN_LOG_STEP`] decades. Each stage is [`Solver::newton_warm`], so the equilibrium
+    /// reached at `to` is that of the tenfold path wherever both converge.
+    async fn continue_down(
+        &mut self,
+        from: f64,
+        to: f64,
+        counts: &mut Counts,
+        kernels: Kernels<'_>,
+    ) -> Result<(), SolveError> {
+        let n = self.structure.free;
+        let mut back = self.work.u[..n].to_vec();
+        let (mut at, end) = (from.log10(), to.log10());
+        let mut step: f64 = 0.5;
+        loop {
+            let next = (at - step).max(end);
+            self.set_limit_ratio(if next <= end { to } else { 10f64.powf(next) });
+            match self.newton_warm(kernels).await {
+                Ok(r) => {
+                    counts.iterations += r.iterations;
+                    counts.factorisations += r.factorisations;
+                    if next <= end {
+                        return Ok(());
+                    }
+                    at = next;
+                    back.copy_from_slice(&self.work.u[..n]);
+                    step = (step * 1.5).min(1.0);
+                }
+                Err(e) => {
+                    if let SolveError::NotConverged { iterations, .. } = e {
+                        counts.iterations += iterations;
+                    }
+                    self.work.u[..n].copy_from_slice(&back);
+                    step *= 0.5;
+                    if step < MIN_LOG_STEP {
+                        return Err(e);
+                    }
+                }
+            }
+        }
+    }
+
     /// The continuation of the module doc, from the linearised start at `ρ₀`.
     pub(super) async fn solve_limit(
         &mut self,
@@ -73,10 +133,28 @@ impl Solver {
         self.work.u.fill(0.0);
         let mut start_factorisations = 0;
         self.linearised_from_rest(&mut start_factorisations);
-        let first = self.newton_warm(kernels).await?;
         counts.factorisations += start_factorisations;
-        counts.iterations = first.iterations + 1;
-        counts.factorisations += first.factorisations;
+        counts.iterations = 1;
+        match self.newton_warm(kernels).await {
+            Ok(first) => {
+                counts.iterations += first.iterations;
+                counts.factorisations += first.factorisations;
+            }
+            Err(_) => {
+                // A tall truss whose many panels rack at once: reach `ρ₀` from a stiffer
+                // anchor instead (see `continue_down`).
+                self.set_limit_ratio(FALLBACK_RATIO);
+                self.work.u.fill(0.0);
+                let mut f = 0;
+                self.linearised_from_rest(&mut f);
+                counts.factorisations += f;
+                let anchor = self.newton_warm(kernels).await?;
+                counts.iterations += anchor.iterations;
+                counts.factorisations += anchor.factorisations;
+                self.continue_down(FALLBACK_RATIO, FIRST_RATIO, &mut counts, kernels)
+                    .await?;
+            }
+        }
         let stages = (FIRST_RATIO / LAST_RATIO).log10().round() as i32;
         for stage in 1..=stages + 1 {
             self.limit.saved.copy_from_slice(&self.work.u);
@@ -99,9 +177,18 @@ impl Solver {
             self.work.u[..n].copy_from_slice(&self.limit.saved[..n]);
             let ratio = FIRST_RATIO * 10f64.powi(-stage);
             self.set_limit_ratio(ratio);
-            let r = self.newton_warm(kernels).await?;
-            counts.iterations += r.iterations;
-            counts.factorisations += r.factorisations;
+            match self.newton_warm(kernels).await {
+                Ok(r) => {
+                    counts.iterations += r.iterations;
+                    counts.factorisations += r.factorisations;
+                }
+                Err(_) => {
+                    self.work.u[..n].copy_from_slice(&self.limit.saved[..n]);
+                    let from = ratio * 10.0;
+                    self.continue_down(from, ratio, &mut counts, kernels)
+                        .await?;
+                }
+            }
         }
         let eval = self.evaluate_current(kernels).await;
         let floor = self.force_floor(&eval);
