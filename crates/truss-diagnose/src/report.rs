@@ -10,7 +10,10 @@
 //! job {path, id, case, seed}, samples (N per simulation), measurement_sigma [mm]
 //! data        {file, rows, specimens_in_file, specimens_used, left_out_count, left_out[],
 //!              outliers[] {specimen, line, node, axis, displacement [mm], robust_z},
-//!              nodes[], unknown_nodes[], rare_nodes[], supports[], member_rows, unknown_members[]}
+//!              nodes[], unknown_nodes[], rare_nodes[], supports[], member_rows, unknown_members[],
+//!              checks[] {check ("scatter_below_noise" | "specimens_closer_than_noise"),
+//!              flagged (coordinates or pairs), p_value (the smallest), words}: the data
+//!              checks' warnings against the stated noise (crate::comparison::checks)}
 //! verdict     "named" | "none" | "cannot_tell" | "unexplained";  reason (words)
 //!              ("named" when an effect was added, else step 1's verdict)
 //! named_effect "none" or the first added effect's name

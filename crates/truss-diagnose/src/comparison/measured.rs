@@ -131,6 +131,9 @@ pub struct DataReport {
     pub member_rows: Option<usize>,
     /// Member ids in the member file that the model does not have.
     pub unknown_members: Vec<String>,
+    /// The warnings of the checks against the stated instrument noise
+    /// ([`crate::comparison::checks`]).
+    pub checks: Vec<crate::comparison::checks::DataCheck>,
 }
 
 impl DataReport {

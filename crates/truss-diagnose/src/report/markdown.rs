@@ -241,6 +241,12 @@ fn data_section(m: &mut String, baseline: &Baseline, measured: &Measured, d: &Di
             ),
         );
     }
+    for c in &r.checks {
+        push(
+            m,
+            &format!("**Warning (data check `{}`):** {}.\n", c.check, c.words),
+        );
+    }
     if !r.unknown_nodes.is_empty() || !r.rare_nodes.is_empty() {
         push(
             m,
