@@ -85,7 +85,12 @@
 //!    their intervals, or is itself significant given the model and widens them
 //!    two-fold, is listed as confounded with it (a
 //!    temperature field's offset and vertical gradient against a longeron length bias),
-//!    with the measurement that would separate them.
+//!    never one whose joint re-fit ends below the model's ℓ̂ (the model is the rival at
+//!    its null, so that fit is short of the maximum),
+//!    with the measurement that would separate them. What cannot be told apart from each
+//!    effect (a step's own indistinguishable candidates, effects it took over from, rivals
+//!    confounded with it) is one record, [`selection::indistinguishable`], for effects
+//!    named and swapped in alike, which both reports read.
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
 //! plots of [`report::plot`], each written through a temporary file and never through a link (a

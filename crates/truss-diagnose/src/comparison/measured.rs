@@ -19,6 +19,12 @@
 //! from the others (the scatter candidates scale every specimen's scatter alike, which the
 //! robust deviation follows), while a typo (z × 10) or a shifted column does.
 //!
+//! **Copies.** A specimen whose compared coordinates repeat another's bit for bit is refused,
+//! naming the copies grouped by the specimen they repeat (a run of consecutive copies as
+//! one range, with its first lines): independent measurements never agree to the last
+//! digit. Near-copies, and scatter below the stated noise, are checked against σ_m in
+//! [`crate::comparison::checks`].
+//!
 //! Which coordinates enter the diagnosis: the nodes of the model that at least half of the
 //! specimens measured (the top-surface nodes must be among them); node ids the model does not
 //! know, and nodes measured by fewer than half of the specimens, are ignored and reported.
@@ -715,7 +721,7 @@ fn repeated_specimens(
     ))
 }
 
-/// Most groups of copies named in the refusal ([`repeated_specimens`]).
+/// Most groups of copies named in the refusal of repeated specimens (module doc).
 pub const NAMED_GROUPS: usize = 5;
 
 /// The runs of consecutive indices in `k` (increasing), as (first, last).
