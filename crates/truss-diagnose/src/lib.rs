@@ -85,7 +85,12 @@
 //!    their intervals, or is itself significant given the model and widens them
 //!    two-fold, is listed as confounded with it (a
 //!    temperature field's offset and vertical gradient against a longeron length bias),
-//!    with the measurement that would separate them.
+//!    never one whose joint re-fit ends below the model's ℓ̂ (the model is the rival at
+//!    its null, so that fit is short of the maximum),
+//!    with the measurement that would separate them. What cannot be told apart from each
+//!    effect (a step's own indistinguishable candidates, effects it took over from, rivals
+//!    confounded with it) is one record, [`selection::indistinguishable`], for effects
+//!    named and swapped in alike, which both reports read.
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
 //! plots of [`report::plot`], each written through a temporary file and never through a link (a
@@ -115,7 +120,13 @@
 //! (and rows with extra fields) are errors with their line; specimens missing a compared
 //! node are left out and counted; outlier rows (a coordinate beyond 10 robust SD) are left
 //! out and listed by specimen and line; member rows of specimens the node file lacks, and
-//! member errors beyond 1 % of the member's length, are refused. With
+//! member errors beyond 1 % of the member's length, are refused; a specimen that repeats
+//! another's coordinates exactly is refused, naming the copies. Against the stated noise
+//! σ_m ([`comparison::checks`]), before anything is simulated: a coordinate with the same
+//! value in every specimen is refused; a coordinate whose scatter is below σ_m (χ² lower
+//! tail, Bonferroni over the coordinates, family-wise 10⁻³), and pairs of specimens closer
+//! together than two draws of the noise allow (the same test on their distance), are
+//! warned of on stderr and in `diagnosis.json`'s `data.checks[]` and `diagnosis.md`. With
 //! `--measured-members` each specimen's own measured members enter its likelihood
 //! ([`likelihood::conditional`]).
 
@@ -221,12 +232,13 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
     run_dir::OutputDir::check(&options.out, WRITER, &OUTPUTS)?;
     let progress = settings::Progress::new(s.quiet);
     let base = comparison::baseline::Baseline::read(&options.job, &options.case)?;
-    let data = comparison::measured::read(
+    let mut data = comparison::measured::read(
         base.model(),
         &options.measured,
         options.measured_members.as_deref(),
         MIN_SPECIMENS,
     )?;
+    data.report.checks = comparison::checks::check(&data, s.measurement_sigma)?;
     warn_left_out(&data.report);
     let d = selection::diagnose(&base, &data, s, &progress)?;
     let dir = &options.out;
@@ -303,5 +315,8 @@ fn warn_left_out(r: &comparison::measured::DataReport) {
             "member ids the model does not have, ignored: {}",
             r.unknown_members.join(", ")
         ));
+    }
+    for c in &r.checks {
+        warn(c.words.clone());
     }
 }

@@ -3,14 +3,17 @@
 //! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
 //! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 7)
+//! ## diagnosis.json (format `truss-diagnose`, version 9)
 //!
 //! ```text
 //! format, format_version, program_version
 //! job {path, id, case, seed}, samples (N per simulation), measurement_sigma [mm]
 //! data        {file, rows, specimens_in_file, specimens_used, left_out_count, left_out[],
 //!              outliers[] {specimen, line, node, axis, displacement [mm], robust_z},
-//!              nodes[], unknown_nodes[], rare_nodes[], supports[], member_rows, unknown_members[]}
+//!              nodes[], unknown_nodes[], rare_nodes[], supports[], member_rows, unknown_members[],
+//!              checks[] {check ("scatter_below_noise" | "specimens_closer_than_noise"),
+//!              flagged (coordinates or pairs), p_value (the smallest), words}: the data
+//!              checks' warnings against the stated noise (crate::comparison::checks)}
 //! verdict     "named" | "none" | "cannot_tell" | "unexplained";  reason (words)
 //!              ("named" when an effect was added, else step 1's verdict)
 //! named_effect "none" or the first added effect's name
@@ -47,7 +50,8 @@
 //!              good as the model with a parameter outside its interval (along_ridge; its
 //!              with_rival is that fit's value): the data cannot tell how that part of the
 //!              signal divides between the two; the rival is also listed in the
-//!              `indistinguishable` of the step that named the effect
+//!              effect's record of `indistinguishable_by_effect` (and so in the
+//!              `indistinguishable` of the step that named it, or the top-level one)
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
 //!              determined}]
 //!              (the first named effect's, as fitted in its step; for an effect swapped in,
@@ -62,9 +66,17 @@
 //!   joint_interval  where profiled: the joint 95 % region of all k parameters projected on
 //!              this one (same fields, threshold χ²_k(0.95)·c·λ̄): every parameter inside its
 //!              joint interval at once with 95 % confidence
-//! indistinguishable [names]   (the first added effect's step; explain the data as well: ΔBIC within 2, or significant and
-//!              not shown further from the data than the named one, Vuong z < 1.96; empty
-//!              when clear)
+//! indistinguishable [names]   the first effect of the final model's (`named_effect`): as
+//!              the record of `indistinguishable_by_effect` where it last entered the model
+//!              at a kept step, named or swapped in; empty when clear
+//! indistinguishable_by_effect [{effect, step, swapped_in, kept, rivals[]}]   the one
+//!              record every `indistinguishable` field (and diagnosis.md) reads: per step's
+//!              named effect, and per effect swapped in at a kept step (`swapped_in`), the
+//!              rivals the data cannot tell from it: the step's own (explain the data as
+//!              well: ΔBIC within 2, or significant and not shown further from the data than
+//!              the named one, Vuong z < 1.96; none for an effect swapped in), then effects a
+//!              kept step removed because it took over what they explained, then rivals
+//!              `confounding[]` lists against it (added to its latest kept record)
 //! baseline    {log_likelihood}
 //! candidates  (step 1's) [{name, mechanism, k, parameters[], log_likelihood, lr_statistic, adjustment,
 //!               p_value, significant, delta_bic, evaluations, profile_evaluations, seconds,
@@ -86,6 +98,12 @@
 //!              candidates, deciding with the profiles, updating the model, comparing the
 //!              updated model; the final fit; the confounding tests)}
 //! ```
+//!
+//! Version 9 (from 8): `indistinguishable_by_effect`; the `data.checks[]` warnings. An
+//! effect swapped in (never named by a step) now has its rivals too: those removed because
+//! it took over and those confounded with it, which were before in `confounding[]` and the
+//! markdown but in no `indistinguishable` field; `steps[].indistinguishable` and the
+//! top-level one read the record.
 //!
 //! Version 8 (from 7): `confounding[].along_ridge`; a rival that moves nothing at the joint
 //! maximum is listed where the ridge probe finds a fit as good as the model's with an
@@ -125,12 +143,12 @@ use crate::comparison::baseline::Baseline;
 use crate::comparison::measured::{DataReport, Measured};
 use crate::comparison::statistics::Comparison;
 use crate::likelihood::score::{CandidateScore, FittedParameter};
-use crate::selection::Diagnosis;
 use crate::selection::confound::Confounding;
 use crate::selection::decide::Verdict;
 use crate::selection::eliminate::Removal;
 use crate::selection::model::{ModelEffect, RefitEffect};
 use crate::selection::step::Step;
+use crate::selection::{Diagnosis, Indistinguishable};
 use method::{METHOD, Method};
 use serde::Serialize;
 
@@ -145,7 +163,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 8;
+pub const FORMAT_VERSION: u32 = 9;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -197,6 +215,7 @@ struct Report<'a> {
     named_effects: Vec<&'a str>,
     parameters: &'a [FittedParameter],
     indistinguishable: &'a [String],
+    indistinguishable_by_effect: &'a [Indistinguishable],
     baseline: Baseline0,
     candidates: &'a [CandidateScore],
     skipped: Vec<Skipped<'a>>,
@@ -233,7 +252,7 @@ struct StepReport<'a> {
 }
 
 impl<'a> StepReport<'a> {
-    fn of(s: &'a Step) -> Self {
+    fn of(s: &'a Step, d: &'a Diagnosis) -> Self {
         Self {
             number: s.number,
             verdict: s.verdict,
@@ -241,7 +260,9 @@ impl<'a> StepReport<'a> {
             named_effect: s.named_effect().unwrap_or("none"),
             kept: s.kept,
             parameters: s.named_score().map_or(&[][..], |c| &c.parameters),
-            indistinguishable: &s.indistinguishable,
+            indistinguishable: s
+                .named_effect()
+                .map_or(&[][..], |e| d.indistinguishable_of(e, s.number)),
             adjusted_p: s.adjusted_p,
             log_likelihood_before: s.log_likelihood_before,
             candidates: &s.candidates,
@@ -300,11 +321,8 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
                 .rfind(|r| r.name == d.named_effect())
                 .map_or(&[][..], |r| &r.parameters)
         },
-        indistinguishable: if first_named.named_effect() == Some(d.named_effect()) {
-            &first_named.indistinguishable
-        } else {
-            &[]
-        },
+        indistinguishable: d.indistinguishable_of_final(d.named_effect()),
+        indistinguishable_by_effect: &d.indistinguishable,
         baseline: Baseline0 {
             log_likelihood: d.baseline_log_likelihood,
         },
@@ -314,7 +332,7 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
             .iter()
             .map(|(n, r)| Skipped { name: n, reason: r })
             .collect(),
-        steps: d.steps.iter().map(StepReport::of).collect(),
+        steps: d.steps.iter().map(|s| StepReport::of(s, d)).collect(),
         effects: &d.effects,
         final_fit: &d.final_fit,
         confounding: &d.confounding,

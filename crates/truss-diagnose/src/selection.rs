@@ -46,6 +46,7 @@ use crate::comparison::statistics::Comparison;
 use crate::errors::DiagnoseError;
 use crate::likelihood::score::p_text;
 use crate::settings::{NOISE_SEED, Progress, Settings};
+use confound::Confounding as Confound;
 use decide::Verdict;
 use model::{ComparedModel, Context, ModelEffect, Pool};
 use step::Step;
@@ -78,6 +79,10 @@ pub struct Diagnosis {
     pub final_fit: Vec<model::RefitEffect>,
     /// Rivals that explain part of what the final model's effects explain ([`confound`]).
     pub confounding: Vec<confound::Confounding>,
+    /// What the data cannot tell apart from each effect that entered the model
+    /// ([`indistinguishable`]): the one record that `diagnosis.json`'s `indistinguishable`
+    /// fields and `diagnosis.md` read.
+    pub indistinguishable: Vec<Indistinguishable>,
     /// Wall time of the final fit and the confounding tests \[s\].
     pub final_seconds: f64,
     /// Each stage's wall time and simulations, in order.
@@ -99,6 +104,24 @@ impl Diagnosis {
     /// effect, less those a kept step removed, a swapped one's replacement in its place.
     pub fn named_effects(&self) -> Vec<&str> {
         final_effects(&self.steps)
+    }
+
+    /// The rivals indistinguishable from `effect` as it entered the model at step `step`
+    /// (named or swapped in; [`indistinguishable`]); empty when there is no such record.
+    pub fn indistinguishable_of(&self, effect: &str, step: usize) -> &[String] {
+        self.indistinguishable
+            .iter()
+            .find(|r| r.effect == effect && r.step == step)
+            .map_or(&[][..], |r| &r.rivals)
+    }
+
+    /// The rivals indistinguishable from the final model's `effect`, where it last entered
+    /// the model in a kept step.
+    pub fn indistinguishable_of_final(&self, effect: &str) -> &[String] {
+        self.indistinguishable
+            .iter()
+            .rfind(|r| r.effect == effect && r.kept)
+            .map_or(&[][..], |r| &r.rivals)
     }
 
     /// The first added effect's name, or `none`.
@@ -218,7 +241,6 @@ pub fn diagnose(
         steps.push(s);
         edit = next;
     }
-    list_taken_over(&mut steps);
     let adjusted: Vec<f64> = steps
         .iter()
         .filter(|s| s.kept)
@@ -262,15 +284,7 @@ pub fn diagnose(
         }
         None => (Vec::new(), Vec::new()),
     };
-    for c in &confounding {
-        if let Some(s) = steps
-            .iter_mut()
-            .find(|s| s.kept && s.named_effect() == Some(c.effect.as_str()))
-            && !s.indistinguishable.contains(&c.rival)
-        {
-            s.indistinguishable.push(c.rival.clone());
-        }
-    }
+    let indistinguishable = indistinguishable(&steps, &confounding);
     let final_seconds = clock.elapsed().as_secs_f64();
     let sims = ctx.simulations.get();
     let stages = ctx.stages.take();
@@ -296,6 +310,7 @@ pub fn diagnose(
         library,
         final_fit,
         confounding,
+        indistinguishable,
         final_seconds,
         stages,
         threads: settings.thread_count(),
@@ -350,29 +365,73 @@ fn asked_for(
     Ok((remaining, skipped))
 }
 
-/// An effect removed because another took over what it explained is listed as
-/// indistinguishable from that other, at the step that named it; only removals of steps
-/// whose effect was added count, and only the steps up to them are searched.
-fn list_taken_over(steps: &mut [Step]) {
-    for i in 0..steps.len() {
-        if !steps[i].kept {
+/// What the data cannot tell apart from an effect as it entered the model at a step.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Indistinguishable {
+    /// The effect.
+    pub effect: String,
+    /// The step it entered the model at: named there, or swapped in for an earlier effect.
+    pub step: usize,
+    /// Whether it was swapped in (not named by the step's tests).
+    pub swapped_in: bool,
+    /// Whether that step is kept (its effect added to the model).
+    pub kept: bool,
+    /// The rivals, in order: the step's own (ΔBIC within 2 or Vuong, [`decide`]; none for
+    /// an effect swapped in), then effects removed because it took over what they explained,
+    /// then rivals confounded with it in the final model ([`confound`]).
+    pub rivals: Vec<String>,
+}
+
+/// The one record of what cannot be told apart (each report reads it, none adds to it): a
+/// record per step's named effect with the step's own indistinguishable candidates, and
+/// per effect swapped in at a kept step; an effect a kept step removed because another
+/// took over what it explained (`explained_by`) is added to that other's latest record up
+/// to that step; a rival confounded with an effect of the final model, to the effect's
+/// latest kept record. (Before this record, the two additions went only to a step that
+/// had *named* the effect, so the rivals of an effect swapped in were in the markdown's
+/// words and `confounding[]` but in no `indistinguishable` field.)
+pub fn indistinguishable(steps: &[Step], confounding: &[Confound]) -> Vec<Indistinguishable> {
+    let mut out: Vec<Indistinguishable> = Vec::new();
+    let add = |r: &mut Indistinguishable, name: &str| {
+        if r.effect != name && !r.rivals.iter().any(|x| x == name) {
+            r.rivals.push(name.to_string());
+        }
+    };
+    for s in steps {
+        if let Some(named) = s.named_effect() {
+            out.push(Indistinguishable {
+                effect: named.to_string(),
+                step: s.number,
+                swapped_in: false,
+                kept: s.kept,
+                rivals: s.indistinguishable.clone(),
+            });
+        }
+        if !s.kept {
             continue;
         }
-        let taken_over: Vec<(String, String)> = steps[i]
-            .removed
-            .iter()
-            .filter_map(|r| r.explained_by.clone().map(|x| (x, r.name.clone())))
-            .collect();
-        for (by, name) in taken_over {
-            if let Some(s) = steps[..=i]
-                .iter_mut()
-                .find(|s| s.kept && s.named_effect() == Some(by.as_str()))
-                && !s.indistinguishable.contains(&name)
-            {
-                s.indistinguishable.push(name);
+        for by in s.removed.iter().filter_map(|r| r.replaced_by.as_ref()) {
+            out.push(Indistinguishable {
+                effect: by.clone(),
+                step: s.number,
+                swapped_in: true,
+                kept: true,
+                rivals: Vec::new(),
+            });
+        }
+        for r in &s.removed {
+            let Some(by) = &r.explained_by else { continue };
+            if let Some(e) = out.iter_mut().rfind(|e| e.kept && &e.effect == by) {
+                add(e, &r.name);
             }
         }
     }
+    for c in confounding {
+        if let Some(e) = out.iter_mut().rfind(|e| e.kept && e.effect == c.effect) {
+            add(e, &c.rival);
+        }
+    }
+    out
 }
 
 /// The overall verdict and reason from the steps, `kept` of whose named effects are kept.
@@ -423,23 +482,23 @@ mod tests {
     use super::*;
     use crate::likelihood::score::CandidateScore;
 
-    /// The final model's effects from the steps: each kept step's named effect in turn, a
-    /// removed one taken out, a swapped one's replacement in its place, and nothing of a
-    /// step that is not kept (its removals included).
-    #[test]
-    fn final_effects_follow_removals_and_swaps() {
-        use crate::selection::eliminate::Removal;
-        let removal = |name: &str, by: Option<&str>| Removal {
+    use crate::selection::eliminate::Removal;
+
+    fn removal(name: &str, by: Option<&str>, explained_by: Option<&str>) -> Removal {
+        Removal {
             name: name.into(),
             replaced_by: by.map(String::from),
             added_in_step: 1,
             lr_statistic: 0.0,
             p_value: None,
             delta_bic: 0.0,
-            explained_by: None,
+            explained_by: explained_by.map(String::from),
             separate_by: String::new(),
-        };
-        let step = |number: usize, named: &str, kept: bool, removed: Vec<Removal>| Step {
+        }
+    }
+
+    fn step(number: usize, named: &str, kept: bool, removed: Vec<Removal>) -> Step {
+        Step {
             number,
             verdict: Verdict::Named,
             reason: String::new(),
@@ -456,7 +515,89 @@ mod tests {
             effects: Vec::new(),
             joint: None,
             seconds: 0.0,
+        }
+    }
+
+    fn confounding(effect: &str, rival: &str) -> Confound {
+        Confound {
+            effect: effect.into(),
+            rival: rival.into(),
+            parameters: Vec::new(),
+            lr_statistic: 0.0,
+            p_value: 1.0,
+            delta_bic: 0.0,
+            separate_by: String::new(),
+            along_ridge: false,
+        }
+    }
+
+    /// The consistency case: step 1 names `length_bias`, step 2 names `length_sigma` and
+    /// swaps `length_bias` for `diagonal_pretension` (which took over what it explained);
+    /// the confounding tests then find `thermal_gradient` confounded with the pretension.
+    /// The record lists both rivals for `diagonal_pretension` (swapped in at step 2), which
+    /// is the final model's first effect, so the top-level `indistinguishable` reads them;
+    /// before, both went to a step that *named* the pretension, of which there is none, and
+    /// every `indistinguishable` field was empty while `confounding[]` and the markdown said
+    /// the two cannot be told apart. Every rival of `confounding[]` and every taken-over
+    /// removal of a kept step is in its effect's record; a step's own list comes first; a
+    /// step not kept adds nothing.
+    #[test]
+    fn one_record_of_what_cannot_be_told_apart_covers_effects_swapped_in() {
+        let mut first = step(1, "length_bias", true, Vec::new());
+        first.indistinguishable = vec!["thermal_gradient".into()];
+        let steps = vec![
+            first,
+            step(
+                2,
+                "length_sigma",
+                true,
+                vec![removal(
+                    "length_bias",
+                    Some("diagonal_pretension"),
+                    Some("diagonal_pretension"),
+                )],
+            ),
+            step(
+                3,
+                "gravity",
+                false,
+                vec![removal("length_sigma", None, Some("diagonal_pretension"))],
+            ),
+        ];
+        let conf = vec![
+            confounding("diagonal_pretension", "thermal_gradient"),
+            confounding("length_sigma", "backlash"),
+        ];
+        let record = indistinguishable(&steps, &conf);
+        let of = |e: &str, step: usize| {
+            record
+                .iter()
+                .find(|r| r.effect == e && r.step == step)
+                .unwrap_or_else(|| panic!("no record of {e} at step {step}: {record:?}"))
         };
+        assert_eq!(final_effects(&steps[..2])[0], "diagonal_pretension");
+        let swapped = of("diagonal_pretension", 2);
+        assert!(swapped.swapped_in && swapped.kept);
+        assert_eq!(swapped.rivals, ["length_bias", "thermal_gradient"]);
+        assert_eq!(of("length_bias", 1).rivals, ["thermal_gradient"]);
+        assert_eq!(of("length_sigma", 2).rivals, ["backlash"]);
+        assert!(of("gravity", 3).rivals.is_empty() && !of("gravity", 3).kept);
+        for c in &conf {
+            assert!(
+                record
+                    .iter()
+                    .any(|r| r.kept && r.effect == c.effect && r.rivals.contains(&c.rival)),
+                "{c:?} not in {record:?}"
+            );
+        }
+    }
+
+    /// The final model's effects from the steps: each kept step's named effect in turn, a
+    /// removed one taken out, a swapped one's replacement in its place, and nothing of a
+    /// step that is not kept (its removals included).
+    #[test]
+    fn final_effects_follow_removals_and_swaps() {
+        let removal = |name: &str, by: Option<&str>| removal(name, by, None);
         let steps = vec![
             step(1, "length_bias", true, Vec::new()),
             step(

@@ -27,6 +27,8 @@
 
 #[path = "hidden_effects/confounding.rs"]
 mod confounding;
+#[path = "hidden_effects/data_checks.rs"]
+mod data_checks;
 #[path = "hidden_effects/stepwise.rs"]
 mod stepwise;
 

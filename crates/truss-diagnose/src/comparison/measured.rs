@@ -19,6 +19,12 @@
 //! from the others (the scatter candidates scale every specimen's scatter alike, which the
 //! robust deviation follows), while a typo (z × 10) or a shifted column does.
 //!
+//! **Copies.** A specimen whose compared coordinates repeat another's bit for bit is refused,
+//! naming the copies grouped by the specimen they repeat (a run of consecutive copies as
+//! one range, with its first lines): independent measurements never agree to the last
+//! digit. Near-copies, and scatter below the stated noise, are checked against σ_m in
+//! [`crate::comparison::checks`].
+//!
 //! Which coordinates enter the diagnosis: the nodes of the model that at least half of the
 //! specimens measured (the top-surface nodes must be among them); node ids the model does not
 //! know, and nodes measured by fewer than half of the specimens, are ignored and reported.
@@ -131,6 +137,9 @@ pub struct DataReport {
     pub member_rows: Option<usize>,
     /// Member ids in the member file that the model does not have.
     pub unknown_members: Vec<String>,
+    /// The warnings of the checks against the stated instrument noise
+    /// ([`crate::comparison::checks`]).
+    pub checks: Vec<crate::comparison::checks::DataCheck>,
 }
 
 impl DataReport {
@@ -172,6 +181,8 @@ pub struct Measured {
     pub tan_y: Vec<f64>,
     /// θ_P \[rad\].
     pub theta_p: Vec<f64>,
+    /// Each specimen's first line in the node file.
+    pub lines: Vec<u64>,
     /// Member measurements, if given.
     pub members: Option<MemberData>,
     /// What was read and left out.
@@ -473,14 +484,15 @@ pub fn read(
         theta_p.push(d.theta_p);
         specimens.push(s.clone());
     }
-    repeated_specimens(&specimens, &y, coords.len(), &|s| {
+    let first_line = |s: &String| {
         by_specimen[s]
             .values()
             .map(|(_, line)| *line)
             .min()
             .unwrap_or(0)
-    })
-    .map_err(measured_err)?;
+    };
+    repeated_specimens(&specimens, &y, coords.len(), &first_line).map_err(measured_err)?;
+    let lines = specimens.iter().map(first_line).collect();
     report.specimens_used = specimens.len();
     if specimens.len() < min_specimens {
         return Err(measured_err(format!(
@@ -501,6 +513,7 @@ pub fn read(
         tan_x,
         tan_y,
         theta_p,
+        lines,
         members,
         report,
     })
@@ -637,7 +650,10 @@ fn outliers(
 /// earlier specimen's bit for bit. Independent measurements never agree to the last digit
 /// in every coordinate: an exact repeat is a copy (a copy-paste slip, a file joined twice),
 /// and fitted as data its missing scatter reads as an effect (30 copies of one specimen
-/// were once diagnosed as gravity at p < 1e-16). `line` gives a specimen's first row.
+/// were once diagnosed as gravity at p < 1e-16). `line` gives a specimen's first row. The
+/// copies are named grouped by the specimen they repeat, runs of consecutive copies as one
+/// range (`"s2" to "s31" (30 specimens, first lines 5 to 92) repeat "s1" (line 2)`), at
+/// most [`NAMED_GROUPS`] groups.
 fn repeated_specimens(
     specimens: &[String],
     y: &[f64],
@@ -648,39 +664,76 @@ fn repeated_specimens(
         return Ok(());
     }
     let mut first: HashMap<Vec<u64>, usize> = HashMap::new();
-    let mut copies = Vec::new();
+    // For each original (in order of first appearance), its copies in file order.
+    let mut groups: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for (k, row) in y.chunks(d).enumerate() {
         let key: Vec<u64> = row.iter().map(|v| v.to_bits()).collect();
         match first.get(&key) {
-            Some(&original) => copies.push((k, original)),
+            Some(&original) => groups.entry(original).or_default().push(k),
             None => {
                 first.insert(key, k);
             }
         }
     }
-    if copies.is_empty() {
+    if groups.is_empty() {
         return Ok(());
     }
-    let named: Vec<String> = copies
+    let copies: usize = groups.values().map(Vec::len).sum();
+    let named: Vec<String> = groups
         .iter()
-        .take(5)
-        .map(|&(c, o)| {
-            let (c, o) = (&specimens[c], &specimens[o]);
-            format!("{c:?} (line {}) repeats {o:?} (line {})", line(c), line(o))
+        .take(NAMED_GROUPS)
+        .map(|(&o, c)| {
+            let o = &specimens[o];
+            format!(
+                "{} {} {o:?} (line {})",
+                runs(c)
+                    .iter()
+                    .map(|&(i, j)| {
+                        let (a, b) = (&specimens[i], &specimens[j]);
+                        if i == j {
+                            format!("{a:?} (line {})", line(a))
+                        } else {
+                            format!(
+                                "{a:?} to {b:?} ({} specimens, first lines {} to {})",
+                                j - i + 1,
+                                line(a),
+                                line(b)
+                            )
+                        }
+                    })
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                if c.len() == 1 { "repeats" } else { "repeat" },
+                line(o)
+            )
         })
         .collect();
     Err(format!(
-        "{} specimen(s) repeat another's measurements exactly, in all {d} compared coordinates, \
+        "{copies} specimen(s) repeat another's measurements exactly, in all {d} compared coordinates, \
          which independent measurements never do: {}{}; remove the copies (a copy-paste slip \
          or a file joined twice?) or give each specimen its own measurements",
-        copies.len(),
-        named.join(", "),
-        if copies.len() > named.len() {
-            ", …"
+        named.join("; "),
+        if groups.len() > named.len() {
+            format!("; and {} more group(s)", groups.len() - named.len())
         } else {
-            ""
+            String::new()
         }
     ))
+}
+
+/// Most groups of copies named in the refusal of repeated specimens (module doc).
+pub const NAMED_GROUPS: usize = 5;
+
+/// The runs of consecutive indices in `k` (increasing), as (first, last).
+fn runs(k: &[usize]) -> Vec<(usize, usize)> {
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    for &i in k {
+        match out.last_mut() {
+            Some((_, last)) if *last + 1 == i => *last = i,
+            _ => out.push((i, i)),
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -713,6 +766,38 @@ mod tests {
         let text = text.replace("s3,n2.1,380,0,760.002", "s3,n2.1,380,0,760.0020000000001");
         let p = write(dir.path(), "m2.csv", &text);
         assert!(read(&model, &p, None, 1).is_ok());
+    }
+
+    /// The issue's slip: specimen c0 then 30 copies of it (c1–c30), among distinct ones,
+    /// and a second group (a copy of d2 at the end): refused in one message that names the
+    /// 30 as one range with their first lines, and the lone copy apart.
+    #[test]
+    fn thirty_copies_are_named_as_one_range() {
+        let model = PrismOptions::with_stages(2).model().unwrap();
+        let dir = tempfile::tempdir().unwrap();
+        let h = 380.0 * 3f64.sqrt() / 2.0;
+        let rows = |s: &str, z: f64| {
+            format!("{s},n2.0,0,0,760.001\n{s},n2.1,380,0,{z}\n{s},n2.2,190,{h},759.999\n")
+        };
+        let mut text = "specimen,node,x,y,z\n".to_string();
+        for k in 0..5 {
+            text += &rows(&format!("d{k}"), 760.0 + 1e-4 * k as f64);
+        }
+        for k in 0..31 {
+            text += &rows(&format!("c{k}"), 760.00005);
+        }
+        text += &rows("d9", 760.0 + 1e-4 * 2.0);
+        let p = write(dir.path(), "m.csv", &text);
+        let e = read(&model, &p, None, 1).unwrap_err().to_string();
+        // d0–d4 take lines 2–16, c0 lines 17–19, c1 from line 20, …, c30 from 107, d9 from 110.
+        assert!(
+            e.contains(
+                "31 specimen(s) repeat another's measurements exactly, in all 9 compared coordinates"
+            ) && e.contains(
+                "\"c1\" to \"c30\" (30 specimens, first lines 20 to 107) repeat \"c0\" (line 17)"
+            ) && e.contains("\"d9\" (line 110) repeats \"d2\" (line 8)"),
+            "{e}"
+        );
     }
 
     fn write(dir: &Path, name: &str, text: &str) -> PathBuf {

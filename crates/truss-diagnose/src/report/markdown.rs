@@ -241,6 +241,12 @@ fn data_section(m: &mut String, baseline: &Baseline, measured: &Measured, d: &Di
             ),
         );
     }
+    for c in &r.checks {
+        push(
+            m,
+            &format!("**Warning (data check `{}`):** {}.\n", c.check, c.words),
+        );
+    }
     if !r.unknown_nodes.is_empty() || !r.rare_nodes.is_empty() {
         push(
             m,
@@ -309,27 +315,31 @@ fn updated_job_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
 fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
     push(m, "## Next step\n");
     let mut advice = Vec::new();
-    for s in &d.steps {
-        let Some(named) = s.named_effect() else {
+    for r in &d.indistinguishable {
+        if r.rivals.is_empty() {
             continue;
-        };
+        }
+        let named = r.effect.as_str();
         let a = effect(d, named);
-        let mistaken = s.indistinguishable.iter().any(|o| {
+        let at = if r.swapped_in {
+            format!("Step {} (swapped in)", r.step)
+        } else {
+            format!("Step {}", r.step)
+        };
+        let mistaken = r.rivals.iter().any(|o| {
             let b = effect(d, o);
             a.mistaken_without_members(b.trace()) || b.mistaken_without_members(a.trace())
         });
         if mistaken && measured.members.is_none() {
             advice.push(format!(
-                "Step {}: `{named}` and {} fit the node positions equally well: joint free play shortens the truss much as a member-length error does. Measure the member lengths one by one (longerons and diagonals, to a few µm) and run again with `--measured-members`: then they separate.",
-                s.number,
-                code_list(&s.indistinguishable, ", ")
+                "{at}: `{named}` and {} fit the node positions equally well: joint free play shortens the truss much as a member-length error does. Measure the member lengths one by one (longerons and diagonals, to a few µm) and run again with `--measured-members`: then they separate.",
+                code_list(&r.rivals, ", ")
             ));
-        } else if !s.indistinguishable.is_empty() {
+        } else {
             advice.push(format!(
-                "Step {}: `{named}` cannot be told from {} with these data; what would separate them: {}.",
-                s.number,
-                code_list(&s.indistinguishable, ", "),
-                s.indistinguishable
+                "{at}: `{named}` cannot be told from {} with these data; what would separate them: {}.",
+                code_list(&r.rivals, ", "),
+                r.rivals
                     .iter()
                     .map(|n| format!(
                         "from `{n}`, {}",

@@ -22,7 +22,7 @@
 //! strongest first) is added to the final model, all effects fitted jointly from their
 //! final values and R's own fit at the step where it was strongest (R's explanation of the
 //! signal: where the two share it, the joint fit moves the model's parameters off the part
-//! R explains; a fit that ends more than [`NESTED_SLACK`] below the model's ℓ̂, which a
+//! R explains; a fit that ends below the model's ℓ̂ (by more than [`WORSE_BY`]), which a
 //! maximum cannot since the model is R at its null, is started again from R's null, and R
 //! is not judged where that one too ends below), and
 //!
@@ -39,7 +39,14 @@
 //! parameters, R's test and the measurement that separates them
 //! ([`crate::candidates::separating_measurement`]), when R moves one of its parameters out
 //! of its interval, or when R is significant given the model (p < α/2, the level at which
-//! backward elimination keeps an effect) and widens one. A widening alone, by
+//! backward elimination keeps an effect) and widens one; and never when the joint fit with
+//! R ends below the model's ℓ̂ (by more than [`WORSE_BY`]): the model is R at its null, so
+//! such a fit is not the maximum with R but a point short of it, and its moved values are
+//! a reading the data like less than the model's, not a second explanation (gravity was
+//! once listed as confounded with backlash by a re-fit that found backlash near 0 and ℓ̂
+//! slightly below the model's). The fit from R's own values is therefore started again
+//! from R's null wherever it ends below ℓ̂_M, not only beyond [`NESTED_SLACK`]; a fit
+//! started from the model's own maximum cannot end below it. A widening alone, by
 //! a rival the data do not call for, is not listed: a rival with free parameters of its own
 //! widens every interval it shares a direction with, however little of the signal it
 //! explains (a temperature field of four parameters, far from significant, widened a
@@ -93,10 +100,16 @@ pub const MAX_RIVALS: usize = 3;
 /// parameter to be confounded with it (a variance inflation of 4).
 pub const WIDENED: f64 = 2.0;
 
-/// How far below the final model's ℓ̂ a joint fit with a rival added may end and still count
-/// as a maximum (the model is the rival's null, so the maximum is at least ℓ̂_M; a fit that
-/// ends lower stopped on the way and is started again from the rival's null).
+/// How far below the final model's ℓ̂ a ridge probe's fit may end and still count as "as
+/// good as the model" (module doc, the ridge probe): a point on a flat ridge the rival
+/// opens, not a maximum, which the probe asks only of a joint fit that is not worse than
+/// the model ([`WORSE_BY`]).
 pub const NESTED_SLACK: f64 = 1.0;
+
+/// How far below the final model's ℓ̂ the joint fit with a rival may end and still be
+/// judged (module doc): a hundredth of a unit of ℓ (Λ = 0.02), room for rounding in a fit
+/// that started at the model's maximum, far below any difference the tests could see.
+pub const WORSE_BY: f64 = 0.01;
 
 /// How far past its interval's end the ridge probe moves a widened parameter, in units of
 /// the distance from its value to that end.
@@ -375,7 +388,7 @@ fn with_rival<'a>(
     let nulls: Vec<f64> = rival.parameters().iter().map(|q| q.null).collect();
     // The model with the rival at its null is the model itself: a joint fit that ends below
     // the model's ℓ̂ stopped short of the maximum, and its values say nothing.
-    let as_good = |j: &JointFit| j.log_likelihood >= l_model - NESTED_SLACK;
+    let as_good = |j: &JointFit| !worse(j.log_likelihood, l_model);
     let joint = match fit_jointly(ctx, &members, None) {
         Ok(j) if as_good(&j) => j,
         first => {
@@ -429,8 +442,9 @@ fn with_rival<'a>(
         }
     }
     let mut out = Vec::new();
+    let gain = joint.log_likelihood - l_model;
     for (e, parameters) in judged.into_iter().enumerate() {
-        if !listed(&parameters, significant) {
+        if !listed(&parameters, significant, gain) {
             continue;
         }
         out.push(Confounding {
@@ -599,11 +613,19 @@ fn contribution(ctx: &Context, joint: &JointFit, l_model: f64, k: usize) -> (f64
     (lr, p, lambda * (k as f64 * n.ln() - lr))
 }
 
+/// Whether a joint fit with a rival that ends at ℓ̂ `with` is worse than the model's ℓ̂
+/// `model` (by more than [`WORSE_BY`]; module doc).
+fn worse(with: f64, model: f64) -> bool {
+    with < model - WORSE_BY
+}
+
 /// Whether a rival whose parameters `confounded` with an effect's are these is listed as
-/// confounded with it (module doc): one of them moved out of its interval, or the rival
-/// `significant` given the model and one of them widened.
-fn listed(confounded: &[ConfoundedParameter], significant: bool) -> bool {
-    confounded.iter().any(|p| p.moved) || (significant && !confounded.is_empty())
+/// confounded with it (module doc): its joint fit with the model, `gain` = ℓ̂_{M+R} − ℓ̂_M,
+/// is not worse than the model ([`worse`]), and one of them moved out of its interval, or
+/// the rival `significant` given the model and one of them widened.
+fn listed(confounded: &[ConfoundedParameter], significant: bool, gain: f64) -> bool {
+    !worse(gain, 0.0)
+        && (confounded.iter().any(|p| p.moved) || (significant && !confounded.is_empty()))
 }
 
 /// Whether parameter `q`, fitted as `now` in the final model and as `with` with a rival
@@ -676,10 +698,32 @@ mod tests {
             "{wide:?}"
         );
         assert!(confounded(&q, &now, &fitted(-0.25, (-0.43, -0.07), (-0.43, -0.07))).is_none());
-        assert!(listed(std::slice::from_ref(&moved), false));
-        assert!(listed(&[wide.clone(), moved], false));
-        assert!(listed(std::slice::from_ref(&wide), true));
-        assert!(!listed(&[wide], false));
-        assert!(!listed(&[], true));
+        assert!(listed(std::slice::from_ref(&moved), false, 0.0));
+        assert!(listed(&[wide.clone(), moved], false, 3.0));
+        assert!(listed(std::slice::from_ref(&wide), true, 9.0));
+        assert!(!listed(&[wide], false, 0.0));
+        assert!(!listed(&[], true, 9.0));
+    }
+
+    /// The issue's gravity case: a rival whose joint re-fit with the model ends below the
+    /// model's ℓ̂ (here 0.3 units, within the old slack of 1) is not listed, though it moved
+    /// a parameter out of its interval (a |g| at its bound trading its direction, the rival
+    /// near its null): that fit is short of the maximum with the rival, whose ℓ̂ is at least
+    /// the model's. The same moves with the fit as good as the model (gain 0, or within
+    /// rounding, −0.005) or better are listed; significance does not rescue a worse fit.
+    #[test]
+    fn a_rival_whose_joint_refit_is_worse_is_not_listed() {
+        let q = Parameter::linear("offset", "K", -20.0, 20.0, 0.0);
+        let now = fitted(-0.28, (-0.4, -0.16), (-0.4, -0.16));
+        let moved = confounded(&q, &now, &fitted(0.01, (-0.1, 0.12), (-0.1, 0.12))).unwrap();
+        let one = std::slice::from_ref(&moved);
+        assert!(!listed(one, false, -0.3));
+        assert!(!listed(one, true, -0.3));
+        assert!(!listed(one, false, -2.0 * WORSE_BY));
+        assert!(listed(one, false, -0.5 * WORSE_BY));
+        assert!(listed(one, false, 0.0));
+        assert!(listed(one, true, 4.0));
+        // A fit judged worse than the model is restarted from the rival's null.
+        assert!(worse(-100.3, -100.0) && !worse(-100.0, -100.0) && !worse(-99.0, -100.0));
     }
 }

@@ -75,8 +75,9 @@ pub struct Step {
     /// Whether the named effect is kept (the false discovery rate over the steps; see
     /// [`crate::selection`]). A named effect that is not kept ends the selection.
     pub kept: bool,
-    /// Names of the candidates indistinguishable from the named one (and of effects removed
-    /// in later steps because it took over what they explained).
+    /// Names of the candidates indistinguishable from the named one by this step's own tests
+    /// ([`crate::selection::decide`]); what later steps and the confounding tests add is in
+    /// the one record, [`crate::selection::indistinguishable`].
     pub indistinguishable: Vec<String>,
     /// Every remaining candidate's score against the current model.
     pub candidates: Vec<CandidateScore>,
