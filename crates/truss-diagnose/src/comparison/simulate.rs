@@ -161,7 +161,7 @@ pub fn simulate(
         sim.indices.push(k as u64);
         sim.n += 1;
     }
-    if sim.n < 2 || sim.failed * 20 > samples {
+    if sim.n == 0 || sim.failed * 20 > samples {
         return Err(DiagnoseError::Simulation {
             what: case.name.clone(),
             message: format!(

@@ -12,8 +12,8 @@ use truss_diagnose::{DiagnoseOptions, run};
 #[test]
 fn thirty_copies_of_one_specimen_are_refused() {
     let dir = tempfile::tempdir().unwrap();
-    // (synth refuses a single specimen: three made, the first kept.)
-    let one = make(dir.path(), "one", "none", 3, 5);
+    // (One specimen made: synth refused a single one, "0 of 1 samples failed", before.)
+    let one = make(dir.path(), "one", "none", 1, 5);
     let text = std::fs::read_to_string(&one).unwrap();
     let mut lines = text.lines();
     let header = lines.next().unwrap();
