@@ -3,7 +3,7 @@
 //! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
 //! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 7)
+//! ## diagnosis.json (format `truss-diagnose`, version 9)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -48,6 +48,22 @@
 //!              with_rival is that fit's value): the data cannot tell how that part of the
 //!              signal divides between the two; the rival is also listed in the
 //!              `indistinguishable` of the step that named the effect
+//! unseen      [{name, step, significant, p_value, specimens, limit}]   every candidate
+//!              not in the final model, with the smallest effect its test against the
+//!              final model (step `step`: the one after the last kept step, or step 1)
+//!              detects with 80 % power; the verdict `none` means: no effect above these
+//!              sizes is missing (`significant`: that test was significant, and the limit
+//!              says nothing of what is there)
+//!   limit      {power (0.8), level (α_K, the test's Bonferroni-adjusted level),
+//!              critical_value (χ²_k's 1 − α_K quantile), noncentrality (λ₈₀), inflation
+//!              (c), adjustment (λ̄), most_visible (index into parameters, or null: not
+//!              detectable at any size within the plausible range), parameters[] {name,
+//!              unit, value (at the limit), size (|value − null|, the parameter's unit),
+//!              share_of_range, direction ("±", "+", "-"), information_per_specimen
+//!              [1/unit²]}} (one parameter at a time, the others at their null; size and
+//!              value null where not detectable within the range); or null where the fit
+//!              failed. Each of `candidates[]` (and the steps') carries the same as
+//!              `detection_limit` against its step's model
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
 //!              determined}]
 //!              (the first named effect's, as fitted in its step; for an effect swapped in,
@@ -86,6 +102,8 @@
 //!              candidates, deciding with the profiles, updating the model, comparing the
 //!              updated model; the final fit; the confounding tests)}
 //! ```
+//!
+//! Version 9 (from 8): `unseen` (detection limits) and `candidates[].detection_limit`.
 //!
 //! Version 8 (from 7): `confounding[].along_ridge`; a rival that moves nothing at the joint
 //! maximum is listed where the ridge probe finds a fit as good as the model's with an
@@ -131,6 +149,7 @@ use crate::selection::decide::Verdict;
 use crate::selection::eliminate::Removal;
 use crate::selection::model::{ModelEffect, RefitEffect};
 use crate::selection::step::Step;
+use crate::selection::unseen::Unseen;
 use method::{METHOD, Method};
 use serde::Serialize;
 
@@ -145,7 +164,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 8;
+pub const FORMAT_VERSION: u32 = 9;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -204,6 +223,7 @@ struct Report<'a> {
     effects: &'a [ModelEffect],
     final_fit: &'a [RefitEffect],
     confounding: &'a [Confounding],
+    unseen: &'a [Unseen],
     statistics: Statistics<'a>,
     discrepancy_before: f64,
     discrepancy_after: f64,
@@ -318,6 +338,7 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
         effects: &d.effects,
         final_fit: &d.final_fit,
         confounding: &d.confounding,
+        unseen: &d.unseen,
         statistics: Statistics {
             before: &d.before,
             after: d.after.as_ref(),

@@ -36,6 +36,7 @@ pub mod eliminate;
 pub mod model;
 pub mod ridge;
 pub mod step;
+pub mod unseen;
 pub mod update;
 
 use crate::candidates::{Library, library_for, names};
@@ -78,6 +79,9 @@ pub struct Diagnosis {
     pub final_fit: Vec<model::RefitEffect>,
     /// Rivals that explain part of what the final model's effects explain ([`confound`]).
     pub confounding: Vec<confound::Confounding>,
+    /// The candidates not in the final model, with the smallest effect of each these data
+    /// would have detected ([`unseen`]).
+    pub unseen: Vec<unseen::Unseen>,
     /// Wall time of the final fit and the confounding tests \[s\].
     pub final_seconds: f64,
     /// Each stage's wall time and simulations, in order.
@@ -272,6 +276,7 @@ pub fn diagnose(
         }
     }
     let final_seconds = clock.elapsed().as_secs_f64();
+    let unseen = unseen::unseen(&steps, last.map_or(0, |i| i + 1), &final_effects(&steps), n);
     let sims = ctx.simulations.get();
     let stages = ctx.stages.take();
     progress.note(&format!(
@@ -296,6 +301,7 @@ pub fn diagnose(
         library,
         final_fit,
         confounding,
+        unseen,
         final_seconds,
         stages,
         threads: settings.thread_count(),
