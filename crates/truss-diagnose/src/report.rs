@@ -142,6 +142,7 @@
 use crate::comparison::baseline::Baseline;
 use crate::comparison::measured::{DataReport, Measured};
 use crate::comparison::statistics::Comparison;
+use crate::likelihood::power::Unseen;
 use crate::likelihood::score::{CandidateScore, FittedParameter};
 use crate::selection::Diagnosis;
 use crate::selection::confound::Confounding;
@@ -149,7 +150,6 @@ use crate::selection::decide::Verdict;
 use crate::selection::eliminate::Removal;
 use crate::selection::model::{ModelEffect, RefitEffect};
 use crate::selection::step::Step;
-use crate::selection::unseen::Unseen;
 use method::{METHOD, Method};
 use serde::Serialize;
 

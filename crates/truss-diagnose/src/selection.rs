@@ -81,7 +81,7 @@ pub struct Diagnosis {
     pub confounding: Vec<confound::Confounding>,
     /// The candidates not in the final model, with the smallest effect of each these data
     /// would have detected ([`unseen`]).
-    pub unseen: Vec<unseen::Unseen>,
+    pub unseen: Vec<crate::likelihood::power::Unseen>,
     /// Wall time of the final fit and the confounding tests \[s\].
     pub final_seconds: f64,
     /// Each stage's wall time and simulations, in order.

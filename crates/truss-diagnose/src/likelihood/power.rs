@@ -146,6 +146,25 @@ pub struct DetectionLimit {
     pub most_visible: Option<usize>,
 }
 
+/// A candidate not in the final model and the smallest effect of it these data detect.
+#[derive(Debug, Clone, Serialize)]
+pub struct Unseen {
+    /// The candidate's name.
+    pub name: String,
+    /// The step whose test (against the final model) the limit is of.
+    pub step: usize,
+    /// Whether that test was significant (the candidate improved the fit, but was not
+    /// named or not kept): its limit is then no statement that nothing is there.
+    pub significant: bool,
+    /// Its p-value there.
+    pub p_value: f64,
+    /// Specimens n.
+    pub specimens: usize,
+    /// The limits, one parameter at a time; `None` where the fit failed or had no
+    /// curvature.
+    pub limit: Option<DetectionLimit>,
+}
+
 /// The detection limits of a candidate with `parameters`, from the observed information
 /// `curvature` = A = −∂²ℓ/∂t² of `n` specimens (internal coordinates), for its test at
 /// `level` with `c` = `inflation` and λ̄ = `adjustment` (module doc):
