@@ -91,6 +91,20 @@
 //!    effect (a step's own indistinguishable candidates, effects it took over from, rivals
 //!    confounded with it) is one record, [`selection::indistinguishable`], for effects
 //!    named and swapped in alike, which both reports read.
+//! 6. **What the data could not have seen** ([`selection::unseen`],
+//!    [`likelihood::power`]): for every candidate not in the final model, the smallest
+//!    effect its test against the final model (the step after the last kept one, with that
+//!    test's α_K, c, λ̄ and k) would have detected with 80 % power, one parameter at a time
+//!    in its own unit: Λ under the shift δ of internal coordinate j is non-central
+//!    χ²_k(λ), λ = δ²·Aⱼⱼ/(c·λ̄) (A = −∂²ℓ/∂t² at the candidate's fit, n times the
+//!    information per specimen), and δ solves P(χ²_k(λ) > q) = 0.8, q the test's critical
+//!    value. The most visible parameter (smallest limit as a share of its plausible range)
+//!    is reported in words ("`length_bias` bias.longeron below 1.8 µm"); a parameter
+//!    whose limit lies beyond its plausible range, or with no curvature, is "not
+//!    detectable at any size within its plausible range". One-sided parameters (a
+//!    clearance, a diagonal shortening) move only the way their range allows; the test's
+//!    χ²_k reference is kept, so the limit is that of the selection's own test. The
+//!    verdict `none` reads "no effect above these sizes is missing".
 //!
 //! Outputs: `DIR/diagnosis.json` (schema in [`report`]), `DIR/diagnosis.md`, and the SVG
 //! plots of [`report::plot`], each written through a temporary file and never through a link (a
@@ -175,6 +189,9 @@ pub struct Summary {
     pub reason: String,
     /// Discrepancy before and after.
     pub discrepancy: (f64, f64),
+    /// The smallest effect of each candidate not in the final model these data would have
+    /// detected, in words ([`selection::unseen`]).
+    pub unseen: Vec<String>,
     /// Files written.
     pub files: Vec<PathBuf>,
 }
@@ -287,6 +304,16 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
             d.before.energy,
             d.after.as_ref().map_or(d.before.energy, |a| a.energy),
         ),
+        unseen: d
+            .unseen
+            .iter()
+            .map(|u| {
+                u.words(
+                    d.candidate(&u.name)
+                        .expect("every candidate tested is in the library"),
+                )
+            })
+            .collect(),
         files,
     })
 }

@@ -10,11 +10,13 @@
 //! - [`score`]: one candidate against the current model: its fit, likelihood-ratio test,
 //!   BIC and intervals;
 //! - [`joint`]: several effects fitted as one (the joint re-fit of a model's effects).
+//! - [`power`]: the power of a candidate's test and its detection limits.
 
 pub mod conditional;
 pub mod derivatives;
 pub mod fit;
 pub mod gaussian;
 pub mod joint;
+pub mod power;
 pub mod profile;
 pub mod score;

@@ -52,6 +52,22 @@
 //!              signal divides between the two; the rival is also listed in the
 //!              effect's record of `indistinguishable_by_effect` (and so in the
 //!              `indistinguishable` of the step that named it, or the top-level one)
+//! unseen      [{name, step, significant, p_value, specimens, limit}]   every candidate
+//!              not in the final model, with the smallest effect its test against the
+//!              final model (step `step`: the one after the last kept step, or step 1)
+//!              detects with 80 % power; the verdict `none` means: no effect above these
+//!              sizes is missing (`significant`: that test was significant, and the limit
+//!              says nothing of what is there)
+//!   limit      {power (0.8), level (α_K, the test's Bonferroni-adjusted level),
+//!              critical_value (χ²_k's 1 − α_K quantile), noncentrality (λ₈₀), inflation
+//!              (c), adjustment (λ̄), most_visible (index into parameters, or null: not
+//!              detectable at any size within the plausible range), parameters[] {name,
+//!              unit, value (at the limit), size (|value − null|, the parameter's unit),
+//!              share_of_range, direction ("±", "+", "-"), information_per_specimen
+//!              [1/unit²]}} (one parameter at a time, the others at their null; size and
+//!              value null where not detectable within the range); or null where the fit
+//!              failed. Each of `candidates[]` (and the steps') carries the same as
+//!              `detection_limit` against its step's model
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
 //!              determined}]
 //!              (the first named effect's, as fitted in its step; for an effect swapped in,
@@ -99,7 +115,8 @@
 //!              updated model; the final fit; the confounding tests)}
 //! ```
 //!
-//! Version 9 (from 8): `indistinguishable_by_effect`; the `data.checks[]` warnings. An
+//! Version 9 (from 8): `indistinguishable_by_effect`; the `data.checks[]` warnings;
+//! `unseen` (detection limits) and `candidates[].detection_limit`. An
 //! effect swapped in (never named by a step) now has its rivals too: those removed because
 //! it took over and those confounded with it, which were before in `confounding[]` and the
 //! markdown but in no `indistinguishable` field; `steps[].indistinguishable` and the
@@ -142,6 +159,7 @@
 use crate::comparison::baseline::Baseline;
 use crate::comparison::measured::{DataReport, Measured};
 use crate::comparison::statistics::Comparison;
+use crate::likelihood::power::Unseen;
 use crate::likelihood::score::{CandidateScore, FittedParameter};
 use crate::selection::confound::Confounding;
 use crate::selection::decide::Verdict;
@@ -223,6 +241,7 @@ struct Report<'a> {
     effects: &'a [ModelEffect],
     final_fit: &'a [RefitEffect],
     confounding: &'a [Confounding],
+    unseen: &'a [Unseen],
     statistics: Statistics<'a>,
     discrepancy_before: f64,
     discrepancy_after: f64,
@@ -336,6 +355,7 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
         effects: &d.effects,
         final_fit: &d.final_fit,
         confounding: &d.confounding,
+        unseen: &d.unseen,
         statistics: Statistics {
             before: &d.before,
             after: d.after.as_ref(),

@@ -36,6 +36,7 @@ pub mod eliminate;
 pub mod model;
 pub mod ridge;
 pub mod step;
+pub mod unseen;
 pub mod update;
 
 use crate::candidates::{Library, library_for, names};
@@ -83,6 +84,9 @@ pub struct Diagnosis {
     /// ([`indistinguishable`]): the one record that `diagnosis.json`'s `indistinguishable`
     /// fields and `diagnosis.md` read.
     pub indistinguishable: Vec<Indistinguishable>,
+    /// The candidates not in the final model, with the smallest effect of each these data
+    /// would have detected ([`unseen`]).
+    pub unseen: Vec<crate::likelihood::power::Unseen>,
     /// Wall time of the final fit and the confounding tests \[s\].
     pub final_seconds: f64,
     /// Each stage's wall time and simulations, in order.
@@ -286,6 +290,7 @@ pub fn diagnose(
     };
     let indistinguishable = indistinguishable(&steps, &confounding);
     let final_seconds = clock.elapsed().as_secs_f64();
+    let unseen = unseen::unseen(&steps, last.map_or(0, |i| i + 1), &final_effects(&steps), n);
     let sims = ctx.simulations.get();
     let stages = ctx.stages.take();
     progress.note(&format!(
@@ -311,6 +316,7 @@ pub fn diagnose(
         final_fit,
         confounding,
         indistinguishable,
+        unseen,
         final_seconds,
         stages,
         threads: settings.thread_count(),

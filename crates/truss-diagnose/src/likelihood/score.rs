@@ -11,6 +11,7 @@ use crate::errors::DiagnoseError;
 use crate::likelihood::derivatives::Terms;
 use crate::likelihood::fit::{Fit, Interval, Options, adjustments, maximise, wald_intervals};
 use crate::likelihood::gaussian::{Gaussian, member_log_likelihood};
+use crate::likelihood::power::{DetectionLimit, detection_limit};
 use crate::likelihood::profile::{Intervals, Problem, Profile, profile_intervals};
 use serde::Serialize;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -125,6 +126,11 @@ pub struct CandidateScore {
     /// Why the fit failed, if it did.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
+    /// The smallest effect of each parameter this test detects with 80 % power, from the
+    /// curvature at the fit ([`crate::likelihood::power`]); `None` where the fit failed or
+    /// has no curvature.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub detection_limit: Option<DetectionLimit>,
 }
 
 /// A p-value for people: `p < 1e-16` below what a double can tell from 0 after
@@ -404,6 +410,14 @@ pub(crate) fn score_of(c: &dyn Candidate, fit: &Fit, test: &Test) -> CandidateSc
         seconds: 0.0,
         vuong_z: None,
         error: None,
+        detection_limit: detection_limit(
+            params,
+            &fit.curvature,
+            test.n,
+            test.level,
+            test.inflation,
+            mean_eig,
+        ),
     }
 }
 
@@ -444,6 +458,7 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
                 seconds: 0.0,
                 vuong_z: None,
                 error: Some(e.to_string()),
+                detection_limit: None,
             },
             None,
         ),
@@ -588,6 +603,7 @@ impl CandidateScore {
             seconds: 0.0,
             vuong_z: None,
             error: None,
+            detection_limit: None,
         }
     }
 }

@@ -66,6 +66,7 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
         ),
     );
     push(m, &format!("{}.\n", d.reason.trim_end_matches('.')));
+    unseen_section(m, baseline, d);
     let span = spans(baseline);
     for e in &d.final_fit {
         let c = effect(d, &e.name);
@@ -127,6 +128,39 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
         push(m, "");
     }
     confounding_section(m, d);
+}
+
+/// What the data could not have seen: the smallest effect of each candidate not in the
+/// final model that its test would have detected with 80 % power, with its hardware reading.
+fn unseen_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
+    let Some(first) = d.unseen.first() else {
+        return;
+    };
+    push(
+        m,
+        &format!(
+            "**Could not have been seen** with these {} specimens (each candidate not in the final model: the smallest effect its test in step {} would have detected with 80 % power, at that test's level α_K, its most visible parameter, the others at their null){}:\n",
+            first.specimens,
+            first.step,
+            if d.verdict == Verdict::None {
+                "; no effect above these sizes is missing"
+            } else {
+                ""
+            }
+        ),
+    );
+    let span = spans(baseline);
+    for u in &d.unseen {
+        let c = effect(d, &u.name);
+        let reading = u
+            .limit
+            .as_ref()
+            .and_then(|l| l.most_visible.map(|j| (j, &l.parameters[j])))
+            .and_then(|(j, p)| p.value.map(|v| c.reading(j, v, span)))
+            .map_or(String::new(), |r| format!(" (at that size: {r})"));
+        push(m, &format!("- {}{reading}", u.words(c)));
+    }
+    push(m, "");
 }
 
 /// What the data cannot tell apart within the final model: each rival confounded with an

@@ -43,11 +43,12 @@ impl Verdict {
         }
     }
 
-    /// The verdict in words.
+    /// The verdict in words; `none`'s "these sizes" are the detection limits the reports
+    /// give beside it ([`crate::selection::unseen`]).
     pub fn words(self) -> &'static str {
         match self {
             Verdict::Named => "a missing effect is named",
-            Verdict::None => "the model agrees; no effect is missing",
+            Verdict::None => "the model agrees; no effect above these sizes is missing",
             Verdict::CannotTell => "the data cannot tell",
             Verdict::Unexplained => "the model disagrees, and no candidate explains it",
         }
