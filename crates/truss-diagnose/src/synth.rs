@@ -67,17 +67,7 @@ pub fn synth(options: &SynthOptions, out: &mut dyn Write) -> Result<usize, Diagn
     } else {
         top.to_vec()
     };
-    let coords: Vec<Coordinate> = nodes
-        .iter()
-        .flat_map(|&node| {
-            let id = model.nodes()[node].id.clone();
-            (0..3).map(move |axis| Coordinate {
-                node,
-                node_id: id.clone(),
-                axis,
-            })
-        })
-        .collect();
+    let coords = Coordinate::of_nodes(&model, &nodes);
     let top_ix = top_indices(&coords, top).expect("top nodes are written");
     let noise = Noise {
         sigma: options.measurement_sigma,

@@ -869,17 +869,7 @@ fn a_bad_batch_below_the_limits_is_reported_as_unseen() {
         }
     }
     let top = model.top_surface().unwrap().nodes;
-    let coords: Vec<Coordinate> = top
-        .iter()
-        .flat_map(|&node| {
-            let id = model.nodes()[node].id.clone();
-            (0..3).map(move |axis| Coordinate {
-                node,
-                node_id: id.clone(),
-                axis,
-            })
-        })
-        .collect();
+    let coords = Coordinate::of_nodes(&model, &top);
     let noise = Noise {
         sigma: 0.001,
         seed: 91,

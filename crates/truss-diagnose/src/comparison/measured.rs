@@ -101,6 +101,21 @@ pub struct Coordinate {
 }
 
 impl Coordinate {
+    /// The x, y and z coordinates of each of `nodes` (indices into `model`), in order.
+    pub fn of_nodes(model: &Model, nodes: &[usize]) -> Vec<Coordinate> {
+        nodes
+            .iter()
+            .flat_map(|&node| {
+                let id = model.nodes()[node].id.clone();
+                (0..3).map(move |axis| Coordinate {
+                    node,
+                    node_id: id.clone(),
+                    axis,
+                })
+            })
+            .collect()
+    }
+
     /// `n5.1 z`.
     pub fn label(&self) -> String {
         format!("{} {}", self.node_id, ["x", "y", "z"][self.axis])
