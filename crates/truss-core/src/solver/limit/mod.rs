@@ -70,7 +70,7 @@ const FIRST_RATIO: f64 = crate::structure::LIMIT_RATIO;
 const FALLBACK_RATIO: f64 = 1e-2;
 
 /// The smallest step of [`Solver::continue_down`], in decades of the ratio.
-const MIN_LOG_STEP: f64 = 1.0 / 16.0;
+const MIN_LOG_STEP: f64 = 1.0 / 128.0;
 
 /// The last positive ratio of the continuation.
 const LAST_RATIO: f64 = 1e-12;
