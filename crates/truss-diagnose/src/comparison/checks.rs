@@ -31,7 +31,7 @@
 //! `diagnosis.md` (the Data section); the diagnosis still runs, since the stated noise may
 //! simply be too large, but its verdict then rests on a noise the data contradict.
 
-use crate::comparison::measured::Measured;
+use crate::comparison::measured::{DataCheck, Measured};
 use crate::errors::DiagnoseError;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
@@ -41,19 +41,6 @@ pub const CHECK_LEVEL: f64 = 1e-3;
 
 /// Most coordinates or pairs named in a warning.
 pub const NAMED: usize = 5;
-
-/// A warning from a data check, in `diagnosis.json`'s `data.checks[]`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
-pub struct DataCheck {
-    /// `scatter_below_noise` or `specimens_closer_than_noise`.
-    pub check: &'static str,
-    /// How many coordinates (or pairs of specimens) are flagged.
-    pub flagged: usize,
-    /// The smallest p-value among them (module doc).
-    pub p_value: f64,
-    /// The warning in one sentence.
-    pub words: String,
-}
 
 /// A length in µm for the sentences (the data are in mm).
 fn um(mm: f64) -> String {

@@ -89,6 +89,20 @@ impl Outlier {
     }
 }
 
+/// A warning from a data check ([`crate::comparison::checks`]), in `diagnosis.json`'s
+/// `data.checks[]`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct DataCheck {
+    /// `scatter_below_noise` or `specimens_closer_than_noise`.
+    pub check: &'static str,
+    /// How many coordinates (or pairs of specimens) are flagged.
+    pub flagged: usize,
+    /// The smallest p-value among them (module doc).
+    pub p_value: f64,
+    /// The warning in one sentence.
+    pub words: String,
+}
+
 /// One measured coordinate: a node of the model and an axis (0 = x, 1 = y, 2 = z).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Coordinate {
@@ -154,7 +168,7 @@ pub struct DataReport {
     pub unknown_members: Vec<String>,
     /// The warnings of the checks against the stated instrument noise
     /// ([`crate::comparison::checks`]).
-    pub checks: Vec<crate::comparison::checks::DataCheck>,
+    pub checks: Vec<DataCheck>,
 }
 
 impl DataReport {
