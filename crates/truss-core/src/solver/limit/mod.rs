@@ -76,6 +76,25 @@ const MIN_LOG_STEP: f64 = 1.0 / 128.0;
 const LAST_RATIO: f64 = 1e-12;
 
 impl Solver {
+    /// Step 1 of the module doc at `ratio`: the linearised start from rest, then Newton
+    /// there (the start's factorisations counted even where Newton fails).
+    async fn anchor_at(
+        &mut self,
+        ratio: f64,
+        counts: &mut Counts,
+        kernels: Kernels<'_>,
+    ) -> Result<(), SolveError> {
+        self.set_limit_ratio(ratio);
+        self.work.u.fill(0.0);
+        let mut start_factorisations = 0;
+        self.linearised_from_rest(&mut start_factorisations);
+        counts.factorisations += start_factorisations;
+        let r = self.newton_warm(kernels).await?;
+        counts.iterations += r.iterations;
+        counts.factorisations += r.factorisations;
+        Ok(())
+    }
+
     /// Continues the converged equilibrium at ratio `from` (the current point) down to
     /// `to < from`, where the tenfold steps of the module doc do not converge: steps of
     /// `log₁₀ ρ` that halve where Newton at the next ratio does not converge from the last
@@ -90,7 +109,8 @@ impl Solver {
         kernels: Kernels<'_>,
     ) -> Result<(), SolveError> {
         let n = self.structure.free;
-        let mut back = self.work.u[..n].to_vec();
+        // The last converged point, restored where a step fails.
+        self.limit.saved[..n].copy_from_slice(&self.work.u[..n]);
         let (mut at, end) = (from.log10(), to.log10());
         let mut step: f64 = 0.5;
         loop {
@@ -104,14 +124,14 @@ impl Solver {
                         return Ok(());
                     }
                     at = next;
-                    back.copy_from_slice(&self.work.u[..n]);
+                    self.limit.saved[..n].copy_from_slice(&self.work.u[..n]);
                     step = (step * 1.5).min(1.0);
                 }
                 Err(e) => {
                     if let SolveError::NotConverged { iterations, .. } = e {
                         counts.iterations += iterations;
                     }
-                    self.work.u[..n].copy_from_slice(&back);
+                    self.work.u[..n].copy_from_slice(&self.limit.saved[..n]);
                     step *= 0.5;
                     if step < MIN_LOG_STEP {
                         return Err(e);
@@ -128,32 +148,21 @@ impl Solver {
     ) -> Result<SolveReport, SolveError> {
         let s = Arc::clone(&self.structure);
         let n = s.free;
-        let mut counts = Counts::default();
-        self.set_limit_ratio(FIRST_RATIO);
-        self.work.u.fill(0.0);
-        let mut start_factorisations = 0;
-        self.linearised_from_rest(&mut start_factorisations);
-        counts.factorisations += start_factorisations;
-        counts.iterations = 1;
-        match self.newton_warm(kernels).await {
-            Ok(first) => {
-                counts.iterations += first.iterations;
-                counts.factorisations += first.factorisations;
-            }
-            Err(_) => {
-                // A tall truss whose many panels rack at once: reach `ρ₀` from a stiffer
-                // anchor instead (see `continue_down`).
-                self.set_limit_ratio(FALLBACK_RATIO);
-                self.work.u.fill(0.0);
-                let mut f = 0;
-                self.linearised_from_rest(&mut f);
-                counts.factorisations += f;
-                let anchor = self.newton_warm(kernels).await?;
-                counts.iterations += anchor.iterations;
-                counts.factorisations += anchor.factorisations;
-                self.continue_down(FALLBACK_RATIO, FIRST_RATIO, &mut counts, kernels)
-                    .await?;
-            }
+        // The linearised start counts as an iteration.
+        let mut counts = Counts {
+            iterations: 1,
+            ..Counts::default()
+        };
+        if self
+            .anchor_at(FIRST_RATIO, &mut counts, kernels)
+            .await
+            .is_err()
+        {
+            // A tall truss whose many panels rack at once: reach `ρ₀` from a stiffer
+            // anchor instead (see `continue_down`).
+            self.anchor_at(FALLBACK_RATIO, &mut counts, kernels).await?;
+            self.continue_down(FALLBACK_RATIO, FIRST_RATIO, &mut counts, kernels)
+                .await?;
         }
         let stages = (FIRST_RATIO / LAST_RATIO).log10().round() as i32;
         for stage in 1..=stages + 1 {
