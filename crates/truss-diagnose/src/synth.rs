@@ -41,6 +41,33 @@ pub struct SynthOptions {
     pub members_out: Option<PathBuf>,
 }
 
+/// Writes the node CSV of measured positions (mm): the header, then for each specimen
+/// `S0001, …` the nominal position plus the displacements in `x` (each specimen's x, y, z
+/// of every one of `nodes`, in order, as [`Coordinate::of_nodes`] lists them).
+pub fn write_specimens(
+    out: &mut dyn Write,
+    model: &truss_core::Model,
+    nodes: &[usize],
+    x: &[f64],
+) -> std::io::Result<()> {
+    writeln!(out, "specimen,node,x,y,z")?;
+    for (s, row) in x.chunks_exact(3 * nodes.len()).enumerate() {
+        for (k, &node) in nodes.iter().enumerate() {
+            let n = &model.nodes()[node];
+            writeln!(
+                out,
+                "S{:04},{},{},{},{}",
+                s + 1,
+                n.id,
+                n.xyz[0] + row[3 * k],
+                n.xyz[1] + row[3 * k + 1],
+                n.xyz[2] + row[3 * k + 2]
+            )?;
+        }
+    }
+    Ok(())
+}
+
 /// Writes the node CSV to `out`; returns the number of specimens written.
 pub fn synth(options: &SynthOptions, out: &mut dyn Write) -> Result<usize, DiagnoseError> {
     if !(options.measurement_sigma >= 0.0 && options.measurement_sigma.is_finite()) {
@@ -81,23 +108,7 @@ pub fn synth(options: &SynthOptions, out: &mut dyn Write) -> Result<usize, Diagn
         truss_threads::available(),
     )?;
     let io = |e: std::io::Error| DiagnoseError::io(std::path::Path::new("<stdout>"), e);
-    writeln!(out, "specimen,node,x,y,z").map_err(io)?;
-    let d = coords.len();
-    for (s, row) in sim.x_noisy.chunks_exact(d).enumerate() {
-        for (k, &node) in nodes.iter().enumerate() {
-            let n = &model.nodes()[node];
-            writeln!(
-                out,
-                "S{:04},{},{},{},{}",
-                s + 1,
-                n.id,
-                n.xyz[0] + row[3 * k],
-                n.xyz[1] + row[3 * k + 1],
-                n.xyz[2] + row[3 * k + 2]
-            )
-            .map_err(io)?;
-        }
-    }
+    write_specimens(out, &model, &nodes, &sim.x_noisy).map_err(io)?;
     if let Some(path) = &options.members_out {
         let case = &job.cases[0];
         let key = truss_job::sampler::stream_key(options.seed, &case.name);

@@ -34,7 +34,7 @@ mod stepwise;
 
 use std::path::{Path, PathBuf};
 use truss_diagnose::settings::Settings;
-use truss_diagnose::synth::{SynthOptions, synth};
+use truss_diagnose::synth::{SynthOptions, synth, write_specimens};
 use truss_diagnose::{DiagnoseOptions, run};
 
 fn job() -> PathBuf {
@@ -851,7 +851,6 @@ fn out_of_range_settings_and_effects_are_refused() {
 #[test]
 #[ignore = "slow statistical check: run in release"]
 fn a_bad_batch_below_the_limits_is_reported_as_unseen() {
-    use std::fmt::Write as _;
     use truss_diagnose::comparison::baseline::Baseline;
     use truss_diagnose::comparison::measured::Coordinate;
     use truss_diagnose::comparison::simulate::{Noise, simulate, top_indices};
@@ -882,22 +881,8 @@ fn a_bad_batch_below_the_limits_is_reported_as_unseen() {
         1,
     )
     .unwrap();
-    let mut csv = String::from("specimen,node,x,y,z\n");
-    for (s, row) in sim.x_noisy.chunks_exact(coords.len()).enumerate() {
-        for (k, &node) in top.iter().enumerate() {
-            let n = &model.nodes()[node];
-            writeln!(
-                csv,
-                "S{:04},{},{},{},{}",
-                s + 1,
-                n.id,
-                n.xyz[0] + row[3 * k],
-                n.xyz[1] + row[3 * k + 1],
-                n.xyz[2] + row[3 * k + 2]
-            )
-            .unwrap();
-        }
-    }
+    let mut csv = Vec::new();
+    write_specimens(&mut csv, &model, &top, &sim.x_noisy).unwrap();
     let measured = dir.path().join("batch.csv");
     std::fs::write(&measured, csv).unwrap();
     let out = dir.path().join("out");
