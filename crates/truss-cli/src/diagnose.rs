@@ -110,12 +110,8 @@ pub fn run_diagnose(args: &DiagnoseArgs, out: &mut dyn Write) -> Result<(), CliE
         s.discrepancy.0,
         s.discrepancy.1
     )?;
-    if !s.unseen.is_empty() {
-        writeln!(
-            out,
-            "not detectable (80 % power) below: {}",
-            s.unseen.join("; ").replace('`', "")
-        )?;
+    for line in &s.answer {
+        writeln!(out, "{line}")?;
     }
     for f in &s.files {
         writeln!(out, "wrote {}", f.display())?;

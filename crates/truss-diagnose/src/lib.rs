@@ -189,9 +189,10 @@ pub struct Summary {
     pub reason: String,
     /// Discrepancy before and after.
     pub discrepancy: (f64, f64),
-    /// The smallest effect of each candidate not in the final model these data would have
-    /// detected, in words ([`selection::unseen`]).
-    pub unseen: Vec<String>,
+    /// The answer's lines as the console prints them ([`report::Answer::plain_lines`]):
+    /// the lines `diagnosis.md` opens with and `diagnosis.json`'s `answer.lines`, without
+    /// Markdown's marks.
+    pub answer: Vec<String>,
     /// Files written.
     pub files: Vec<PathBuf>,
 }
@@ -278,14 +279,16 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
             )?);
         }
     }
+    // One answer for the three reports: diagnosis.json, diagnosis.md and the summary.
+    let answer = report::Answer::of(&data, &d);
     let mut files = vec![
         out.write(
             "diagnosis.json",
-            report::json(&base, &data, &d, s.measurement_sigma).as_bytes(),
+            report::json(&base, &data, &d, &answer, s.measurement_sigma).as_bytes(),
         )?,
         out.write(
             "diagnosis.md",
-            report::markdown(&base, &data, &d, &plots).as_bytes(),
+            report::markdown(&base, &data, &d, &answer, &plots).as_bytes(),
         )?,
         out.write(
             "updated-job.json",
@@ -304,16 +307,7 @@ pub fn run(options: &DiagnoseOptions) -> Result<Summary, DiagnoseError> {
             d.before.energy,
             d.after.as_ref().map_or(d.before.energy, |a| a.energy),
         ),
-        unseen: d
-            .unseen
-            .iter()
-            .map(|u| {
-                u.words(
-                    d.candidate(&u.name)
-                        .expect("every candidate tested is in the library"),
-                )
-            })
-            .collect(),
+        answer: answer.plain_lines(),
         files,
     })
 }

@@ -3,7 +3,7 @@
 //! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
 //! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 9)
+//! ## diagnosis.json (format `truss-diagnose`, version 10)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -15,6 +15,13 @@
 //!              flagged (coordinates or pairs), p_value (the smallest), words}: the data
 //!              checks' warnings against the stated noise (crate::comparison::checks)}
 //! verdict     "named" | "none" | "cannot_tell" | "unexplained";  reason (words)
+//! answer      {verdict, missing[] {effect, parameters[] {name, unit (the hardware's: µm
+//!              for a length fitted in mm), value, lower, upper (95 % interval; null where
+//!              not found), determined, shown (the interval excludes the null)}},
+//!              cannot_tell_apart[] {effect, rivals[], separate_by[]}, could_not_have_seen[]
+//!              (words), specimens, next[] (words), lines[] (Markdown)}: the answer
+//!              diagnosis.md opens with and the console prints (report::answer), written
+//!              from this record once
 //!              ("named" when an effect was added, else step 1's verdict)
 //! named_effect "none" or the first added effect's name
 //! named_effects [names]   every effect added, in order; [] when none
@@ -115,6 +122,9 @@
 //!              updated model; the final fit; the confounding tests)}
 //! ```
 //!
+//! Version 10 (from 9): `answer`, the answer the reports share; diagnosis.md opens with
+//! its lines and its `## Next step` section became the answer's `next` lines.
+//!
 //! Version 9 (from 8): `indistinguishable_by_effect`; the `data.checks[]` warnings;
 //! `unseen` (detection limits) and `candidates[].detection_limit`. An
 //! effect swapped in (never named by a step) now has its rivals too: those removed because
@@ -170,18 +180,20 @@ use crate::selection::{Diagnosis, Indistinguishable};
 use method::{METHOD, Method};
 use serde::Serialize;
 
+pub mod answer;
 mod markdown;
 mod method;
 pub mod plot;
 mod wording;
 
 pub use crate::likelihood::score::{p_is, p_text};
+pub use answer::Answer;
 pub use markdown::markdown;
 
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 9;
+pub const FORMAT_VERSION: u32 = 10;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -228,6 +240,7 @@ struct Report<'a> {
     measurement_sigma: f64,
     data: &'a DataReport,
     verdict: Verdict,
+    answer: &'a Answer,
     reason: &'a str,
     named_effect: &'a str,
     named_effects: Vec<&'a str>,
@@ -304,8 +317,14 @@ pub fn named_effect(d: &Diagnosis) -> &str {
     d.named_effect()
 }
 
-/// diagnosis.json.
-pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f64) -> String {
+/// diagnosis.json, with `answer` (the one [`Answer::of`] `d`).
+pub fn json(
+    baseline: &Baseline,
+    measured: &Measured,
+    d: &Diagnosis,
+    answer: &Answer,
+    sigma_m: f64,
+) -> String {
     let first = d.first_step();
     let first_named = d
         .steps
@@ -326,6 +345,7 @@ pub fn json(baseline: &Baseline, measured: &Measured, d: &Diagnosis, sigma_m: f6
         measurement_sigma: sigma_m,
         data: &measured.report,
         verdict: d.verdict,
+        answer,
         reason: &d.reason,
         named_effect: d.named_effect(),
         named_effects: d.named_effects(),

@@ -1,6 +1,7 @@
 //! The `truss` binary, run as a user would: generated models, solve output, exit codes.
 
 use crate::{json, truss};
+use std::path::Path;
 
 #[test]
 fn prism_model_has_the_papers_counts_and_overrides_apply() {
@@ -218,6 +219,74 @@ fn synth_measured_then_diagnose_names_the_hidden_effect() {
         None => panic!("the updated case has no diagonal length error"),
     }
     assert_eq!(updated.case().samples, 4000);
+    the_three_reports_give_one_answer(&d, &stdout, &report);
+}
+
+/// diagnosis.json's `answer`, the lines diagnosis.md opens with and the console summary
+/// are one answer: the same lines (the console's without Markdown's `**` and backticks),
+/// and the record they are written from agrees with the rest of diagnosis.json (the
+/// verdict, the effects added, the final fit's values in µm).
+fn the_three_reports_give_one_answer(d: &serde_json::Value, stdout: &str, report: &Path) {
+    let answer = &d["answer"];
+    let lines: Vec<&str> = answer["lines"]
+        .as_array()
+        .expect("answer.lines")
+        .iter()
+        .map(|l| l.as_str().unwrap())
+        .collect();
+    assert!(lines.len() >= 3, "{lines:?}");
+    assert_eq!(answer["verdict"], d["verdict"]);
+    assert_eq!(
+        lines[0],
+        format!(
+            "**Verdict: {}.**",
+            stdout
+                .lines()
+                .find_map(|l| l.strip_prefix("verdict: named ("))
+                .and_then(|l| l.strip_suffix(')'))
+                .expect("the verdict line")
+        )
+    );
+    // diagnosis.md: the title, then the answer, before any reasoning.
+    let md = std::fs::read_to_string(report.join("diagnosis.md")).unwrap();
+    let mut expected = vec![lines[0], ""];
+    expected.extend(&lines[1..]);
+    let opening: Vec<&str> = md.lines().skip(2).take(expected.len()).collect();
+    assert_eq!(opening, expected, "{md}");
+    assert!(md.lines().nth(2 + expected.len()) == Some(""), "{md}");
+    // The console: the same lines, plain.
+    let plain: Vec<String> = lines
+        .iter()
+        .map(|l| l.replace("**", "").replace('`', ""))
+        .collect();
+    let printed: Vec<&str> = stdout
+        .lines()
+        .skip_while(|l| !l.starts_with("Verdict: "))
+        .take_while(|l| !l.starts_with("wrote "))
+        .collect();
+    assert_eq!(printed, plain, "{stdout}");
+    // The record: the effects added, each parameter as the final fit has it.
+    let missing = answer["missing"].as_array().unwrap();
+    let named: Vec<&serde_json::Value> = missing.iter().map(|m| &m["effect"]).collect();
+    assert_eq!(
+        named,
+        d["named_effects"].as_array().unwrap().iter().collect::<Vec<_>>()
+    );
+    for (m, f) in missing.iter().zip(d["final_fit"].as_array().unwrap()) {
+        for (a, p) in m["parameters"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(f["parameters"].as_array().unwrap())
+        {
+            assert_eq!(a["name"], p["name"]);
+            let scale = if p["unit"] == "mm" { 1e3 } else { 1.0 };
+            assert_eq!(a["value"].as_f64(), p["value"].as_f64().map(|v| v * scale));
+            let name = a["name"].as_str().unwrap();
+            assert!(lines[1].contains(name), "{name} missing from {}", lines[1]);
+        }
+    }
+    assert!(lines.iter().any(|l| l.starts_with("- **Next:** ")), "{lines:?}");
 }
 
 /// A bad row is an invalid-data error (exit 3) naming the file and line.

@@ -1,11 +1,13 @@
-//! `diagnosis.md`: the diagnosis for people, section by section: the verdict and the
-//! fitted values, the data read, where the baseline disagrees with the measurements, each
-//! step of the selection, the updated job, the baseline against the final model, what to
-//! measure or do next, the plots and the method.
+//! `diagnosis.md`: the diagnosis for people. It opens with the answer ([`Answer`]: what is
+//! missing and how large, what cannot be told apart or could not have been seen, what to
+//! measure next), then shows how it was reached, section by section: the verdict's reason
+//! and the fitted values in full, the data read, where the baseline disagrees with the
+//! measurements, each step of the selection, the updated job, the baseline against the
+//! final model, the plots and the method.
 
+use super::answer::Answer;
 use super::method::METHOD;
 use super::wording::{code_list, effect, g, parameter_text, plain_reading, push, spans};
-use crate::candidates::candidate::separating_measurement;
 use crate::comparison::baseline::Baseline;
 use crate::comparison::measured::Measured;
 use crate::likelihood::score::p_is;
@@ -16,14 +18,23 @@ use discrepancy::{before_after_section, disagreement_section, step_section};
 
 mod discrepancy;
 
-/// diagnosis.md.
+/// diagnosis.md, opening with `answer` (the one [`Answer::of`] `d`).
 pub fn markdown(
     baseline: &Baseline,
     measured: &Measured,
     d: &Diagnosis,
+    answer: &Answer,
     plots: &[String],
 ) -> String {
     let mut m = String::new();
+    push(
+        &mut m,
+        &format!(
+            "# Diagnosis of case `{}` against the measurements\n",
+            baseline.case_name
+        ),
+    );
+    answer_section(&mut m, answer);
     verdict_section(&mut m, baseline, d);
     data_section(&mut m, baseline, measured, d);
     disagreement_section(&mut m, d);
@@ -38,30 +49,35 @@ pub fn markdown(
     }
     updated_job_section(&mut m, baseline, d);
     before_after_section(&mut m, d);
-    next_step_section(&mut m, measured, d);
     method_section(&mut m, d, plots);
     m
 }
 
-/// The title, the verdict and the fitted values.
+/// The answer's lines: the verdict, then the list.
+fn answer_section(m: &mut String, answer: &Answer) {
+    let (verdict, list) = answer
+        .lines
+        .split_first()
+        .expect("an answer has its verdict line");
+    push(m, &format!("{verdict}\n"));
+    for l in list {
+        push(m, l);
+    }
+    push(m, "");
+}
+
+/// How the verdict was reached, and the fitted values in full.
 fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
-    push(
-        m,
-        &format!(
-            "# Diagnosis of case `{}` against the measurements\n",
-            baseline.case_name
-        ),
-    );
+    push(m, "## How the diagnosis reached it\n");
     let named = d.named_effects();
     push(
         m,
         &format!(
-            "**Verdict: {}** — {}.\n",
-            d.verdict.words(),
+            "{}.\n",
             if named.is_empty() {
-                "no effect added".to_string()
+                "No effect added".to_string()
             } else {
-                format!("effects added, in order: {}", code_list(&named, ", then "))
+                format!("Effects added, in order: {}", code_list(&named, ", then "))
             }
         ),
     );
@@ -343,69 +359,6 @@ fn updated_job_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
             ),
         );
     }
-}
-
-/// `## Next step`: what to measure or do next.
-fn next_step_section(m: &mut String, measured: &Measured, d: &Diagnosis) {
-    push(m, "## Next step\n");
-    let mut advice = Vec::new();
-    for r in &d.indistinguishable {
-        if r.rivals.is_empty() {
-            continue;
-        }
-        let named = r.effect.as_str();
-        let a = effect(d, named);
-        let at = if r.swapped_in {
-            format!("Step {} (swapped in)", r.step)
-        } else {
-            format!("Step {}", r.step)
-        };
-        let mistaken = r.rivals.iter().any(|o| {
-            let b = effect(d, o);
-            a.mistaken_without_members(b.trace()) || b.mistaken_without_members(a.trace())
-        });
-        if mistaken && measured.members.is_none() {
-            advice.push(format!(
-                "{at}: `{named}` and {} fit the node positions equally well: joint free play shortens the truss much as a member-length error does. Measure the member lengths one by one (longerons and diagonals, to a few µm) and run again with `--measured-members`: then they separate.",
-                code_list(&r.rivals, ", ")
-            ));
-        } else {
-            advice.push(format!(
-                "{at}: `{named}` cannot be told from {} with these data; what would separate them: {}.",
-                code_list(&r.rivals, ", "),
-                r.rivals
-                    .iter()
-                    .map(|n| format!(
-                        "from `{n}`, {}",
-                        separating_measurement(a, effect(d, n))
-                    ))
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            ));
-        }
-    }
-    match d.verdict {
-        Verdict::Named => advice.push(
-            "Run `updated-job.json` with mc-shard and mc-merge for the precision budget with the effects added.".into(),
-        ),
-        Verdict::None => advice.push(
-            "None needed: the baseline job's prediction stands for these trusses.".into(),
-        ),
-        Verdict::CannotTell => advice.push(format!(
-            "Measure more specimens: with {} the data cannot decide; about four times as many halve the intervals.",
-            measured.n()
-        )),
-        Verdict::Unexplained => advice.push(
-            "Look for a mechanism outside the candidates (a support that moves, a member bent or damaged, the instrument's own error): measure the supports and the instrument against a reference.".into(),
-        ),
-    }
-    if !measured.report.outliers.is_empty() {
-        advice.push("Check the outlier rows listed under Data against the instrument's records; they were left out.".into());
-    }
-    for a in advice {
-        push(m, &format!("- {a}"));
-    }
-    push(m, "");
 }
 
 /// The plots and `## Method`: how every number was found.
