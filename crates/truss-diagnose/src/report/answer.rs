@@ -18,6 +18,7 @@ use crate::comparison::measured::Measured;
 use crate::likelihood::score::FittedParameter;
 use crate::selection::Diagnosis;
 use crate::selection::decide::Verdict;
+use crate::selection::unseen::in_hardware_units as hardware;
 use serde::Serialize;
 
 /// The answer record (`diagnosis.json`'s `answer`).
@@ -78,15 +79,6 @@ pub struct CannotTellApart {
     pub rivals: Vec<String>,
     /// Per rival, the measurement that would separate them.
     pub separate_by: Vec<String>,
-}
-
-/// A value in the hardware's unit: mm as µm, others as they are.
-fn hardware(v: f64, unit: &'static str) -> (f64, &'static str) {
-    if unit == "mm" {
-        (v * truss_units::MICROMETRE_PER_MM, "µm")
-    } else {
-        (v, unit)
-    }
 }
 
 /// `v` to the second significant digit of `scale` (an interval's width: 0.68 µm gives

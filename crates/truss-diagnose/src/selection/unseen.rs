@@ -30,12 +30,17 @@ pub fn unseen(steps: &[Step], index: usize, named: &[&str], n: usize) -> Vec<Uns
 }
 
 /// A size with its unit, µm for mm, to two significant digits.
-fn size_text(v: f64, unit: &str) -> String {
-    let (v, unit) = if unit == "mm" {
+/// A value in the hardware's unit: a length in mm as µm, others as they are.
+pub(crate) fn in_hardware_units(v: f64, unit: &'static str) -> (f64, &'static str) {
+    if unit == "mm" {
         (v * truss_units::MICROMETRE_PER_MM, "µm")
     } else {
         (v, unit)
-    };
+    }
+}
+
+fn size_text(v: f64, unit: &'static str) -> String {
+    let (v, unit) = in_hardware_units(v, unit);
     let digits = if v > 0.0 {
         (1 - v.log10().floor() as i32).max(0) as usize
     } else {
