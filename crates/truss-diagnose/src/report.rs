@@ -71,10 +71,13 @@
 //!              detectable at any size within the plausible range), parameters[] {name,
 //!              unit, value (at the limit), size (|value − null|, the parameter's unit),
 //!              share_of_range, direction ("±", "+", "-"), information_per_specimen
-//!              [1/unit²]}} (one parameter at a time, the others at their null; size and
-//!              value null where not detectable within the range); or null where the fit
-//!              failed. Each of `candidates[]` (and the steps') carries the same as
-//!              `detection_limit` against its step's model
+//!              [1/unit²], naming_value, naming_size (the naming limit, below)}} (one
+//!              parameter at a time, the others at their null; size and value null where
+//!              not detectable within the range), naming_critical_value (q_name =
+//!              max(q, k·ln n + 2/λ̄): a step names only at ΔBIC ≤ −2), naming_noncentrality;
+//!              or null where the fit failed. Each of `candidates[]` (and the steps')
+//!              carries the same as `detection_limit` against its step's model, without
+//!              the naming fields
 //! parameters  [{name, unit, value, interval, wald_interval, joint_interval?, range, null,
 //!              determined}]
 //!              (the first named effect's, as fitted in its step; for an effect swapped in,
@@ -123,7 +126,8 @@
 //! ```
 //!
 //! Version 10 (from 9): `answer`, the answer the reports share; diagnosis.md opens with
-//! its lines and its `## Next step` section became the answer's `next` lines.
+//! its lines and its `## Next step` section became the answer's `next` lines; the naming
+//! limits in `unseen[].limit`.
 //!
 //! Version 9 (from 8): `indistinguishable_by_effect`; the `data.checks[]` warnings;
 //! `unseen` (detection limits) and `candidates[].detection_limit`. An

@@ -290,7 +290,13 @@ pub fn diagnose(
     };
     let indistinguishable = indistinguishable(&steps, &confounding);
     let final_seconds = clock.elapsed().as_secs_f64();
-    let unseen = unseen::unseen(&steps, last.map_or(0, |i| i + 1), &final_effects(&steps), n);
+    let unseen = unseen::unseen(
+        &steps,
+        last.map_or(0, |i| i + 1),
+        &final_effects(&steps),
+        n,
+        &library,
+    );
     let sims = ctx.simulations.get();
     let stages = ctx.stages.take();
     progress.note(&format!(

@@ -38,6 +38,18 @@
 //! unconstrained one, so χ²_k(λ) overstates the power and the stated limit is, if
 //! anything, too small: an effect below it is still not detected with 80 % power.
 
+//!
+//! ## Naming
+//!
+//! Significance is not all a step asks: it names a candidate only where its BIC is also
+//! clearly better, ΔBIC = λ̄·(k·ln n − Λ) ≤ −Δ (Δ = 2, `selection::decide`), i.e.
+//! Λ ≥ k·ln n + Δ/λ̄. Where that bound is above q (k ≥ 2, or many specimens), an effect at
+//! the detection limit is significant but not named. The *naming limit*
+//! ([`DetectionLimit::with_naming`]) is the same computation with q replaced by
+//! q_name = max(q, k·ln n + Δ/λ̄): the smallest effect the step would name with 80 % power
+//! (as the candidate tested alone; among rivals it must also be the best by BIC).
+//! Since δ ∝ √λ, it is the detection limit scaled by √(λ_name/λ₈₀).
+
 use crate::candidates::parameter::Parameter;
 use nalgebra::DMatrix;
 use serde::Serialize;
@@ -122,6 +134,29 @@ pub struct ParameterLimit {
     /// The observed information per specimen along it at the fit, Aⱼⱼ/(n·(dv/dt)²)
     /// \[1/unit²\] (dv/dt the map from the internal coordinate at the null).
     pub information_per_specimen: f64,
+    /// The naming limit's value and size ([`DetectionLimit::with_naming`]), where computed;
+    /// `None` inside the `Some` where not reachable within the plausible range.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub naming_value: Option<Option<f64>>,
+    /// \|naming_value − null\|.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub naming_size: Option<Option<f64>>,
+}
+
+/// The parameter `p` moved from its null by `delta` (internal coordinates), upwards where
+/// the range allows, else downwards; `None` where neither fits in the range.
+fn shifted(p: &Parameter, delta: Option<f64>) -> Option<f64> {
+    let t0 = p.internal(p.null);
+    let (up, down) = (t0 < 1.0 - 1e-12, t0 > 1e-12);
+    delta.and_then(|d| {
+        if up && t0 + d <= 1.0 {
+            Some(t0 + d)
+        } else if down && t0 - d >= 0.0 {
+            Some(t0 - d)
+        } else {
+            None
+        }
+    })
 }
 
 /// The smallest effects a candidate's test detects with 80 % power, one parameter at a time
@@ -144,7 +179,43 @@ pub struct DetectionLimit {
     pub parameters: Vec<ParameterLimit>,
     /// The parameter whose limit is the smallest share of its range, if any is detectable.
     pub most_visible: Option<usize>,
+    /// For the naming limit (module doc), where computed: q_name = max(q, k·ln n + Δ/λ̄).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub naming_critical_value: Option<f64>,
+    /// λ at which P(χ²_k(λ) > q_name) = 0.8.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub naming_noncentrality: Option<f64>,
 }
+
+impl DetectionLimit {
+    /// Adds the naming limit (module doc) of a candidate with `parameters` tested on `n`
+    /// specimens, where a step names only at ΔBIC ≤ −`delta_bic`: each parameter's limit
+    /// scaled by √(λ_name/λ₈₀).
+    pub fn with_naming(&mut self, parameters: &[Parameter], n: usize, delta_bic: f64) {
+        let k = self.parameters.len();
+        if k != parameters.len() || n < 2 {
+            return;
+        }
+        let bic = k as f64 * (n as f64).ln() + delta_bic / self.adjustment;
+        let q = self.critical_value.max(bic);
+        let lambda = if q > self.critical_value {
+            noncentrality_for_power(q, k, POWER)
+        } else {
+            self.noncentrality
+        };
+        let scale = (lambda / self.noncentrality).sqrt();
+        for (l, p) in self.parameters.iter_mut().zip(parameters) {
+            // δ of the detection limit (its share of the range), where found within it.
+            let t = shifted(p, l.share_of_range.map(|d| d * scale));
+            let value = t.map(|t| p.value(t));
+            l.naming_value = Some(value);
+            l.naming_size = Some(value.map(|v| (v - p.null).abs()));
+        }
+        self.naming_critical_value = Some(q);
+        self.naming_noncentrality = Some(lambda);
+    }
+}
+
 
 /// A candidate not in the final model and the smallest effect of it these data detect.
 #[derive(Debug, Clone, Serialize)]
@@ -199,15 +270,7 @@ pub fn detection_limit(
             let delta = (a > 0.0 && a.is_finite())
                 .then(|| (lambda * inflation * adjustment / a).sqrt())
                 .filter(|d| d.is_finite());
-            let t = delta.and_then(|d| {
-                if up && t0 + d <= 1.0 {
-                    Some(t0 + d)
-                } else if down && t0 - d >= 0.0 {
-                    Some(t0 - d)
-                } else {
-                    None
-                }
-            });
+            let t = shifted(p, delta);
             let value = t.map(|t| p.value(t));
             ParameterLimit {
                 name: p.name.clone(),
@@ -221,6 +284,8 @@ pub fn detection_limit(
                     _ => "-",
                 },
                 information_per_specimen: a / (n as f64 * slope * slope),
+                naming_value: None,
+                naming_size: None,
             }
         })
         .collect();
@@ -239,6 +304,8 @@ pub fn detection_limit(
         adjustment,
         parameters: limits,
         most_visible,
+        naming_critical_value: None,
+        naming_noncentrality: None,
     })
 }
 
@@ -359,5 +426,43 @@ mod tests {
         .unwrap();
         let by_hand = ((1.959_964f64 + 0.841_621).powi(2) * 1.05 * 1.2 / 4e4).sqrt() * 0.2;
         assert!((one.parameters[0].size.unwrap() - by_hand).abs() < 1e-5 * by_hand);
+    }
+
+    /// The naming limit by hand: one parameter, n = 100, λ̄ = 1.2: naming needs
+    /// Λ ≥ ln 100 + 2/1.2 = 6.272 > q = 3.841, so λ_name solves Φ(√λ − √6.272) = 0.8 (the
+    /// other tail is below 1e-8): √λ = 2.5044 + 0.8416, λ = 11.196, and the size is
+    /// √(11.196·1.05·1.2/4e4)·0.2 mm. With 3 specimens ln 3 + 2/1.2 = 2.77 < q: naming asks
+    /// nothing more. A clearance (one-sided) whose naming shift leaves the
+    /// range (its detection shift inside it) is not named at any size within it.
+    #[test]
+    fn naming_limits_by_hand() {
+        let bias = [Parameter::linear("bias", "mm", -0.1, 0.1, 0.0)];
+        let a = DMatrix::from_element(1, 1, 4e4);
+        let mut l = detection_limit(&bias, &a, 100, 0.05, 1.05, 1.2).unwrap();
+        l.with_naming(&bias, 100, 2.0);
+        let q = 100f64.ln() + 2.0 / 1.2;
+        assert!((l.naming_critical_value.unwrap() - q).abs() < 1e-12);
+        let by_hand = (q.sqrt() + 0.841_621).powi(2);
+        assert!((l.naming_noncentrality.unwrap() - by_hand).abs() < 1e-4, "{l:?}");
+        let size = (by_hand * 1.05 * 1.2 / 4e4).sqrt() * 0.2;
+        let named = l.parameters[0].naming_size.unwrap().unwrap();
+        assert!((named - size).abs() < 1e-5 * size, "{named} vs {size}");
+        // √(11.196/7.849) = 1.194 times the detection limit.
+        let ratio = named / l.parameters[0].size.unwrap();
+        let exact = (l.naming_noncentrality.unwrap() / l.noncentrality).sqrt();
+        assert!((ratio - exact).abs() < 1e-9 && ratio > 1.19, "{ratio} vs {exact}");
+        let mut few = detection_limit(&bias, &a, 3, 0.05, 1.05, 1.2).unwrap();
+        few.with_naming(&bias, 3, 2.0);
+        assert_eq!(few.naming_critical_value, Some(few.critical_value));
+        assert_eq!(few.parameters[0].naming_size, Some(few.parameters[0].size));
+        // With A = 12.2 the detection shift √(7.849·1.26/12.2) = 0.900 of the range fits,
+        // the naming one 1.194 times that does not.
+        let clearance = [Parameter::linear("clearance", "mm", 0.0, 0.05, 0.0)];
+        let soft = DMatrix::from_element(1, 1, 12.2);
+        let mut c = detection_limit(&clearance, &soft, 100, 0.05, 1.05, 1.2).unwrap();
+        c.with_naming(&clearance, 100, 2.0);
+        let p = &c.parameters[0];
+        assert!(p.size.is_some(), "{p:?}");
+        assert_eq!(p.naming_value, Some(None), "{p:?}");
     }
 }

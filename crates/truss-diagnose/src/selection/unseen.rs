@@ -6,12 +6,20 @@
 
 use crate::candidates::candidate::Candidate;
 use crate::likelihood::power::Unseen;
+use crate::selection::decide::DELTA_BIC;
 use crate::selection::step::Step;
 
 /// The candidates of `steps[index]` (the step after the last kept one) not named in the
-/// final model `named`, with their limits; none when no step tested against the final
-/// model (no candidate was left).
-pub fn unseen(steps: &[Step], index: usize, named: &[&str], n: usize) -> Vec<Unseen> {
+/// final model `named`, with their limits and naming limits (the step names only at
+/// ΔBIC ≤ −[`DELTA_BIC`]); none when no step tested against the final model (no
+/// candidate was left). `library` holds every candidate.
+pub fn unseen(
+    steps: &[Step],
+    index: usize,
+    named: &[&str],
+    n: usize,
+    library: &[Box<dyn Candidate>],
+) -> Vec<Unseen> {
     let Some(step) = steps.get(index) else {
         return Vec::new();
     };
@@ -24,7 +32,12 @@ pub fn unseen(steps: &[Step], index: usize, named: &[&str], n: usize) -> Vec<Uns
             significant: c.significant,
             p_value: c.p_value,
             specimens: n,
-            limit: c.detection_limit.clone(),
+            limit: c.detection_limit.clone().map(|mut l| {
+                if let Some(k) = library.iter().find(|k| k.name() == c.name) {
+                    l.with_naming(k.parameters(), n, DELTA_BIC);
+                }
+                l
+            }),
         })
         .collect()
 }
@@ -49,10 +62,14 @@ fn size_text(v: f64, unit: &'static str) -> String {
     format!("{v:.digits$} {unit}")
 }
 
+/// A naming limit is said where it exceeds the detection limit by more than this factor.
+const NAMING_SAYS: f64 = 1.05;
+
 impl Unseen {
     /// The limit of the candidate's most visible parameter in words: `` `length_bias`
-    /// bias.longeron below 1.8 µm `` (a scale as its factor), or that it is not detectable
-    /// at any size within the plausible range; `c` is the candidate.
+    /// bias.longeron below 1.8 µm `` (a scale as its factor), then its naming limit where
+    /// that is more than [`NAMING_SAYS`] times larger (` (named only from 2.3 µm)`), or that it
+    /// is not detectable at any size within the plausible range; `c` is the candidate.
     pub fn words(&self, c: &dyn Candidate) -> String {
         let Some(limit) = &self.limit else {
             return format!("`{}`: no limit (its fit failed)", self.name);
@@ -75,8 +92,20 @@ impl Unseen {
         } else {
             format!("below {}", size_text(size, q.unit))
         };
+        // The naming limit, where naming asks clearly more than significance (its BIC).
+        let naming = match (p.naming_value, p.naming_size) {
+            (Some(Some(v)), Some(Some(d))) if d > NAMING_SAYS * size => {
+                if q.log {
+                    format!(" (named only from a factor {:.2})", v / q.null)
+                } else {
+                    format!(" (named only from {})", size_text(d, q.unit))
+                }
+            }
+            (Some(None), _) => " (not named at any size within its plausible range)".into(),
+            _ => String::new(),
+        };
         format!(
-            "`{}` {} {amount}{}",
+            "`{}` {} {amount}{naming}{}",
             self.name,
             p.name,
             if self.significant {
