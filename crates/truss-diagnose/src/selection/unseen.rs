@@ -68,7 +68,8 @@ const NAMING_SAYS: f64 = 1.05;
 impl Unseen {
     /// The limit of the candidate's most visible parameter in words: `` `length_bias`
     /// bias.longeron below 1.8 µm `` (a scale as its factor), then its naming limit where
-    /// that is more than [`NAMING_SAYS`] times larger (` (named only from 2.3 µm)`), or that it
+    /// that is more than [`NAMING_SAYS`] times larger and reads differently
+    /// (` (named only from 2.3 µm)`), or that it
     /// is not detectable at any size within the plausible range; `c` is the candidate.
     pub fn words(&self, c: &dyn Candidate) -> String {
         let Some(limit) = &self.limit else {
@@ -94,7 +95,9 @@ impl Unseen {
         };
         // The naming limit, where naming asks clearly more than significance (its BIC).
         let naming = match (p.naming_value, p.naming_size) {
-            (Some(Some(v)), Some(Some(d))) if d > NAMING_SAYS * size => {
+            (Some(Some(v)), Some(Some(d)))
+                if d > NAMING_SAYS * size && size_text(d, q.unit) != size_text(size, q.unit) =>
+            {
                 if q.log {
                     format!(" (named only from a factor {:.2})", v / q.null)
                 } else {
