@@ -34,14 +34,23 @@
 # is that effect's step fit, the same fit and interval as `true` gives (seed 1001 of all
 # three cases: the same intervals to the last digit).
 #
-# Simulation seed (SIM_SEED): `job` (the default) diagnoses every data set with the job's
-# own seed, as a user's run does: every run then shares one realisation of the
-# simulation's Monte-Carlo error in μ and Σ (N samples), which shifts every estimate
-# alike, so the coverage measured is conditional on that realisation. `vary` diagnoses
-# each data set with a copy of the job whose seed is 20210325 + the data seed (written to
-# WORKDIR/job-SEED.json): the simulation's error then varies from run to run as the data's
-# does, and the coverage measured is the marginal one the intervals claim (their
-# inflation c = 1 + n/N treats that error as random).
+# Simulation seed (SIM_SEED): `vary` (the default) diagnoses each data set with a copy of
+# the job whose seed is 20210325 + the data seed (written to WORKDIR/job-SEED.json): each
+# run is then an independent repetition of the whole experiment, new specimens and a new
+# simulation, which is what a 95 % interval's coverage is a claim about (the intervals'
+# inflation c = 1 + n/N treats the simulation's Monte-Carlo error in μ and Σ as random)
+# and what makes the runs independent, as the binomial interval assumes. `job` diagnoses
+# every data set with the job's own seed: every run then shares one realisation of that
+# error, which shifts every estimate alike, so the coverage measured is conditional on it
+# and the runs are not independent trials. Measured (100 specimens, N = 2000, 40 seeds,
+# true candidate only): with `job`, bias.longeron and length_error cover 35/40 with mean
+# z +0.41 and +0.37 (this job's seed sits about 0.5 standard errors off for these
+# parameters: 24 other job seeds on one data set spread its estimate by 0.30 SE, as
+# c = 1 + n/N allows); with `vary` every key parameter covers 38–39/40, and
+# length_error 119/120 over 120 seeds. A default chosen after that run (it was `job`
+# first): the check was not loosened, its trials were made independent. `job` stays
+# available for the conditional question (one user's seed; --samples 10000 brings it
+# to 36–38/40 at 3.7 times the time).
 #
 # The rule, fixed before the results were seen: a parameter PASSES if its coverage point
 # estimate, covered / runs, is at least 0.90 (the issue's target; at 40 runs, 36 covered);
@@ -58,7 +67,7 @@
 # Usage (from the repo root or anywhere): scripts/diagnose-coverage.sh [WORKDIR]
 #   SEEDS="1001 … 1040", SPECIMENS=N (default 100), CASES="bias thermal pretension" (a
 #   subset), CANDIDATES=true|all|LIST (above), SAMPLES=N (diagnose's --samples; default its
-#   own), SIM_SEED=job|vary (above), TRUSS=PATH (a built `truss` binary to check, instead
+#   own), SIM_SEED=vary|job (above), TRUSS=PATH (a built `truss` binary to check, instead
 #   of building the release one).
 #   Every run's data (CASE-SEED.csv), its diagnosis (CASE-SEED/diagnosis.json) and stderr
 #   stay in WORKDIR (default a mktemp dir); runs.tsv there has one line per run and
@@ -79,7 +88,7 @@ N="${SPECIMENS:-100}"
 SEEDS="${SEEDS:-$(seq -s ' ' 1001 1040)}"
 CASES="${CASES:-bias thermal pretension}"
 CANDIDATES="${CANDIDATES:-true}"
-SIM_SEED="${SIM_SEED:-job}"
+SIM_SEED="${SIM_SEED:-vary}"
 [[ $SIM_SEED == job || $SIM_SEED == vary ]] || { echo "SIM_SEED is job or vary" >&2; exit 4; }
 SAMPLES="${SAMPLES:-}"
 B="as-built"
