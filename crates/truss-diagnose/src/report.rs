@@ -134,7 +134,12 @@
 //! effect swapped in (never named by a step) now has its rivals too: those removed because
 //! it took over and those confounded with it, which were before in `confounding[]` and the
 //! markdown but in no `indistinguishable` field; `steps[].indistinguishable` and the
-//! top-level one read the record.
+//! top-level one read the record. The `gravity` candidate's `g_x`, `g_y`, `g_z` are each
+//! fitted within their range \[−1, 1\] g and free of one another (before: within
+//! \|g\| ≤ 1): the shape is unchanged, but a fit's \|g\| may exceed 1, and an interval
+//! end that reaches ±1 is flagged at the range end where the ball cut it unflagged. A
+//! parameter the final fit leaves not `determined` is never in `confounding[].parameters`
+//! (a rival that moves only such parameters is not listed).
 //!
 //! Version 8 (from 7): `confounding[].along_ridge`; a rival that moves nothing at the joint
 //! maximum is listed where the ridge probe finds a fit as good as the model's with an

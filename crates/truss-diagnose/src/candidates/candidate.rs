@@ -47,7 +47,7 @@ pub trait Candidate: Send + Sync {
     /// Applies the effect with `values` (one per parameter) to the case.
     fn apply(&self, values: &[f64], edit: &mut CaseEdit) -> Result<(), DiagnoseError>;
     /// Moves `values` onto the feasible set if the box alone does not describe it
-    /// (gravity's \|g\| ≤ 1), leaving `values[fixed]` where it is if `fixed` is given (a
+    /// (backlash's spread no larger than its mean clearance), leaving `values[fixed]` where it is if `fixed` is given (a
     /// profile holds that parameter); the default does nothing.
     fn project(&self, _values: &mut [f64], _fixed: Option<usize>) {}
     /// Parameter `j` at `value` in plain words: what it means for the hardware; `span` is

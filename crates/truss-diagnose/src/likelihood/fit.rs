@@ -423,7 +423,7 @@ mod tests {
     }
 
     /// A maximum on a curved constraint: ℓ = −(x − 1)²/(2·0.01²) − (y − 0.7)²/(2·0.2²) on
-    /// the disc |t − (½, ½)| ≤ ½ (gravity's ball in internal coordinates), started on the
+    /// the disc |t − (½, ½)| ≤ ½ (a curved feasible set in internal coordinates), started on the
     /// circle at (1, ½), where the unconstrained step points out of the disc. The method
     /// slides along the circle to the constrained maximum, found here by a fine scan of the
     /// angle (the reference).

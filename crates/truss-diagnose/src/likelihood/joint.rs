@@ -172,9 +172,9 @@ mod tests {
     use super::*;
 
     /// Several effects as one: their parameters in order, cut back by `split`; applying the
-    /// combination is applying each in turn; each part projects its own slice (gravity's
-    /// |g| ≤ 1 on its three, the temperature field's left alone), a held parameter indexed
-    /// within the whole.
+    /// combination is applying each in turn; each part projects its own slice (backlash's
+    /// spread held to its mean clearance, the temperature field's left alone), a held
+    /// parameter indexed within the whole.
     #[test]
     fn combined_effects_apply_in_turn() {
         let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -202,11 +202,14 @@ mod tests {
         thermal.apply(&parts[1], &mut each).unwrap();
         assert_eq!(one, each);
         assert_ne!(one, baseline.derived_case());
-        // |g|² = 0.36 + 2.56 with g_y held at 0.6: g_z scaled to √(1 − 0.36) = 0.8.
-        let mut v = [0.0, 0.6, 1.6, 0.001, 0.0, 0.0, 2.0];
-        combined.project(&mut v, Some(1));
-        assert_eq!(v[1], 0.6, "held");
-        assert!((v[2] - 0.8).abs() < 1e-12, "{v:?}");
-        assert_eq!(v[3..], values[3..]);
+        // Backlash after the field: its spread 0.006 above its mean 0.004 is held to the
+        // mean, or with the spread held (index 5 of the whole) the mean raised to it.
+        let combined = Combined::new(vec![thermal, pick("backlash")]);
+        let mut v = [0.001, 0.0, 0.0, 2.0, 0.004, 0.006];
+        combined.project(&mut v, None);
+        assert_eq!(v, [0.001, 0.0, 0.0, 2.0, 0.004, 0.004]);
+        let mut v = [0.001, 0.0, 0.0, 2.0, 0.004, 0.006];
+        combined.project(&mut v, Some(5));
+        assert_eq!(v, [0.001, 0.0, 0.0, 2.0, 0.006, 0.006]);
     }
 }

@@ -3,7 +3,7 @@
 //! ## Definition
 //!
 //! For parameter `j` the profile log-likelihood `ℓ_p(θⱼ)` is the maximum of ℓ over the other
-//! parameters (on their feasible set, e.g. \|g\| ≤ 1 for gravity) with `θⱼ` held, and its
+//! parameters (on their feasible set, e.g. backlash's spread no larger than its mean) with `θⱼ` held, and its
 //! 95 % interval is the set of values where
 //!
 //! ```text
@@ -30,12 +30,16 @@
 //! the joint 95 % region `{θ : 2(ℓ̂ − ℓ(θ)) ≤ q_k = χ²_k(0.95)·c·λ̄}` is projected on each
 //! parameter: its joint interval is the same profile computation with the threshold `q_k`
 //! (`λ̄` the test's own), and every parameter of a θ in the region lies in its joint
-//! interval. The projection stays valid where the truth is on the edge of the plausible
-//! range (gravity's \|g\| = 1), where a single parameter's profile is not: holding g_x at ±1
-//! leaves the other two no room, so `D(±1)` is the joint statistic of all three, distributed
-//! (the ball locally a half-space) as ½χ²₂ + ½χ²₃ (Self & Liang 1987), which exceeds
-//! χ²₁(0.95) = 3.84 with probability ½·0.147 + ½·0.279 ≈ 0.21 but χ²₃(0.95) = 7.81 with
-//! ½·0.020 + ½·0.050 ≈ 0.035.
+//! interval. The projection stays valid where the truth is on the edge of a feasible set
+//! that couples the parameters, where a single parameter's profile is not: under a ball
+//! \|θ\| ≤ 1 of three, holding θ₁ at ±1 leaves the other two no room, so `D(±1)` is the
+//! joint statistic of all three, distributed (the ball locally a half-space) as
+//! ½χ²₂ + ½χ²₃ (Self & Liang 1987), which exceeds χ²₁(0.95) = 3.84 with probability
+//! ½·0.147 + ½·0.279 ≈ 0.21 but χ²₃(0.95) = 7.81 with ½·0.020 + ½·0.050 ≈ 0.035. (That was
+//! gravity's \|g\| ≤ 1; its components are now free in their box,
+//! [`crate::candidates::gravity`].) At the end of a box, which holds one parameter only,
+//! `D` is ½χ²₀ + ½χ²₁ and the threshold χ²₁(0.95) errs on the safe side (exceeded with
+//! probability 0.025).
 //!
 //! ## Computation
 //!

@@ -64,7 +64,7 @@ impl FittedParameter {
     /// open: the larger of its interval's and its Wald interval's [`coverage`]. The Wald
     /// interval is the likelihood's own curvature, without the feasible set: where a
     /// profile's ends are set by a constraint that couples the parameter to others
-    /// (gravity's \|g\| ≤ 1 holding g_z small because g_x and g_y are large), the interval
+    /// (backlash's spread held below a small mean clearance), the interval
     /// is narrow while the data say nothing of the parameter itself. A Wald interval with an
     /// end not found (the curvature not positive definite, as at a fit on the range's edge:
     /// backlash's spread at 0) says nothing either way, and the interval decides alone
@@ -624,7 +624,7 @@ mod tests {
     /// A profile interval of 0.11 µm out of a 0.05 mm range is determined, also where the
     /// Wald interval was not found (a backlash fit with its spread at 0: the curvature not
     /// positive definite); a Wald interval over most of the range makes it undetermined
-    /// (gravity's g_z held small by |g| ≤ 1); with neither interval found, nothing is.
+    /// (a parameter held small by a constraint); with neither interval found, nothing is.
     #[test]
     fn an_unfound_wald_interval_leaves_the_decision_to_the_profile() {
         let p = Parameter::linear("clearance", "mm", 0.0, 0.05, 0.0);

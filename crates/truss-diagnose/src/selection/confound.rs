@@ -51,7 +51,13 @@
 //! widens every interval it shares a direction with, however little of the signal it
 //! explains (a temperature field of four parameters, far from significant, widened a
 //! backlash model's diagonal scatter and pretension four-fold on data with no temperature
-//! change). A rival with no confounded parameter is not listed, whatever its test: either
+//! change). A parameter the final fit leaves *not determined* is never confounded: it has
+//! no reading for a rival to take over, and its interval, half its range or more, is
+//! mostly where the data leave it free, not what it explained (gravity's axial g_z, free
+//! since gravity has no \|g\| ≤ 1, moved from −0.04 to −0.83 g in its [−0.69, 0.60] with a
+//! temperature field whose offset lengthens the columns as an axial self-weight shortens
+//! them, on data with self-weight along x alone, and gravity was listed as confounded with
+//! the field, p = 0.65). A rival with no confounded parameter is not listed, whatever its test: either
 //! it explains nothing the model does not (a rival the model already excludes), or what it
 //! adds is separate from the model's effects, and the selection's own steps judge it.
 //!
@@ -629,12 +635,16 @@ fn listed(confounded: &[ConfoundedParameter], significant: bool, gain: f64) -> b
 }
 
 /// Whether parameter `q`, fitted as `now` in the final model and as `with` with a rival
-/// added, is confounded with the rival (module doc).
+/// added, is confounded with the rival (module doc); never where the final fit leaves it
+/// not determined (it has no reading for the rival to take over).
 fn confounded(
     q: &Parameter,
     now: &FittedParameter,
     with: &FittedParameter,
 ) -> Option<ConfoundedParameter> {
+    if !now.determined {
+        return None;
+    }
     let i = &now.interval;
     let moved = i.lower.is_some_and(|l| with.value < l) || i.upper.is_some_and(|u| with.value > u);
     // On the fit's scale; none where an end is missing (the curvature not positive
@@ -684,8 +694,9 @@ mod tests {
     /// A parameter is confounded with a rival when the rival moves it out of its interval
     /// (−0.28 K in [−0.4, −0.16] moved to 0.01 K), or widens its Wald interval by 2 or more
     /// (0.24 K wide to 0.5 K: 2.08); a move within the interval that widens it by 1.5 is
-    /// not. The rival is listed for a move whatever its own test, for a widening only when
-    /// it is significant given the model, and never without a confounded parameter.
+    /// not, nor is a parameter not determined, however far it moves. The rival is listed for
+    /// a move whatever its own test, for a widening only when it is significant given the
+    /// model, and never without a confounded parameter.
     #[test]
     fn moved_or_widened_is_confounded_and_a_widening_lists_only_a_significant_rival() {
         let q = Parameter::linear("offset", "K", -20.0, 20.0, 0.0);
@@ -698,6 +709,12 @@ mod tests {
             "{wide:?}"
         );
         assert!(confounded(&q, &now, &fitted(-0.25, (-0.43, -0.07), (-0.43, -0.07))).is_none());
+        // The same move of a parameter the final fit leaves not determined: none.
+        let open = FittedParameter {
+            determined: false,
+            ..now.clone()
+        };
+        assert!(confounded(&q, &open, &fitted(0.01, (-0.1, 0.12), (-0.1, 0.12))).is_none());
         assert!(listed(std::slice::from_ref(&moved), false, 0.0));
         assert!(listed(&[wide.clone(), moved], false, 3.0));
         assert!(listed(std::slice::from_ref(&wide), true, 9.0));
