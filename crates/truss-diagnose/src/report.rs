@@ -127,19 +127,19 @@
 //!
 //! Version 10 (from 9): `answer`, the answer the reports share; diagnosis.md opens with
 //! its lines and its `## Next step` section became the answer's `next` lines; the naming
-//! limits in `unseen[].limit`.
+//! limits in `unseen[].limit`. The `gravity` candidate's `g_x`, `g_y`, `g_z` are each
+//! fitted within their range \[−1, 1\] g and free of one another (before: within
+//! \|g\| ≤ 1): the shape is unchanged, but a fit's \|g\| may exceed 1, and an interval
+//! end that reaches ±1 is flagged at the range end where the ball cut it unflagged. A
+//! parameter the final fit leaves not `determined` is never in `confounding[].parameters`
+//! (a rival that moves only such parameters is not listed).
 //!
 //! Version 9 (from 8): `indistinguishable_by_effect`; the `data.checks[]` warnings;
 //! `unseen` (detection limits) and `candidates[].detection_limit`. An
 //! effect swapped in (never named by a step) now has its rivals too: those removed because
 //! it took over and those confounded with it, which were before in `confounding[]` and the
 //! markdown but in no `indistinguishable` field; `steps[].indistinguishable` and the
-//! top-level one read the record. The `gravity` candidate's `g_x`, `g_y`, `g_z` are each
-//! fitted within their range \[−1, 1\] g and free of one another (before: within
-//! \|g\| ≤ 1): the shape is unchanged, but a fit's \|g\| may exceed 1, and an interval
-//! end that reaches ±1 is flagged at the range end where the ball cut it unflagged. A
-//! parameter the final fit leaves not `determined` is never in `confounding[].parameters`
-//! (a rival that moves only such parameters is not listed).
+//! top-level one read the record.
 //!
 //! Version 8 (from 7): `confounding[].along_ridge`; a rival that moves nothing at the joint
 //! maximum is listed where the ridge probe finds a fit as good as the model's with an

@@ -89,10 +89,17 @@ impl Candidate for Gravity {
         edit.set_effects(&effects);
         Ok(())
     }
+    /// To two decimals, or two significant digits below 0.1 g (a detection limit of
+    /// 1.9e-5 g read "0.00 g").
     fn reading(&self, j: usize, v: f64, _span: [f64; 3]) -> String {
+        let a = v.abs();
+        let digits = if a > 0.0 && a < 0.1 {
+            (1 - a.log10().floor() as i32) as usize
+        } else {
+            2
+        };
         format!(
-            "self-weight of {:.2} g along {}{} (a ground test's gravity direction)",
-            v.abs(),
+            "self-weight of {a:.digits$} g along {}{} (a ground test's gravity direction)",
             if v >= 0.0 { "+" } else { "−" },
             ["x", "y", "z"][j]
         )
@@ -109,6 +116,14 @@ impl Candidate for Gravity {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The reading keeps two significant digits of a small self-weight.
+    #[test]
+    fn small_self_weights_read_to_two_digits() {
+        let g = Gravity::new();
+        assert!(g.reading(0, 1.9e-5, [0.0; 3]).starts_with("self-weight of 0.000019 g along +x"));
+        assert!(g.reading(2, -0.707, [0.0; 3]).starts_with("self-weight of 0.71 g along −z"));
+    }
     use crate::comparison::baseline::Baseline;
 
     /// The components are free of one another: a self-weight vector outside the unit ball
