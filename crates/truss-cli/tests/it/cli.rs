@@ -270,7 +270,11 @@ fn the_three_reports_give_one_answer(d: &serde_json::Value, stdout: &str, report
     let named: Vec<&serde_json::Value> = missing.iter().map(|m| &m["effect"]).collect();
     assert_eq!(
         named,
-        d["named_effects"].as_array().unwrap().iter().collect::<Vec<_>>()
+        d["named_effects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .collect::<Vec<_>>()
     );
     for (m, f) in missing.iter().zip(d["final_fit"].as_array().unwrap()) {
         for (a, p) in m["parameters"]
@@ -286,7 +290,10 @@ fn the_three_reports_give_one_answer(d: &serde_json::Value, stdout: &str, report
             assert!(lines[1].contains(name), "{name} missing from {}", lines[1]);
         }
     }
-    assert!(lines.iter().any(|l| l.starts_with("- **Next:** ")), "{lines:?}");
+    assert!(
+        lines.iter().any(|l| l.starts_with("- **Next:** ")),
+        "{lines:?}"
+    );
 }
 
 /// A bad row is an invalid-data error (exit 3) naming the file and line.

@@ -121,8 +121,14 @@ mod tests {
     #[test]
     fn small_self_weights_read_to_two_digits() {
         let g = Gravity::new();
-        assert!(g.reading(0, 1.9e-5, [0.0; 3]).starts_with("self-weight of 0.000019 g along +x"));
-        assert!(g.reading(2, -0.707, [0.0; 3]).starts_with("self-weight of 0.71 g along −z"));
+        assert!(
+            g.reading(0, 1.9e-5, [0.0; 3])
+                .starts_with("self-weight of 0.000019 g along +x")
+        );
+        assert!(
+            g.reading(2, -0.707, [0.0; 3])
+                .starts_with("self-weight of 0.71 g along −z")
+        );
     }
     use crate::comparison::baseline::Baseline;
 

@@ -216,7 +216,6 @@ impl DetectionLimit {
     }
 }
 
-
 /// A candidate not in the final model and the smallest effect of it these data detect.
 #[derive(Debug, Clone, Serialize)]
 pub struct Unseen {
@@ -443,14 +442,20 @@ mod tests {
         let q = 100f64.ln() + 2.0 / 1.2;
         assert!((l.naming_critical_value.unwrap() - q).abs() < 1e-12);
         let by_hand = (q.sqrt() + 0.841_621).powi(2);
-        assert!((l.naming_noncentrality.unwrap() - by_hand).abs() < 1e-4, "{l:?}");
+        assert!(
+            (l.naming_noncentrality.unwrap() - by_hand).abs() < 1e-4,
+            "{l:?}"
+        );
         let size = (by_hand * 1.05 * 1.2 / 4e4).sqrt() * 0.2;
         let named = l.parameters[0].naming_size.unwrap().unwrap();
         assert!((named - size).abs() < 1e-5 * size, "{named} vs {size}");
         // √(11.196/7.849) = 1.194 times the detection limit.
         let ratio = named / l.parameters[0].size.unwrap();
         let exact = (l.naming_noncentrality.unwrap() / l.noncentrality).sqrt();
-        assert!((ratio - exact).abs() < 1e-9 && ratio > 1.19, "{ratio} vs {exact}");
+        assert!(
+            (ratio - exact).abs() < 1e-9 && ratio > 1.19,
+            "{ratio} vs {exact}"
+        );
         let mut few = detection_limit(&bias, &a, 3, 0.05, 1.05, 1.2).unwrap();
         few.with_naming(&bias, 3, 2.0);
         assert_eq!(few.naming_critical_value, Some(few.critical_value));

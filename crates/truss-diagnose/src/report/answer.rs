@@ -91,7 +91,10 @@ fn number(v: f64, scale: f64) -> String {
     };
     let s = format!("{v:.digits$}");
     // No "-0.0".
-    if s.trim_start_matches('-').chars().all(|c| c == '0' || c == '.') {
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
         s.trim_start_matches('-').to_string()
     } else {
         s.replace('-', "−")
@@ -104,8 +107,8 @@ impl Size {
         let end = |v: Option<f64>| v.map(|v| hardware(v, p.unit).0);
         let (lower, upper) = (end(p.interval.lower), end(p.interval.upper));
         let null = hardware(p.null, p.unit).0;
-        let shown = p.determined
-            && (lower.is_some_and(|l| l > null) || upper.is_some_and(|u| u < null));
+        let shown =
+            p.determined && (lower.is_some_and(|l| l > null) || upper.is_some_and(|u| u < null));
         Self {
             name: p.name.clone(),
             unit,
@@ -134,7 +137,11 @@ impl Size {
             self.unit,
             end(self.lower),
             end(self.upper),
-            if self.shown { "" } else { ", consistent with none" }
+            if self.shown {
+                ""
+            } else {
+                ", consistent with none"
+            }
         )
     }
 }
@@ -364,7 +371,13 @@ mod tests {
         assert_eq!(s.words(), "bias.longeron 2.04 K (95 % CI 1.91 to 2.17)");
         let mut p = parameter("g", 0.5, -1.0, 1.0);
         p.determined = false;
-        assert_eq!(Size::of(&p).words(), "bias.longeron not determined by these data");
-        assert_eq!((number(-0.04, 1.0), number(-1.26, 1.0)), ("0.0".into(), "−1.3".into()));
+        assert_eq!(
+            Size::of(&p).words(),
+            "bias.longeron not determined by these data"
+        );
+        assert_eq!(
+            (number(-0.04, 1.0), number(-1.26, 1.0)),
+            ("0.0".into(), "−1.3".into())
+        );
     }
 }
