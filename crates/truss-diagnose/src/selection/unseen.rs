@@ -63,7 +63,7 @@ fn size_text(v: f64, unit: &'static str) -> String {
 }
 
 /// A naming limit is said where it exceeds the detection limit by more than this factor.
-const NAMING_SAYS: f64 = 1.05;
+pub const NAMING_SAYS: f64 = 1.05;
 
 impl Unseen {
     /// The limit of the candidate's most visible parameter in words: `` `length_bias`
