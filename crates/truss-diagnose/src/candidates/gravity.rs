@@ -32,7 +32,7 @@
 //! the three components, and may exceed 1.
 
 use super::candidate::{Candidate, Registration, Trace};
-use super::parameter::Parameter;
+use super::parameter::{Parameter, two_digit_decimals};
 use crate::comparison::baseline::CaseEdit;
 use crate::errors::DiagnoseError;
 use truss_job::effects::{ALUMINIUM_DENSITY, GravitySpec, STANDARD_GRAVITY};
@@ -93,8 +93,8 @@ impl Candidate for Gravity {
     /// 1.9e-5 g read "0.00 g").
     fn reading(&self, j: usize, v: f64, _span: [f64; 3]) -> String {
         let a = v.abs();
-        let digits = if a > 0.0 && a < 0.1 {
-            (1 - a.log10().floor() as i32) as usize
+        let digits = if a < 0.1 {
+            two_digit_decimals(a).unwrap_or(2)
         } else {
             2
         };
@@ -116,6 +116,7 @@ impl Candidate for Gravity {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::comparison::baseline::Baseline;
 
     /// The reading keeps two significant digits of a small self-weight.
     #[test]
@@ -130,7 +131,6 @@ mod tests {
                 .starts_with("self-weight of 0.71 g along −z")
         );
     }
-    use crate::comparison::baseline::Baseline;
 
     /// The components are free of one another: a self-weight vector outside the unit ball
     /// (0.6, 0.8, 0.6) g, \|g\| = √1.36 = 1.166 19, is left where it is, held component or

@@ -1,6 +1,13 @@
 //! One parameter of a candidate effect and its plausible range, with the map onto the unit
 //! interval on which the fits work (linear, or logarithmic for a scale).
 
+/// The decimals that show a positive finite `v` to two significant digits (0.0183 → 3,
+/// 18.3 → 0, never fewer than 0); `None` for zero, a negative or a non-finite `v`. The
+/// reports' sizes and readings round with it.
+pub(crate) fn two_digit_decimals(v: f64) -> Option<usize> {
+    (v > 0.0 && v.is_finite()).then(|| (1 - v.log10().floor() as i32).max(0) as usize)
+}
+
 /// One parameter of a candidate and its plausible range.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Parameter {

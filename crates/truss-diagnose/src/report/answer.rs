@@ -14,6 +14,7 @@
 
 use super::wording::{code_list, effect};
 use crate::candidates::candidate::{Candidate, separating_measurement};
+use crate::candidates::parameter::two_digit_decimals;
 use crate::comparison::measured::Measured;
 use crate::likelihood::score::FittedParameter;
 use crate::selection::Diagnosis;
@@ -84,11 +85,7 @@ pub struct CannotTellApart {
 /// `v` to the second significant digit of `scale` (an interval's width: 0.68 µm gives
 /// 0.01 µm), with a true minus sign and no "−0".
 fn number(v: f64, scale: f64) -> String {
-    let digits = if scale > 0.0 && scale.is_finite() {
-        (1 - scale.log10().floor() as i32).clamp(0, 9) as usize
-    } else {
-        2
-    };
+    let digits = two_digit_decimals(scale).map_or(2, |d| d.min(9));
     let s = format!("{v:.digits$}");
     // No "-0.0".
     if s.trim_start_matches('-')

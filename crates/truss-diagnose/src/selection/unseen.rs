@@ -5,6 +5,7 @@
 //! kept.
 
 use crate::candidates::candidate::Candidate;
+use crate::candidates::parameter::two_digit_decimals;
 use crate::likelihood::power::Unseen;
 use crate::selection::decide::DELTA_BIC;
 use crate::selection::step::Step;
@@ -54,11 +55,7 @@ pub(crate) fn in_hardware_units(v: f64, unit: &'static str) -> (f64, &'static st
 
 fn size_text(v: f64, unit: &'static str) -> String {
     let (v, unit) = in_hardware_units(v, unit);
-    let digits = if v > 0.0 {
-        (1 - v.log10().floor() as i32).max(0) as usize
-    } else {
-        0
-    };
+    let digits = two_digit_decimals(v).unwrap_or(0);
     format!("{v:.digits$} {unit}")
 }
 
