@@ -147,6 +147,35 @@ pub fn derivatives(
     f: &mut Objective,
     evaluations: &mut usize,
 ) -> Result<Derivatives, DiagnoseError> {
+    stencil(t, f_t, steps, clusters, None, f, evaluations)
+}
+
+/// [`derivatives`] without the mixed second differences: the gradient, the diagonal of the
+/// Hessian and `B` from the central stencil alone (`1 + 2k` evaluations when no step
+/// changes), the Hessian's off-diagonal entries taken from `cross` (a quasi-Newton
+/// estimate, [`crate::likelihood::fit`]).
+pub fn derivatives_along_axes(
+    t: &[f64],
+    f_t: &Terms,
+    steps: &[f64],
+    clusters: Option<&[usize]>,
+    cross: &DMatrix<f64>,
+    f: &mut Objective,
+    evaluations: &mut usize,
+) -> Result<Derivatives, DiagnoseError> {
+    stencil(t, f_t, steps, clusters, Some(cross), f, evaluations)
+}
+
+/// The stencil of the module doc; the mixed differences from `cross` where it is given.
+fn stencil(
+    t: &[f64],
+    f_t: &Terms,
+    steps: &[f64],
+    clusters: Option<&[usize]>,
+    cross: Option<&DMatrix<f64>>,
+    f: &mut Objective,
+    evaluations: &mut usize,
+) -> Result<Derivatives, DiagnoseError> {
     let k = t.len();
     let mut memo = Memo {
         f,
@@ -181,6 +210,11 @@ pub fn derivatives(
     }
     for i in 0..k {
         for j in 0..i {
+            if let Some(cross) = cross {
+                hess[(i, j)] = cross[(i, j)];
+                hess[(j, i)] = cross[(i, j)];
+                continue;
+            }
             let mut p = centre.clone();
             p[i] += h[i];
             p[j] += h[j];
