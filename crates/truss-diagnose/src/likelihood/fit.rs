@@ -17,9 +17,11 @@
 //! the central stencil, which give the gradient and the diagonal. So after a successful step
 //! only the central stencil is evaluated ([`derivatives_along_axes`]) and the mixed entries
 //! are updated from the change of gradient across the step (symmetric rank one, `sr1_mixed`).
-//! The full Hessian is measured again where the updated model fails (a step that loses ℓ),
-//! where it promises no progress (only the measured model decides the maximum), and at the
-//! maximum when `A` is wanted, so the stopping rule and `A` are those of the exact model.
+//! The full Hessian is measured again where the updated model fails (a step that loses ℓ)
+//! and, when `A` is wanted, where the updated model promises no progress (only the measured
+//! model decides that maximum) and at the maximum: for such fits the stopping rule and `A`
+//! are those of the measured model. An inner maximisation of a profile, which wants only ℓ,
+//! may stop on the updated model.
 //!
 //! ## Wald intervals
 //!
