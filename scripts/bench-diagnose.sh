@@ -19,16 +19,7 @@
 #   SPECIMENS=N, SEED=S, RUNS=R, THREADS=T (`truss diagnose --threads`; default all cores),
 #   TRUSS=PATH (a built `truss` binary instead of building the release one). Needs python3.
 set -euo pipefail
-REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-WORK="${1:-$(mktemp -d)}"
-mkdir -p "$WORK"
-cd "$REPO"
-if [[ -n "${TRUSS:-}" ]]; then
-  T="$TRUSS"
-else
-  cargo build --release -p truss-cli --quiet
-  T="${CARGO_TARGET_DIR:-$REPO/target}/release/truss"
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/lib/truss-binary.sh" "$@"
 N="${SPECIMENS:-200}"
 SEED="${SEED:-601}"
 RUNS="${RUNS:-1}"

@@ -59,16 +59,7 @@
 #   not in the default set), TRUSS=PATH (a built `truss` binary to check, instead of building
 #   the release one). Needs python3.
 set -uo pipefail
-REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-WORK="${1:-$(mktemp -d)}"
-mkdir -p "$WORK"
-cd "$REPO" || exit 4
-if [[ -n "${TRUSS:-}" ]]; then
-  T="$TRUSS"
-else
-  cargo build --release -p truss-cli --quiet || exit 1
-  T="${CARGO_TARGET_DIR:-$REPO/target}/release/truss"
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/lib/truss-binary.sh" "$@"
 J="$REPO/jobs/diagnose-baseline.json"
 P="$REPO/jobs/paper-4.2.3.json"
 N="${SPECIMENS:-200}"

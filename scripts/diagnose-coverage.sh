@@ -73,16 +73,7 @@
 #   stay in WORKDIR (default a mktemp dir); runs.tsv there has one line per run and
 #   parameter. Exit status 0 if every parameter PASSED, 1 if any FAILED. Needs python3.
 set -uo pipefail
-REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-WORK="${1:-$(mktemp -d)}"
-mkdir -p "$WORK"
-cd "$REPO" || exit 4
-if [[ -n "${TRUSS:-}" ]]; then
-  T="$TRUSS"
-else
-  cargo build --release -p truss-cli --quiet || exit 1
-  T="${CARGO_TARGET_DIR:-$REPO/target}/release/truss"
-fi
+source "$(dirname "${BASH_SOURCE[0]}")/lib/truss-binary.sh" "$@"
 J="$REPO/jobs/diagnose-baseline.json"
 N="${SPECIMENS:-100}"
 SEEDS="${SEEDS:-$(seq -s ' ' 1001 1040)}"
