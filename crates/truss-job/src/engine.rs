@@ -8,7 +8,7 @@
 //! ## Contract
 //!
 //! [`Engine::run`] solves the indices it is given (a range of global sample indices, or a
-//! list of them) with one [`SampleSolver`] per thread. Workers take chunks of [`CHUNK`]
+//! list of them) with one [`SampleSolver`] per thread. Workers take chunks of [`chunk_for`]
 //! consecutive positions from a shared counter; for each sample, on the worker that solved
 //! it, `each` adds what the caller keeps to the chunk (it sees the [`SampleResult`] and the
 //! solver that produced it, for what the result does not carry: the drawn length errors,
@@ -32,13 +32,38 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{RecvTimeoutError, sync_channel};
 use std::time::{Duration, Instant};
 use truss_core::SolveOptions;
-use truss_core::solver::lanes::{BatchKernels, Kernels, LaneSolve, LaneWork, run_lanes};
+use truss_core::solver::lanes::{BatchKernels, Kernels, LANES, LaneSolve, LaneWork, run_lanes};
 
-/// Positions a worker takes at a time. Each chunk wakes the calling thread once (the
-/// runner: one write): at 16 (about 0.2 ms of 5-stage samples) those wakeups, on a machine
-/// with as many cores as workers, held two threads to 1.73 times one on
-/// `scripts/bench-shard.sh`'s job; at 64, 1.84 times.
+/// Positions a worker takes at a time, for models up to [`CHUNK_UNKNOWNS`] unknowns. Each
+/// chunk wakes the calling thread once (the runner: one write): at 16 (about 0.2 ms of
+/// 5-stage samples) those wakeups, on a machine with as many cores as workers, held two
+/// threads to 1.73 times one on `scripts/bench-shard.sh`'s job; at 64, 1.84 times.
 pub const CHUNK: u64 = 64;
+
+/// The unknowns of the paper's 5-stage prism (15 free nodes × 3), the model [`CHUNK`] is
+/// sized for. A larger model's chunk is smaller in proportion (see [`chunk_for`]).
+pub const CHUNK_UNKNOWNS: u64 = 45;
+
+/// The chunk of `job`: [`CHUNK`] positions scaled by `CHUNK_UNKNOWNS / n` for the largest
+/// model's `n` unknowns, so that a chunk is about the same solver work whatever the model
+/// (a sample's cost grows about linearly with its unknowns: the banded factorisation),
+/// and never fewer than one sample per lane.
+///
+/// A chunk is what a worker holds before handing it over, so it bounds both the balance
+/// between threads at the end of a run and what a crash loses: 64 samples of the 300-stage
+/// prism with free play are about half an hour of one core, and with fewer than 64 samples
+/// in a run only one thread would work. Which worker solves a sample never changes its
+/// result, so the chunk moves no byte of the output.
+pub fn chunk_for(job: &Job) -> u64 {
+    let largest = job
+        .cases
+        .iter()
+        .map(|c| c.structure.free_dofs() as u64)
+        .max()
+        .unwrap_or(0)
+        .max(1);
+    (CHUNK * CHUNK_UNKNOWNS / largest).clamp(LANES as u64, CHUNK)
+}
 
 /// How often the calling thread calls `take(None)` while a run lasts.
 pub const TICK: Duration = Duration::from_millis(100);
@@ -144,7 +169,7 @@ impl<'a> Engine<'a> {
         self.job
     }
 
-    /// Solves `indices`, `each` filling a chunk per [`CHUNK`] samples on the workers, and
+    /// Solves `indices`, `each` filling a chunk per [`chunk_for`] samples on the workers, and
     /// `take` receiving the chunks in order, or `None` every [`TICK`] while it waits.
     /// Returns how many samples were handed over: all of them unless the halt check stopped
     /// the run.
@@ -164,7 +189,8 @@ impl<'a> Engine<'a> {
             self.job.samples()
         );
         let total = indices.len();
-        let threads = (self.threads as u64).min(total.div_ceil(CHUNK)).max(1) as usize;
+        let chunk_size = chunk_for(self.job);
+        let threads = (self.threads as u64).min(total.div_ceil(chunk_size)).max(1) as usize;
         let next = AtomicU64::new(0);
         let stop = AtomicBool::new(false);
         let halted = || stop.load(Ordering::Relaxed) || self.halt.is_some_and(|h| h());
@@ -178,11 +204,11 @@ impl<'a> Engine<'a> {
                     let mut pool = vec![SampleSolver::with_options(self.job, self.options.clone())];
                     let mut kernels = BatchKernels::default();
                     loop {
-                        let start = next.fetch_add(CHUNK, Ordering::Relaxed);
+                        let start = next.fetch_add(chunk_size, Ordering::Relaxed);
                         if start >= total || halted() {
                             return;
                         }
-                        let end = (start + CHUNK).min(total);
+                        let end = (start + chunk_size).min(total);
                         let mut chunk = C::default();
                         let mut done = 0;
                         if self.lanes {
@@ -441,6 +467,30 @@ mod tests {
             },
         );
         assert_eq!((r, calls), (Err("stop"), 1));
+    }
+
+    /// A chunk is about the same solver work whatever the model: 64 samples of the paper's
+    /// 5-stage prism (45 unknowns), 64·45/270 of the 30-stage one, and one per lane of the
+    /// 300-stage one (2,700 unknowns), whose samples take seconds each with free play.
+    #[test]
+    fn the_chunk_shrinks_with_the_model() {
+        let prism = |stages: usize| {
+            let text = format!(
+                r#"{{"model": {{"prism": {{"stages": {stages}}}}}, "seed": 3, "cases": [
+                    {{"name": "a", "samples": 8,
+                      "length_errors": {{"longeron": {{"normal": {{"sigma": 0.01}}}}}}}}]}}"#
+            );
+            Job::from_json(&text, std::path::Path::new(".")).unwrap()
+        };
+        let unknowns = |job: &Job| job.cases[0].structure.free_dofs() as u64;
+        let (five, thirty, tall) = (prism(5), prism(30), prism(300));
+        assert_eq!(unknowns(&five), CHUNK_UNKNOWNS);
+        assert_eq!((unknowns(&thirty), unknowns(&tall)), (270, 2_700));
+        assert_eq!(chunk_for(&five), CHUNK);
+        assert_eq!(chunk_for(&thirty), 10);
+        assert_eq!(chunk_for(&tall), LANES as u64);
+        // A job's chunk is its largest model's.
+        assert_eq!(chunk_for(&job(10)), CHUNK);
     }
 
     /// A halt stops the workers; what they finished is handed over up to the first gap, in
