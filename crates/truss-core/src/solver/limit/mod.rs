@@ -87,7 +87,8 @@ impl Solver {
         self.set_limit_ratio(ratio);
         self.work.u.fill(0.0);
         let mut start_factorisations = 0;
-        self.linearised_from_rest(&mut start_factorisations);
+        self.linearised_from_rest(&mut start_factorisations, kernels)
+            .await;
         counts.factorisations += start_factorisations;
         let r = self.newton_warm(kernels).await?;
         counts.iterations += r.iterations;

@@ -13,6 +13,7 @@
 //! its set, with the sample's own member stiffnesses.
 
 use super::super::Solver;
+use super::super::lanes::Kernels;
 use crate::linearised::{gather_b, scatter_b};
 use std::sync::Arc;
 
@@ -27,7 +28,11 @@ impl Solver {
     /// The linearised start of the module doc into `self.work.u`; counts factorisations.
     /// Returns false (leaving `u = 0`) where a piece's stiffness is not positive definite
     /// (a mechanism of that set).
-    pub(super) fn linearised_from_rest(&mut self, factorisations: &mut u32) -> bool {
+    pub(super) async fn linearised_from_rest(
+        &mut self,
+        factorisations: &mut u32,
+        kernels: Kernels<'_>,
+    ) -> bool {
         let s = Arc::clone(&self.structure);
         let n = s.free;
         for (m, c) in s.members.iter().enumerate() {
@@ -63,11 +68,23 @@ impl Solver {
                 );
             }
             *factorisations += 1;
-            if self.factor.k.factor().is_err() {
+            // (In the batch where the solve runs in lanes: the same bits, see `lanes`.)
+            kernels
+                .factor(
+                    &s,
+                    self.sample_key,
+                    &mut self.factor.k,
+                    &mut self.work.failures,
+                    1,
+                )
+                .await;
+            if !self.work.failures.is_empty() {
                 self.work.u.fill(0.0);
                 return false;
             }
-            self.factor.k.solve_in_place(&mut self.work.u[..n]);
+            kernels
+                .solve(&s, self.sample_key, &mut self.factor.k, &mut self.work.u)
+                .await;
             self.work.u[n] = 0.0;
             let mut settled = true;
             for (m, c) in s.members.iter().enumerate() {
