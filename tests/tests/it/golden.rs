@@ -90,11 +90,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "4885e77eb0e2f7df19d894f231d7a429955f247c80534b984bb80b5e33878075",
+        "c841f1faea978a80a1e0005834c2ae9fc860ea118f36a7c8a7bfad9594fbba8a",
         "94ce944399e4677c5705bde025cc92a70f975a9f2ab7c855a7e8f13ecf665d24",
         "546cf9d696c4c41815489fa90b763f7db5a7158a8fe8896316e035a3f1ee86a1",
         "7b94c46945c2820f627e0bdcc5aa42e331a0f6fe76f9a1cbbfa384b72441d183",
-        "dd42e18c32ec37687d7c75646284709af4d73372a0dbe710c766a90b7eda60a0",
+        "dc75524d6de0594a35efb531f5cd4a5d22e273b2fe5eb0b0a60f9ba7652097b6",
     ];
     for (what, (g, w)) in [
         "job id",

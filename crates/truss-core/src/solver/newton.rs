@@ -13,9 +13,14 @@ use std::sync::Arc;
 /// The force "has stopped falling" when it has not halved in this many iterations.
 const STALL_ITERATIONS: u32 = 3;
 
-/// A stalled force is accepted within this factor of the rounding floor (1e-10 of the
-/// largest member force with the default floor): an ill-conditioned tall tower's rounding
-/// noise keeps the steps from shrinking further.
+/// A stalled force is accepted within this factor of the floor the force test uses: the
+/// larger of `residual_floor·F` (1e-10 of the largest member force with the default floor)
+/// and the displacements' rounding floor ([`Solver::rounding_floor`]). An ill-conditioned
+/// tall tower's rounding noise keeps the steps from shrinking further. Both floors, as the
+/// force test has them: with the first alone, a stage of the limit solver on the 300-stage
+/// prism with free play (tops 40–80 mm out, a rounding floor of 2e-10 N against a force
+/// floor of 1.4e-11 N) stalled at 1.5e-8 to 4e-8 N, its line search unable to see a
+/// descent below that noise, and was abandoned; with both such stages end.
 const STALL_FLOOR_FACTOR: f64 = 1e3;
 
 /// The rounding floor of the out-of-balance force from the displacements, in units of
@@ -281,11 +286,11 @@ impl Solver {
     }
 
     /// The force test of step 5 at the current point: done when the out-of-balance force
-    /// is at its rounding floor `residual_floor·F` (`F` the largest member force, or the
-    /// sample's force scale), or has stopped falling ([`STALL_ITERATIONS`]) within
-    /// [`STALL_FLOOR_FACTOR`] times the floor (an ill-conditioned tall tower, whose
-    /// bending is far softer than its members: the steps stop shrinking before the step
-    /// test is met). Errors on a non-finite force or too many iterations.
+    /// is at its floor, the larger of `residual_floor·F` (`F` the largest member force, or
+    /// the sample's force scale) and the rounding floor, or has stopped falling
+    /// ([`STALL_ITERATIONS`]) within [`STALL_FLOOR_FACTOR`] times it (an ill-conditioned
+    /// tall tower, whose bending is far softer than its members: the steps stop shrinking
+    /// before the step test is met). Errors on a non-finite force or too many iterations.
     fn force_converged(&self, p: &mut Progress) -> Result<Next, SolveError> {
         let eval = &p.eval;
         if !eval.residual.is_finite() {
@@ -303,7 +308,9 @@ impl Solver {
         } else {
             p.stalled += 1;
         }
-        if p.stalled >= STALL_ITERATIONS && eval.residual <= STALL_FLOOR_FACTOR * floor {
+        if p.stalled >= STALL_ITERATIONS
+            && eval.residual <= STALL_FLOOR_FACTOR * floor.max(self.rounding_floor(p.u_max))
+        {
             return Ok(Next::Done);
         }
         if p.iterations >= self.options.max_iterations {
@@ -420,15 +427,17 @@ impl Solver {
     }
 
     /// After a line search: a step that no longer moves ([`STUCK_STEP`]) while the force
-    /// is far from its floor raises the damping (an error once it is beyond
+    /// is far from its floor (beyond [`STALL_FLOOR_FACTOR`] times the force test's floor)
+    /// raises the damping (an error once it is beyond
     /// [`DAMPING_MAX`]); full steps again relax it back towards Newton's method.
     fn adapt_damping(&mut self, p: &mut Progress, alpha: f64) -> Result<(), SolveError> {
         // (Multiplied in this order, as ever: the comparison's rounding is part of the
         // results.)
         let far_from_floor = p.eval.residual
-            > STALL_FLOOR_FACTOR
+            > (STALL_FLOOR_FACTOR
                 * self.options.residual_floor
-                * p.eval.force_scale.max(self.sample.force_ref);
+                * p.eval.force_scale.max(self.sample.force_ref))
+            .max(STALL_FLOOR_FACTOR * self.rounding_floor(p.u_max));
         if far_from_floor && p.step <= STUCK_STEP * p.u_max.max(self.sample.scale) {
             if !self.raise_damping() {
                 return Err(SolveError::NotConverged {

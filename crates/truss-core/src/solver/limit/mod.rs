@@ -42,8 +42,12 @@
 //!
 //! At `ρ = 0` itself nothing is regularised: a slack cable's compression stiffness is
 //! exactly zero. A watched attempt that does not converge is abandoned as an event is.
+//! An attempt whose step meets more free directions than its dense reduced problem takes
+//! (`MAX_REDUCED` of the `newton` module: a tall truss with many stages floating at once)
+//! does not converge either.
 //! Where even the last attempt does not converge (a loaded stage coming to rest against
-//! its joints' contacts, in about 1 of 40 Fig. 16 samples under a top load of 1 nN), the
+//! its joints' contacts, in about 1 of 40 Fig. 16 samples under a top load of 1 nN; or a
+//! 300-stage prism with free play whose last attempt meets 1,653 free directions), the
 //! last stage's equilibrium stands for the limit: at [`LAST_RATIO`] the slack diagonals'
 //! compression stiffness is 4e-10 N/mm, and what it holds moves by that fraction of what a
 //! member that bears would.

@@ -35,6 +35,16 @@ const MAX_ENGAGEMENTS: u32 = 8;
 /// Most pieces (model bearing sets) of one iteration.
 const MAX_PIECES: u32 = 8;
 
+/// Most soft pivots (directions of the [`reduced`](super::reduced) problem) of one step.
+/// The reduced problem is dense and its eigen-decomposition (cyclic Jacobi) costs about
+/// `p³` per sweep: 9 directions at most in 2,000 samples of the paper's Fig. 16 case, up to
+/// 198 in a 300-stage prism with free play that solves in 303 iterations, and 1,653 in
+/// another's last attempt at `ρ = 0` (that sample had not finished after 20 minutes).
+/// An attempt that meets more is abandoned as one that does not converge: a watched one
+/// as an event, the last one leaving the last stage to stand for the limit (see the
+/// module doc of `limit`).
+const MAX_REDUCED: usize = 256;
+
 /// How a stage of the continuation ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum StageEnd {
@@ -167,6 +177,12 @@ impl Solver {
                 if watch && engaged {
                     self.factor.locked = locked;
                     return Ok(StageEnd::Event);
+                }
+                if self.work.failures.len() > MAX_REDUCED {
+                    // Too many free directions for the dense reduced problem: the attempt
+                    // is abandoned (see `MAX_REDUCED`).
+                    self.factor.locked = locked;
+                    return Err(self.stalled(counts, &eval, last_step));
                 }
                 finding = self.reduced_step(floor, kernels).await;
                 if matches!(finding, Finding::Unstable { .. }) {
