@@ -100,16 +100,7 @@ impl Solver {
         }
         self.step.pinned.fill(false);
         self.assemble_model();
-        kernels
-            .factor(
-                &s,
-                self.sample_key,
-                &mut self.factor.k,
-                &mut self.work.failures,
-                1,
-            )
-            .await;
-        if !self.work.failures.is_empty() {
+        if !self.factor_tangent(kernels).await {
             return Some(Holding {
                 force: 0.0,
                 node: top.nodes[0],

@@ -125,6 +125,23 @@ impl Solver {
         self.iterate(p, true, kernels).await
     }
 
+    /// Factorises the tangent in `self.factor.k` (in the batch where the solve runs in
+    /// lanes: the same bits), stopping at its first pivot that is not safely positive;
+    /// returns whether there was none (the failure, if any, in `self.work.failures`).
+    pub(super) async fn factor_tangent(&mut self, kernels: Kernels<'_>) -> bool {
+        let s = Arc::clone(&self.structure);
+        kernels
+            .factor(
+                &s,
+                self.sample_key,
+                &mut self.factor.k,
+                &mut self.work.failures,
+                1,
+            )
+            .await;
+        self.work.failures.is_empty()
+    }
+
     /// Evaluates the current point `u` into the solver's state: the residual, the members'
     /// states and the slack set.
     pub(super) async fn evaluate_current(&mut self, kernels: Kernels<'_>) -> Evaluation {

@@ -68,17 +68,7 @@ impl Solver {
                 );
             }
             *factorisations += 1;
-            // (In the batch where the solve runs in lanes: the same bits, see `lanes`.)
-            kernels
-                .factor(
-                    &s,
-                    self.sample_key,
-                    &mut self.factor.k,
-                    &mut self.work.failures,
-                    1,
-                )
-                .await;
-            if !self.work.failures.is_empty() {
+            if !self.factor_tangent(kernels).await {
                 self.work.u.fill(0.0);
                 return false;
             }
