@@ -19,8 +19,8 @@ const STALL_ITERATIONS: u32 = 3;
 /// tall tower's rounding noise keeps the steps from shrinking further. Both floors, as the
 /// force test has them: with the first alone, a stage of the limit solver on the 300-stage
 /// prism with free play (tops 40–80 mm out, a rounding floor of 2e-10 N against a force
-/// floor of 1.4e-11 N) stalled at 1.5e-8 to 4e-8 N, its line search unable to see a
-/// descent below that noise, and was abandoned; with both such stages end.
+/// floor of 1.4e-11 N) stalled at 1.5e-8 to 1.3e-7 N, its line search unable to see a
+/// descent in that noise, and was abandoned; with both, such stages end.
 const STALL_FLOOR_FACTOR: f64 = 1e3;
 
 /// The rounding floor of the out-of-balance force from the displacements, in units of
@@ -445,8 +445,8 @@ impl Solver {
 
     /// After a line search: a step that no longer moves ([`STUCK_STEP`]) while the force
     /// is far from its floor (beyond [`STALL_FLOOR_FACTOR`] times the force test's floor)
-    /// raises the damping (an error once it is beyond
-    /// [`DAMPING_MAX`]); full steps again relax it back towards Newton's method.
+    /// raises the damping (an error once it is beyond [`DAMPING_MAX`]); full steps again
+    /// relax it back towards Newton's method.
     fn adapt_damping(&mut self, p: &mut Progress, alpha: f64) -> Result<(), SolveError> {
         // (Multiplied in this order, as ever: the comparison's rounding is part of the
         // results.)
