@@ -144,7 +144,7 @@ impl<'a> Engine<'a> {
         }
     }
 
-    /// Whether each worker solves [`LANES`](truss_core::solver::lanes::LANES) samples side by side, their kernels batched
+    /// Whether each worker solves [`LANES`] samples side by side, their kernels batched
     /// (the default; see [`truss_core::solver::lanes`]), or one sample at a time. The
     /// results are the same bits either way.
     pub fn in_lanes(mut self, lanes: bool) -> Self {
