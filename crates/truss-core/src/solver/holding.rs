@@ -100,7 +100,7 @@ impl Solver {
         }
         self.step.pinned.fill(false);
         self.assemble_model();
-        if !self.factor_tangent(kernels).await {
+        if !self.factor_tangent(kernels, 1).await {
             return Some(Holding {
                 force: 0.0,
                 node: top.nodes[0],

@@ -126,9 +126,10 @@ impl Solver {
     }
 
     /// Factorises the tangent in `self.factor.k` (in the batch where the solve runs in
-    /// lanes: the same bits), stopping at its first pivot that is not safely positive;
-    /// returns whether there was none (the failure, if any, in `self.work.failures`).
-    pub(super) async fn factor_tangent(&mut self, kernels: Kernels<'_>) -> bool {
+    /// lanes: the same bits), stopping at its `max`-th pivot that is not safely positive
+    /// (see [`crate::block::BlockBandMatrix::factor_collecting`]); returns whether there
+    /// was none (the failures, if any, in `self.work.failures`).
+    pub(super) async fn factor_tangent(&mut self, kernels: Kernels<'_>, max: usize) -> bool {
         let s = Arc::clone(&self.structure);
         kernels
             .factor(
@@ -136,7 +137,7 @@ impl Solver {
                 self.sample_key,
                 &mut self.factor.k,
                 &mut self.work.failures,
-                1,
+                max,
             )
             .await;
         self.work.failures.is_empty()
@@ -316,8 +317,8 @@ impl Solver {
                 what: "out-of-balance force (a member may have collapsed to zero length)".into(),
             });
         }
-        let floor = self.force_floor(eval);
-        if eval.residual == 0.0 || eval.residual <= floor.max(self.rounding_floor(p.u_max)) {
+        let floor = self.force_floor(eval).max(self.rounding_floor(p.u_max));
+        if eval.residual == 0.0 || eval.residual <= floor {
             return Ok(Next::Done);
         }
         if eval.residual <= 0.5 * p.lowest {
@@ -325,9 +326,7 @@ impl Solver {
         } else {
             p.stalled += 1;
         }
-        if p.stalled >= STALL_ITERATIONS
-            && eval.residual <= STALL_FLOOR_FACTOR * floor.max(self.rounding_floor(p.u_max))
-        {
+        if p.stalled >= STALL_ITERATIONS && eval.residual <= STALL_FLOOR_FACTOR * floor {
             return Ok(Next::Done);
         }
         if p.iterations >= self.options.max_iterations {

@@ -299,15 +299,7 @@ impl Solver {
         }
         self.factor.k.set_pivot_tolerance(SOFT_PIVOT);
         counts.factorisations += 1;
-        kernels
-            .factor(
-                &s,
-                self.sample_key,
-                &mut self.factor.k,
-                &mut self.work.failures,
-                n + 1,
-            )
-            .await;
+        self.factor_tangent(kernels, n + 1).await;
         self.factor.k.set_pivot_tolerance(PIVOT_TOLERANCE);
     }
 

@@ -68,7 +68,7 @@ impl Solver {
                 );
             }
             *factorisations += 1;
-            if !self.factor_tangent(kernels).await {
+            if !self.factor_tangent(kernels, 1).await {
                 self.work.u.fill(0.0);
                 return false;
             }
