@@ -336,7 +336,6 @@ pub(crate) struct Test {
 pub(crate) struct Fitted {
     pub score: CandidateScore,
     pub fit: Option<Fit>,
-    pub profiled: bool,
 }
 
 /// A candidate's objective: ℓ's terms at internal coordinates.
@@ -465,11 +464,7 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
     };
     score.evaluations = count.get();
     score.seconds = clock.elapsed().as_secs_f64();
-    Fitted {
-        score,
-        fit,
-        profiled: false,
-    }
+    Fitted { score, fit }
 }
 
 /// Profile-likelihood intervals for a fitted candidate ([`crate::likelihood::profile`]); where a profile
@@ -483,7 +478,6 @@ pub(crate) fn profile_candidate(
     test: &Test,
     note: &dyn Fn(&str),
 ) {
-    fitted.profiled = true;
     let Some(mut fit) = fitted.fit.take() else {
         return;
     };
