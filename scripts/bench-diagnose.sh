@@ -9,11 +9,12 @@
 #   diagonal_pretension  every diagonal 0.05 mm short
 #   length_sigma         the diagonals scatter twice as widely (σ 0.0572 mm, stated 0.0286)
 # `truss diagnose` runs on them RUNS times (default 1) under /usr/bin/time; each run prints
-# its wall and CPU (user + sys) seconds, the named effects, and the seconds of each stage
+# its wall and CPU (user + sys) seconds, the named effects, the seconds of each stage
 # (`timing.stages` in diagnosis.json: the baseline's simulation and comparison, each step's
-# comparison, candidate fits, profiles and update, the final fit and the confounding
-# tests). The machine's load average is printed with each run: on a shared machine the
-# CPU time says more than the wall time.
+# comparison, candidate fits, decision and update, the final fit and the confounding
+# tests), and each final interval against the hidden value (holds / MISSES). The machine's
+# load average is printed with each run: on a shared machine the CPU time says more than
+# the wall time.
 #
 # Usage (from anywhere): scripts/bench-diagnose.sh [WORKDIR]
 #   SPECIMENS=N, SEED=S, RUNS=R, THREADS=T (`truss diagnose --threads`; default all cores),
@@ -54,9 +55,21 @@ for stage in stages:
     print(f"    {stage['stage']:<44} {stage['seconds']:7.1f} s  ({stage['simulations']} simulations)")
 if not stages:
     print("    steps " + " ".join(f"{s['seconds']:.0f}" for s in d["steps"]) + " s")
+# The hidden values (the baseline's own σ for the bars' scatter): each final interval is
+# marked by whether it holds its truth.
+truth = {"backlash.clearance": 0.0105, "backlash.spread": 0.0065,
+         "length_sigma.sigma.batten": 0.033, "length_sigma.sigma.longeron": 0.033,
+         "length_sigma.sigma.diagonal": 0.0572, "diagonal_pretension.length_error": -0.05}
 for e in d.get("final_fit", []):
     for p in e["parameters"]:
         i = p.get("joint_interval") or p["interval"]
-        print(f"    {e['name']}.{p['name']} = {p['value']:.5g} [{i.get('lower')}, {i.get('upper')}]")
+        lo, hi = i.get("lower"), i.get("upper")
+        name = f"{e['name']}.{p['name']}"
+        held = ""
+        if name in truth:
+            held = ("holds" if lo is not None and hi is not None and lo <= truth[name] <= hi
+                    else "MISSES") + f" the truth {truth[name]}"
+        ends = "not found" if lo is None or hi is None else f"[{lo:.5g}, {hi:.5g}]"
+        print(f"    {name} = {p['value']:.5g} {ends} ({i.get('method')}) {held}")
 PY
 done

@@ -133,6 +133,9 @@
 //! interval is cut at the range. Before, every step profiled its named candidate and those
 //! indistinguishable from it, which the final joint fit then superseded. The stage
 //! `step k: decide and profile` is now `step k: decide`, and `final fit: profiles` is new.
+//! Where a fit's curvature A at its maximum is not positive definite, it is measured again
+//! at longer steps (`method.fit`): the three-effect benchmark's final fit, whose Wald
+//! intervals were all null ("not determined"), now has them.
 //!
 //! Version 10 (from 9): `answer`, the answer the reports share; diagnosis.md opens with
 //! its lines and its `## Next step` section became the answer's `next` lines; the naming

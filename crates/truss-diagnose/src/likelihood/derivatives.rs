@@ -166,6 +166,21 @@ pub fn derivatives_along_axes(
     stencil(t, f_t, steps, clusters, Some(cross), f, evaluations)
 }
 
+/// [`derivatives`] at exactly `steps`, none adapted (each clamped to
+/// [[`MIN_STEP`], [`MAX_STEP`]]): for a curvature measured again at a longer scale than
+/// the likelihood's standard error ([`crate::likelihood::fit`]).
+pub fn derivatives_at_steps(
+    t: &[f64],
+    f_t: &Terms,
+    steps: &[f64],
+    clusters: Option<&[usize]>,
+    f: &mut Objective,
+    evaluations: &mut usize,
+) -> Result<Derivatives, DiagnoseError> {
+    let fixed: Vec<f64> = steps.iter().map(|h| h.clamp(MIN_STEP, MAX_STEP)).collect();
+    stencil_with(t, f_t, &fixed, clusters, None, false, f, evaluations)
+}
+
 /// The stencil of the module doc; the mixed differences from `cross` where it is given.
 fn stencil(
     t: &[f64],
@@ -176,6 +191,21 @@ fn stencil(
     f: &mut Objective,
     evaluations: &mut usize,
 ) -> Result<Derivatives, DiagnoseError> {
+    stencil_with(t, f_t, steps, clusters, cross, true, f, evaluations)
+}
+
+/// [`stencil`], each step adapted to the likelihood's scale first where `adapt_steps`.
+#[allow(clippy::too_many_arguments)]
+fn stencil_with(
+    t: &[f64],
+    f_t: &Terms,
+    steps: &[f64],
+    clusters: Option<&[usize]>,
+    cross: Option<&DMatrix<f64>>,
+    adapt_steps: bool,
+    f: &mut Objective,
+    evaluations: &mut usize,
+) -> Result<Derivatives, DiagnoseError> {
     let k = t.len();
     let mut memo = Memo {
         f,
@@ -183,8 +213,10 @@ fn stencil(
         evaluations: 0,
     };
     let mut h = steps.to_vec();
-    for (i, hi) in h.iter_mut().enumerate() {
-        *hi = adapt(&mut memo, t, i, *hi)?;
+    if adapt_steps {
+        for (i, hi) in h.iter_mut().enumerate() {
+            *hi = adapt(&mut memo, t, i, *hi)?;
+        }
     }
     let centre: Vec<f64> = t.iter().zip(&h).map(|(&x, &hi)| inside(x, hi)).collect();
     let f0 = memo.at(&centre)?.clone();

@@ -23,6 +23,22 @@
 //! are those of the measured model. An inner maximisation of a profile, which wants only ℓ,
 //! may stop on the updated model.
 //!
+//! ## A rough likelihood
+//!
+//! The steps make each central second difference about one unit of ℓ. Where ℓ is rough
+//! on that scale, the mixed differences are not the curvature but the roughness over
+//! `hᵢhⱼ`: with pin joints in free play and solved at the cables' limit, each sample's
+//! contact state changes at its own value of a clearance or a diagonal pretension, and ℓ
+//! has a kink for each. On the three-effect benchmark's data (`scripts/bench-diagnose.sh`:
+//! backlash, the diagonals' scatter and a pretension fitted jointly, 200 specimens) the
+//! mixed entries of the pretension's row read as correlations of 0.72, 1.17, 0.75 and 2.06
+//! at those steps (no positive definite matrix has one above 1), and 0.05 to 0.24 at steps
+//! twice and three times as long, which agree. So where `A` at the maximum is not positive
+//! definite, it is measured again with every step [`LONGER_STEPS`] times as long, without
+//! adapting them, and the first positive definite one is kept (else the first: the Wald
+//! intervals are then not found). A fit whose `A` is positive definite at the likelihood's
+//! own scale is untouched.
+//!
 //! ## Wald intervals
 //!
 //! ℓ is a sum of per-unit terms ℓ_u (one per specimen, one per member observation). With
@@ -40,7 +56,8 @@
 use crate::candidates::parameter::Parameter;
 use crate::errors::DiagnoseError;
 use crate::likelihood::derivatives::{
-    INITIAL_STEP, Objective, derivatives, derivatives_along_axes, total,
+    Derivatives, INITIAL_STEP, Objective, Terms, derivatives, derivatives_along_axes,
+    derivatives_at_steps, total,
 };
 use nalgebra::{DMatrix, DVector};
 
@@ -48,6 +65,9 @@ use nalgebra::{DMatrix, DVector};
 pub const TOLERANCE: f64 = 0.02;
 /// Most Newton iterations.
 pub const MAX_ITERATIONS: usize = 12;
+/// The factors by which the steps grow where the curvature at the maximum, measured at the
+/// likelihood's own standard error, is not positive definite (module doc).
+pub const LONGER_STEPS: [f64; 2] = [2.0, 4.0];
 
 /// The result of a fit.
 #[derive(Debug, Clone)]
@@ -269,6 +289,32 @@ fn sr1_mixed(h: &DMatrix<f64>, s: &DVector<f64>, y: &DVector<f64>) -> DMatrix<f6
     next
 }
 
+/// `A = −H` and `B` at the maximum `t` from the derivatives `d` measured there; where that
+/// `A` is not positive definite, measured again at steps [`LONGER_STEPS`] times longer, the
+/// first positive definite one kept (module doc), else `d`'s.
+fn curvature_at_maximum(
+    t: &[f64],
+    terms: &Terms,
+    d: Derivatives,
+    clusters: Option<&[usize]>,
+    f: &mut Objective,
+    evaluations: &mut usize,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), DiagnoseError> {
+    let a = -&d.hessian;
+    if nalgebra::Cholesky::new(a.clone()).is_some() {
+        return Ok((a, d.variability));
+    }
+    for factor in LONGER_STEPS {
+        let longer: Vec<f64> = d.steps.iter().map(|h| h * factor).collect();
+        let again = derivatives_at_steps(t, terms, &longer, clusters, f, evaluations)?;
+        let a_again = -&again.hessian;
+        if nalgebra::Cholesky::new(a_again.clone()).is_some() {
+            return Ok((a_again, again.variability));
+        }
+    }
+    Ok((a, d.variability))
+}
+
 /// Maximises `f` (ℓ as a function of internal coordinates) over the unit cube from `start`;
 /// `project` maps internal coordinates onto the feasible set.
 pub fn maximise(
@@ -364,7 +410,9 @@ pub fn maximise(
     }
     let (curvature, variability) = if options.curvature {
         steps.clone_from(&d.steps);
-        (-d.hessian, d.variability)
+        let (curvature, variability) =
+            curvature_at_maximum(&t, &terms, d, options.clusters, f, &mut evaluations)?;
+        (curvature, variability)
     } else {
         (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0))
     };
@@ -428,6 +476,43 @@ pub fn wald_intervals(fit: &Fit, parameters: &[Parameter], inflation: f64) -> Ve
 mod tests {
     use super::*;
     use crate::likelihood::derivatives::Terms;
+
+    /// A likelihood rough on the scale of its own standard error: a quadratic of standard
+    /// error 0.002 along each axis and correlation 0.9, rounded to whole units of ℓ (as a
+    /// sum over samples whose contact states change at their own parameter values makes it
+    /// step). At t − m = (−0.0005, 0.0004) the stencil keeps steps of one standard error
+    /// (the second differences are 1 unit), and there the rounded mixed difference reads a
+    /// correlation of 2, so A is indefinite; measured again at twice the steps it reads
+    /// 0.75, the diagonal exact (the same stencil worked in NumPy gives 2 and 0.75). The
+    /// rule of the module doc keeps that one. Without the rule the first A comes back and
+    /// Cholesky fails.
+    #[test]
+    fn a_rough_likelihood_has_its_curvature_measured_at_longer_steps() {
+        let (se, rho, m) = (0.002, 0.9, [0.5, 0.5]);
+        let mut f = |t: &[f64]| -> Result<Terms, DiagnoseError> {
+            let (x, y) = ((t[0] - m[0]) / se, (t[1] - m[1]) / se);
+            Ok(vec![(-0.5 * (x * x + 2.0 * rho * x * y + y * y)).round()])
+        };
+        let t = [m[0] - 0.0005, m[1] + 0.0004];
+        let terms = f(&t).unwrap();
+        let mut evaluations = 0;
+        let d = derivatives(&t, &terms, &[se, se], None, &mut f, &mut evaluations).unwrap();
+        let a = -&d.hessian;
+        assert!(
+            nalgebra::Cholesky::new(a.clone()).is_none(),
+            "the premise: A at the adapted steps {:?} is indefinite, {a}",
+            d.steps
+        );
+        assert_eq!(d.steps, [se, se]);
+        let correlation = |a: &DMatrix<f64>| a[(0, 1)] / (a[(0, 0)] * a[(1, 1)]).sqrt();
+        assert!((correlation(&a) - 2.0).abs() < 1e-9, "{a}");
+        let (a, _) = curvature_at_maximum(&t, &terms, d, None, &mut f, &mut evaluations).unwrap();
+        assert!(nalgebra::Cholesky::new(a.clone()).is_some(), "{a}");
+        for i in 0..2 {
+            assert!((a[(i, i)] * se * se - 1.0).abs() < 1e-9, "{a}");
+        }
+        assert!((correlation(&a) - 0.75).abs() < 1e-9, "{a}");
+    }
 
     /// A concave quadratic with its maximum inside the cube is found in a few iterations, and
     /// the Wald interval is the exact one of a normal likelihood: for ℓ = −(t − m)²/(2s²),
