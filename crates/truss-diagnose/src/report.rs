@@ -83,9 +83,8 @@
 //!              (the first named effect's, as fitted in its step; for an effect swapped in,
 //!              the last joint re-fit's, Wald intervals)
 //!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
-//!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the effect of a final model
-//!              of one effect (in its step) and in `final_fit` where a Wald interval was cut
-//!              at the range, else "wald"; lower/upper null when not found;
+//!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
+//!              indistinguishable from it, else "wald"; lower/upper null when not found;
 //!              an end at the range end is the range's (the interval is cut there)
 //!   determined false where the interval, or the Wald interval, covers at least half of the
 //!              plausible range (on the fit's scale): "not determined by these data", no
@@ -122,20 +121,9 @@
 //! timing      {simulations, solves, seconds, final_fit_seconds, threads (of the
 //!              simulations), stages [{stage, seconds, simulations}] (each stage in order:
 //!              the baseline's simulation and comparison; per step, fitting the
-//!              candidates, deciding, updating the model, comparing the updated model;
-//!              the final fit's profiles where the final model is one effect; the final
-//!              fit; the confounding tests)}
+//!              candidates, deciding with the profiles, updating the model, comparing the
+//!              updated model; the final fit; the confounding tests)}
 //! ```
-//!
-//! Version 11 (from 10): a step's candidates carry Wald intervals only; profile intervals
-//! (`method` "profile", `joint_interval`) are computed for the final model's effect when
-//! it is one (in the step that named it) and, as before, in `final_fit` where a Wald
-//! interval is cut at the range. Before, every step profiled its named candidate and those
-//! indistinguishable from it, which the final joint fit then superseded. The stage
-//! `step k: decide and profile` is now `step k: decide`, and `final fit: profiles` is new.
-//! Where a fit's curvature A at its maximum is not positive definite, it is measured again
-//! at longer steps (`method.fit`): the three-effect benchmark's final fit, whose Wald
-//! intervals were all null ("not determined"), now has them.
 //!
 //! Version 10 (from 9): `answer`, the answer the reports share; diagnosis.md opens with
 //! its lines and its `## Next step` section became the answer's `next` lines; the naming
@@ -214,7 +202,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 11;
+pub const FORMAT_VERSION: u32 = 10;
 
 #[derive(Serialize)]
 struct JobRef<'a> {

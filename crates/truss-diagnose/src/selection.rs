@@ -278,22 +278,6 @@ pub fn diagnose(
     let clock = std::time::Instant::now();
     let (final_fit, confounding) = match last {
         Some(i) => {
-            if steps[i].joint.is_none() || steps[i].refitted.is_empty() {
-                // The final numbers are the steps' own fits: profile them now (step's
-                // module doc).
-                ctx.timed("final fit: profiles", None, || {
-                    for (s, m) in steps[..=i].iter_mut().zip(&models).filter(|(s, _)| s.kept) {
-                        let Some(name) = s.named_effect().map(str::to_owned) else {
-                            continue;
-                        };
-                        let candidate = library.iter().find(|c| c.name() == name);
-                        if let (true, Some(c)) = (effects.iter().any(|e| e.name == name), candidate)
-                        {
-                            step::profile_named(&ctx, s, m, c.as_ref());
-                        }
-                    }
-                });
-            }
             let fit = ctx.timed("final fit", None, || {
                 confound::final_fit(&ctx, &steps[..=i], &steps[i], &library)
             });
@@ -542,7 +526,6 @@ mod tests {
             removed,
             effects: Vec::new(),
             joint: None,
-            named_fit: None,
             seconds: 0.0,
         }
     }

@@ -336,6 +336,7 @@ pub(crate) struct Test {
 pub(crate) struct Fitted {
     pub score: CandidateScore,
     pub fit: Option<Fit>,
+    pub profiled: bool,
 }
 
 /// A candidate's objective: ℓ's terms at internal coordinates.
@@ -464,7 +465,11 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
     };
     score.evaluations = count.get();
     score.seconds = clock.elapsed().as_secs_f64();
-    Fitted { score, fit }
+    Fitted {
+        score,
+        fit,
+        profiled: false,
+    }
 }
 
 /// Profile-likelihood intervals for a fitted candidate ([`crate::likelihood::profile`]); where a profile
@@ -478,6 +483,7 @@ pub(crate) fn profile_candidate(
     test: &Test,
     note: &dyn Fn(&str),
 ) {
+    fitted.profiled = true;
     let Some(mut fit) = fitted.fit.take() else {
         return;
     };

@@ -9,14 +9,9 @@
 //! 2. **fit each candidate** (`fit_each`): every remaining candidate applied to the
 //!    current model's typed case ([`crate::comparison::baseline::CaseEdit`]), its ℓ
 //!    maximised and tested against the current model ([`crate::likelihood::score`]).
-//! 3. **decide** (`decide_step`): the verdict of [`decide`] on the candidates' fits, with
-//!    their Wald intervals. Profile-likelihood intervals are not computed here: the
-//!    numbers a diagnosis ends with are the final model's joint fit's
-//!    ([`crate::selection::confound`]), so a step's profiles were superseded wherever the
-//!    model grew to two effects or more (in the three-effect benchmark they cost 380 of
-//!    3,786 simulations, 84 of 642 s). Where the final model has one effect, its
-//!    step's fit is the final one, and that step's named candidate is profiled then
-//!    ([`profile_named`]), from the fit kept in [`Step::named_fit`].
+//! 3. **decide** (`decide_and_profile`): the verdict of [`decide`]; the candidate it names
+//!    and those indistinguishable from it get profile-likelihood intervals, and should a
+//!    profile find a higher maximum the verdict is decided again on the new fits.
 //! 4. **update** ([`crate::selection::update`]): the named candidate is added at its fitted values, every
 //!    effect of the model is re-fitted jointly and each effect added in an earlier step is
 //!    tested for removal given the others and tried swapped for a rival; the updated
@@ -49,7 +44,6 @@ use crate::comparison::baseline::CaseEdit;
 use crate::comparison::statistics::{Comparison, LEVEL};
 use crate::errors::DiagnoseError;
 use crate::likelihood::derivatives::Terms;
-use crate::likelihood::fit::Fit;
 use crate::likelihood::joint::JointFit;
 use crate::likelihood::score::{
     CandidateScore, Evaluator, Fitted, Test, fit_candidate, p_is, p_text, profile_candidate,
@@ -107,9 +101,6 @@ pub struct Step {
     pub effects: Vec<ModelEffect>,
     /// The joint fit behind `refitted`, if any.
     pub joint: Option<JointFit>,
-    /// The named candidate's fit, kept for a profile should its step's fit be the final one
-    /// ([`profile_named`]).
-    pub named_fit: Option<Fit>,
     /// Wall time of the step \[s\].
     pub seconds: f64,
 }
@@ -232,9 +223,20 @@ pub(crate) fn run(
         || fit_each(ctx, &ev, candidates, &test),
     );
     // 3. Decide.
-    let (decision, scores) = ctx.timed(format!("step {number}: decide"), Some(&ev), || {
-        decide_step(&ev, candidates, &fitted, &test, &current.comparison, n)
-    });
+    let (decision, scores) = ctx.timed(
+        format!("step {number}: decide and profile"),
+        Some(&ev),
+        || {
+            decide_and_profile(
+                ctx,
+                &ev,
+                candidates,
+                &mut fitted,
+                &test,
+                &current.comparison,
+            )
+        },
+    );
     ctx.count(&ev);
     let Decision {
         verdict,
@@ -273,7 +275,6 @@ pub(crate) fn run(
         removed: Vec::new(),
         effects: Vec::new(),
         joint: None,
-        named_fit: named.and_then(|i| fitted[i].fit.take()),
         seconds: 0.0,
     };
     let next = up.map(|up| {
@@ -340,23 +341,62 @@ fn fit_each(
         .collect()
 }
 
-/// Stage 3: the verdict on the candidates' fits; returns the decision and the scores,
-/// Vuong's z against the named one filled in.
-fn decide_step(
+/// Stage 3: the verdict, and profiles of the candidates it rests on (decided again when a
+/// profile moves a fit); returns the decision and the final scores, Vuong's z against the
+/// named one filled in.
+fn decide_and_profile(
+    ctx: &Context,
     ev: &Evaluator,
     candidates: &[Box<dyn Candidate>],
-    fitted: &[Fitted],
+    fitted: &mut [Fitted],
     test: &Test,
     before: &Comparison,
-    n: usize,
 ) -> (Decision, Vec<CandidateScore>) {
+    let note = |m: &str| ctx.progress.note(m);
     let cache: TermsCache = RefCell::new(vec![None; candidates.len()]);
-    let scores: Vec<&CandidateScore> = fitted.iter().map(|f| &f.score).collect();
-    let closeness = |i: usize, j: usize| {
-        closeness_of(ev, candidates, fitted, &cache, test.inflation, (i, j))
-            .unwrap_or(f64::INFINITY)
+    let n = ctx.measured.n();
+    let decision = loop {
+        let scores: Vec<&CandidateScore> = fitted.iter().map(|f| &f.score).collect();
+        let closeness = |i: usize, j: usize| {
+            closeness_of(ev, candidates, fitted, &cache, test.inflation, (i, j))
+                .unwrap_or(f64::INFINITY)
+        };
+        let d = decide(&scores, before, n, test.level, &closeness);
+        let wanted: Vec<usize> = d
+            .named
+            .into_iter()
+            .chain(d.indistinguishable.iter().copied())
+            .filter(|&i| !fitted[i].profiled)
+            .collect();
+        if wanted.is_empty() {
+            break d;
+        }
+        for i in wanted {
+            note(&format!(
+                "profile-likelihood intervals of {}…",
+                candidates[i].name()
+            ));
+            profile_candidate(ev, candidates[i].as_ref(), &mut fitted[i], test, &note);
+            let s = &fitted[i].score;
+            note(&format!(
+                "  {}: {} profile evaluations, {:.1} s for the fit and profiles; {}",
+                s.name,
+                s.profile_evaluations,
+                s.seconds,
+                s.parameters
+                    .iter()
+                    .map(|p| format!(
+                        "{} {:.4e} [{}, {}]",
+                        p.name,
+                        p.value,
+                        p.interval.lower.map_or("?".into(), |v| format!("{v:.4e}")),
+                        p.interval.upper.map_or("?".into(), |v| format!("{v:.4e}"))
+                    ))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
     };
-    let decision = decide(&scores, before, n, test.level, &closeness);
     let mut scores: Vec<CandidateScore> = fitted.iter().map(|f| f.score.clone()).collect();
     if let Some(i) = decision.named {
         for (j, s) in scores.iter_mut().enumerate() {
@@ -366,47 +406,6 @@ fn decide_step(
         }
     }
     (decision, scores)
-}
-
-/// Profile-likelihood intervals of the candidate `step` named, against the model it was
-/// tested on (`model`, the step's stage 1), from the fit the step kept
-/// ([`Step::named_fit`]); the step's score of it is replaced by the profiled one (where a
-/// profile finds a higher point the candidate is fitted again from there and scored anew:
-/// [`profile_candidate`]). `candidate` is the named one.
-pub(crate) fn profile_named(
-    ctx: &Context,
-    step: &mut Step,
-    model: &ComparedModel,
-    candidate: &dyn Candidate,
-) {
-    let (Some(i), Some(fit)) = (step.named, step.named_fit.take()) else {
-        return;
-    };
-    let ev = ctx.evaluator(&model.edit);
-    let test = Test {
-        l0: model.log_likelihood,
-        n: ctx.measured.n(),
-        inflation: ctx.inflation(),
-        level: ctx.settings.candidate_level() / step.candidates.len().max(1) as f64,
-    };
-    let mut fitted = Fitted {
-        score: step.candidates[i].clone(),
-        fit: Some(fit),
-    };
-    let note = |m: &str| ctx.progress.note(m);
-    note(&format!(
-        "profile-likelihood intervals of {} (step {})…",
-        candidate.name(),
-        step.number
-    ));
-    profile_candidate(&ev, candidate, &mut fitted, &test, &note);
-    ctx.count(&ev);
-    let vuong_z = step.candidates[i].vuong_z;
-    step.candidates[i] = CandidateScore {
-        vuong_z,
-        ..fitted.score
-    };
-    step.named_fit = fitted.fit;
 }
 
 /// Vuong's z of fitted candidate i against j ([`vuong`]), `inflation` = c = 1 + n/N;
