@@ -34,10 +34,16 @@
 //! mixed entries of the pretension's row read as correlations of 0.72, 1.17, 0.75 and 2.06
 //! at those steps (no positive definite matrix has one above 1), and 0.05 to 0.24 at steps
 //! twice and three times as long, which agree. So where `A` at the maximum is not positive
-//! definite, it is measured again with every step [`LONGER_STEPS`] times as long, without
-//! adapting them, and the first positive definite one is kept (else the first: the Wald
-//! intervals are then not found). A fit whose `A` is positive definite at the likelihood's
-//! own scale is untouched.
+//! definite *and* a mixed entry exceeds what its two diagonal entries allow any curvature
+//! (`A_ij² > A_ii·A_jj`: a 2 × 2 principal minor below zero, which only the noise of the
+//! mixed differences makes), it is measured again with every step [`LONGER_STEPS`] times
+//! as long, without adapting them, and the first positive definite one is kept (else the
+//! first: the Wald intervals are then not found). An `A` that is merely indefinite, every
+//! pair consistent, is what a flat ridge measures (two effects explaining the same signal,
+//! a temperature offset and a batten length bias: eigenvalues −0.7 and −0.03 against 9e6,
+//! the largest correlation 0.97), and it is kept: the confounding tests read such a
+//! ridge from it ([`crate::selection::confound`]). A fit whose `A` is positive definite
+//! at the likelihood's own scale is untouched.
 //!
 //! ## Wald intervals
 //!
@@ -289,8 +295,21 @@ fn sr1_mixed(h: &DMatrix<f64>, s: &DVector<f64>, y: &DVector<f64>) -> DMatrix<f6
     next
 }
 
+/// Whether a mixed entry of `a` is larger than its two diagonal entries allow any curvature
+/// (`a_ij² > a_ii·a_jj`, both positive): a 2 × 2 principal minor that is negative, which
+/// only noise in the mixed differences makes (module doc).
+fn pairwise_inconsistent(a: &DMatrix<f64>) -> bool {
+    let k = a.nrows();
+    (0..k).any(|i| {
+        (0..i).any(|j| {
+            a[(i, i)] > 0.0 && a[(j, j)] > 0.0 && a[(i, j)] * a[(i, j)] > a[(i, i)] * a[(j, j)]
+        })
+    })
+}
+
 /// `A = −H` and `B` at the maximum `t` from the derivatives `d` measured there; where that
-/// `A` is not positive definite, measured again at steps [`LONGER_STEPS`] times longer, the
+/// `A` is not positive definite and a pair of its entries is inconsistent
+/// ([`pairwise_inconsistent`]), measured again at steps [`LONGER_STEPS`] times longer, the
 /// first positive definite one kept (module doc), else `d`'s.
 fn curvature_at_maximum(
     t: &[f64],
@@ -301,7 +320,7 @@ fn curvature_at_maximum(
     evaluations: &mut usize,
 ) -> Result<(DMatrix<f64>, DMatrix<f64>), DiagnoseError> {
     let a = -&d.hessian;
-    if nalgebra::Cholesky::new(a.clone()).is_some() {
+    if nalgebra::Cholesky::new(a.clone()).is_some() || !pairwise_inconsistent(&a) {
         return Ok((a, d.variability));
     }
     for factor in LONGER_STEPS {
@@ -512,6 +531,35 @@ mod tests {
             assert!((a[(i, i)] * se * se - 1.0).abs() < 1e-9, "{a}");
         }
         assert!((correlation(&a) - 0.75).abs() < 1e-9, "{a}");
+    }
+
+    /// A flat ridge is not noise: an exact quadratic whose curvature is indefinite though
+    /// every pair of parameters is consistent (correlations ±0.99; vᵀCv = 3 − 6·0.99 < 0 for
+    /// v = (1, −1, 1)) keeps the A measured at its own steps, with no further evaluation:
+    /// only a 2 × 2 minor below zero is read as noise.
+    #[test]
+    fn an_indefinite_but_consistent_curvature_is_kept() {
+        let c = [[1.0, 0.99, -0.99], [0.99, 1.0, 0.99], [-0.99, 0.99, 1.0]];
+        let se = 0.01;
+        let mut f = |t: &[f64]| -> Result<Terms, DiagnoseError> {
+            let x: Vec<f64> = t.iter().map(|v| (v - 0.5) / se).collect();
+            let q: f64 = (0..3)
+                .flat_map(|i| (0..3).map(move |j| (i, j)))
+                .map(|(i, j)| c[i][j] * x[i] * x[j])
+                .sum();
+            Ok(vec![-0.5 * q])
+        };
+        let t = [0.5; 3];
+        let terms = f(&t).unwrap();
+        let mut evaluations = 0;
+        let d = derivatives(&t, &terms, &[se; 3], None, &mut f, &mut evaluations).unwrap();
+        let measured = -&d.hessian;
+        assert!(nalgebra::Cholesky::new(measured.clone()).is_none());
+        assert!(!pairwise_inconsistent(&measured), "{measured}");
+        let before = evaluations;
+        let (a, _) = curvature_at_maximum(&t, &terms, d, None, &mut f, &mut evaluations).unwrap();
+        assert_eq!(a, measured);
+        assert_eq!(evaluations, before);
     }
 
     /// A concave quadratic with its maximum inside the cube is found in a few iterations, and
