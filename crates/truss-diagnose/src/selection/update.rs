@@ -474,3 +474,47 @@ fn best_swap<'a>(
         None => (full, None),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A pair named together joins the model in the step's order, both leaving the
+    /// candidates still to try: backlash (alone ΔBIC −8) keeps as rivals the significant
+    /// candidates that explained at least half as much (length_bias at −20), the
+    /// pretension (alone +1, explaining nothing) none, and neither has the other as a
+    /// rival.
+    #[test]
+    fn a_pair_joins_the_model_each_with_its_own_rivals() {
+        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../jobs/diagnose-baseline.json");
+        let baseline = crate::comparison::baseline::Baseline::read(&job, "as-built").unwrap();
+        let (remaining, _) = crate::candidates::library(&baseline);
+        let order: Vec<&str> = remaining.iter().map(|c| c.name()).collect();
+        let scores: Vec<CandidateScore> = order
+            .iter()
+            .map(|&n| match n {
+                "backlash" => CandidateScore::of_test(n, 1, -8.0, true),
+                "length_bias" => CandidateScore::of_test(n, 3, -20.0, true),
+                "diagonal_pretension" => CandidateScore::of_test(n, 1, 1.0, false),
+                _ => CandidateScore::of_test(n, 3, 5.0, false),
+            })
+            .collect();
+        let at = |n: &str| order.iter().position(|&o| o == n).unwrap();
+        let mut pool = Pool {
+            remaining,
+            added: Vec::new(),
+        };
+        let named = [at("backlash"), at("diagonal_pretension")];
+        admit(&mut pool, 1, &named, &scores, &[]);
+        let added: Vec<&str> = pool.added.iter().map(|a| a.candidate.name()).collect();
+        assert_eq!(added, ["backlash", "diagonal_pretension"]);
+        assert_eq!(pool.remaining.len(), order.len() - 2);
+        assert!(pool.remaining.iter().all(|c| !added.contains(&c.name())));
+        let rivals =
+            |i: usize| -> Vec<&str> { pool.added[i].rivals.iter().map(|r| r.0.as_str()).collect() };
+        assert_eq!(rivals(0), ["length_bias"]);
+        assert!(rivals(1).is_empty());
+        assert!(pool.added.iter().all(|a| a.step == 1));
+    }
+}
