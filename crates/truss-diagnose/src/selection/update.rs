@@ -5,8 +5,9 @@
 //!
 //! ## Backward elimination
 //!
-//! For each effect e added in an earlier step (not the one just added, which its own step
-//! has just tested given all the others), the model without e is re-fitted jointly, and e
+//! For each effect e added in an earlier step (not the one just added, nor a pair just
+//! named together, [`crate::selection::pair`], which their own step has just tested given
+//! all the others), the model without e is re-fitted jointly, and e
 //! is tested as a candidate is, against that reduced model: Λₑ = 2(ℓ̂ − ℓ̂₋ₑ)/(c·λₑ),
 //! p = P(χ²_{kₑ} ≥ Λₑ), ΔBICₑ = λₑ·(kₑ ln n − Λₑ), with c = 1 + n/N and λₑ = max(1, the mean
 //! over e's parameters of the one-parameter misspecification factor (A⁻¹BA⁻¹)ⱼⱼ/(A⁻¹)ⱼⱼ of
