@@ -194,6 +194,39 @@ mod tests {
         assert!(between("backlash", "thermal_gradient").starts_with("a measurement that only"));
     }
 
+    /// The interactions the candidates declare: each names a registered candidate and is
+    /// declared on both sides; the one pair is backlash with the diagonal pretension (the
+    /// pretension pulls the joints into contact), and no other two interact.
+    #[test]
+    fn interactions_are_declared_on_both_sides() {
+        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../jobs/diagnose-baseline.json");
+        let baseline = Baseline::read(&job, "as-built").unwrap();
+        let (candidates, _) = library(&baseline);
+        let mut pairs = Vec::new();
+        for a in &candidates {
+            for &b in a.interacts_with() {
+                assert!(
+                    REGISTRY.iter().any(|r| r.name == b),
+                    "{b} is not registered"
+                );
+                let other = candidates.iter().find(|c| c.name() == b).unwrap();
+                assert!(
+                    other.interacts_with().contains(&a.name()),
+                    "{} declares {b}, not the other way round",
+                    a.name()
+                );
+            }
+            for b in &candidates {
+                if a.name() < b.name() && candidate::interact(a.as_ref(), b.as_ref()) {
+                    pairs.push((a.name(), b.name()));
+                }
+            }
+            assert!(!candidate::interact(a.as_ref(), a.as_ref()));
+        }
+        assert_eq!(pairs, [("backlash", "diagonal_pretension")]);
+    }
+
     fn paper_job(case: &str) -> Baseline {
         let job =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../jobs/paper-4.2.3.json");

@@ -67,7 +67,13 @@
 //!    spoils a model that agreed in distribution (the discrepancy grows beyond its noise,
 //!    or turns significant: it is then not added; [`selection::step`]), or none is left. An effect
 //!    removed because another took over what it explained is listed as indistinguishable
-//!    from it, with the measurement that would separate them. The false
+//!    from it, with the measurement that would separate them. Effects that show only
+//!    together (backlash with a diagonal pretension, each alone fitting poorly) are found
+//!    by a pair step ([`selection::pair`]): candidates whose effects interact
+//!    ([`candidates::Candidate::interacts_with`]), one of them significant at the step and
+//!    neither named, are fitted jointly against the current model and named together in
+//!    place of the step's effect when significant and better by ΔBIC ≤ −2, or listed as an
+//!    alternative reading (`a + b`) when within ΔBIC 2 of it. The false
 //!    discovery rate over the steps is held at α/2 by ForwardStop on the steps'
 //!    Bonferroni-adjusted p-values ([`selection::forward_stop`]; removals only take effects
 //!    out); the other half of α = 0.05 is the comparison's ([`comparison::statistics::LEVEL`]), so that on

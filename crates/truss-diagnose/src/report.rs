@@ -3,7 +3,7 @@
 //! in words that both reports carry; [`markdown()`] renders `diagnosis.md`, and [`p_text`]
 //! and [`p_is`] write p-values as the reports and the verdicts' reasons show them.
 //!
-//! ## diagnosis.json (format `truss-diagnose`, version 10)
+//! ## diagnosis.json (format `truss-diagnose`, version 11)
 //!
 //! ```text
 //! format, format_version, program_version
@@ -25,11 +25,14 @@
 //!              ("named" when an effect was added, else step 1's verdict)
 //! named_effect "none" or the first added effect's name
 //! named_effects [names]   every effect added, in order; [] when none
-//! steps       [{number, verdict, reason, named_effect ("none" when nothing was named),
+//! steps       [{number, verdict, reason, named_effect ("none" when nothing was named; for
+//!               a pair named together, its first member: both are in `named_effects`),
 //!               kept (added to the model: significant, better by BIC, not spoiling a
 //!               model that agreed in distribution, and kept by the false discovery rate
 //!               over the steps; a later step may still remove or replace it),
-//!               parameters[] (the named effect's, as below), indistinguishable[],
+//!               parameters[] (the named effect's, as below; a pair's first member's
+//!               from the pair's joint fit), indistinguishable[] (a pair listed as an
+//!               alternative reading is one entry `a + b`),
 //!               adjusted_p (min(1, K·p) of the named one), log_likelihood_before,
 //!               candidates[] (as below, against the model of the step's start),
 //!               refitted[] {name, parameters[]} (every effect of the model after this
@@ -39,6 +42,14 @@
 //!               explained_by?, separate_by} (earlier effects this step removed: given the
 //!               others they no longer improve the fit; `explained_by` took over what they
 //!               explained and is indistinguishable from them on these data),
+//!               pair? {effects [a, b], k (k_a + k_b), parameters [[…], […]] (each
+//!               member's, Wald intervals of the joint fit), log_likelihood, lr_statistic,
+//!               adjustment, p_value, significant, delta_bic (against the step's model),
+//!               decision_delta_bic (the named candidate's, 0 when none), outcome
+//!               ("named" | "alternative" | "not_better"), evaluations, seconds}: two
+//!               candidates whose effects interact, one of them significant at the step and
+//!               neither named, fitted jointly (crate::selection::pair); absent when no
+//!               pair was fitted,
 //!               discrepancy_before, discrepancy_after, discrepancy_noise_before,
 //!               discrepancy_noise_after (the energy distances' permutation noise), seconds}]
 //! effects     [{name, parameters [[name, unit, value]]}]   the final model's effects at
@@ -125,6 +136,11 @@
 //!              updated model; the final fit; the confounding tests)}
 //! ```
 //!
+//! Version 11 (from 10): `steps[].pair`, the pair of interacting candidates fitted jointly
+//! at a step; a step that names a pair has both in `named_effects` and the verdicts'
+//! reasons, its `named_effect` the first; `indistinguishable` fields may list a pair as
+//! `a + b`.
+//!
 //! Version 10 (from 9): `answer`, the answer the reports share; diagnosis.md opens with
 //! its lines and its `## Next step` section became the answer's `next` lines; the naming
 //! limits in `unseen[].limit`. The `gravity` candidate's `g_x`, `g_y`, `g_z` are each
@@ -184,6 +200,7 @@ use crate::selection::confound::Confounding;
 use crate::selection::decide::Verdict;
 use crate::selection::eliminate::Removal;
 use crate::selection::model::{ModelEffect, RefitEffect};
+use crate::selection::pair::PairScore;
 use crate::selection::step::Step;
 use crate::selection::{Diagnosis, Indistinguishable};
 use method::{METHOD, Method};
@@ -202,7 +219,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 10;
+pub const FORMAT_VERSION: u32 = 11;
 
 #[derive(Serialize)]
 struct JobRef<'a> {
@@ -285,6 +302,8 @@ struct StepReport<'a> {
     candidates: &'a [CandidateScore],
     refitted: &'a [RefitEffect],
     removed_effects: &'a [Removal],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pair: Option<&'a PairScore>,
     discrepancy_before: f64,
     discrepancy_noise_before: f64,
     discrepancy_after: f64,
@@ -300,7 +319,7 @@ impl<'a> StepReport<'a> {
             reason: &s.reason,
             named_effect: s.named_effect().unwrap_or("none"),
             kept: s.kept,
-            parameters: s.named_score().map_or(&[][..], |c| &c.parameters),
+            parameters: s.named_parameters(),
             indistinguishable: s
                 .named_effect()
                 .map_or(&[][..], |e| d.indistinguishable_of(e, s.number)),
@@ -309,6 +328,7 @@ impl<'a> StepReport<'a> {
             candidates: &s.candidates,
             refitted: &s.refitted,
             removed_effects: &s.removed,
+            pair: s.pair.as_ref(),
             discrepancy_before: s.before.energy,
             discrepancy_noise_before: s.before.energy_noise,
             discrepancy_after: s.after.as_ref().map_or(s.before.energy, |a| a.energy),
@@ -359,7 +379,7 @@ pub fn json(
         named_effect: d.named_effect(),
         named_effects: d.named_effects(),
         parameters: if first_named.kept && first_named.named_effect() == Some(d.named_effect()) {
-            first_named.named_score().map_or(&[][..], |c| &c.parameters)
+            first_named.named_parameters()
         } else {
             // Swapped in: the last joint re-fit's.
             d.steps

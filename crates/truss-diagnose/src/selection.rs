@@ -6,7 +6,12 @@
 //! remaining candidate against it ([`crate::likelihood::score`]), decides from the tests and
 //! BIC ([`decide`]; the named candidate and those indistinguishable from it get
 //! profile-likelihood intervals, [`crate::likelihood::profile`], and should a profile find a
-//! higher maximum the verdict is decided again on the new fits), and updates the model
+//! higher maximum the verdict is decided again on the new fits; then a pair of candidates
+//! whose effects interact, one of them significant and neither named, is fitted jointly
+//! and named in the step's effect's place when it is significant and better by BIC, or
+//! listed as an alternative reading when as good, [`pair`]: forward selection adds one
+//! effect at a time, and two effects that show only together would each fit poorly
+//! alone), and updates the model
 //! ([`update`]): the named effect is added at its fitted values, every effect of the model
 //! is re-fitted jointly, the effects added earlier are tested for removal given the others
 //! and tried swapped for a rival. The selection stops at the first step that names nothing
@@ -34,6 +39,7 @@ pub mod confound;
 pub mod decide;
 pub mod eliminate;
 pub mod model;
+pub mod pair;
 pub mod ridge;
 pub mod step;
 pub mod unseen;
@@ -151,7 +157,7 @@ impl Diagnosis {
 fn final_effects(steps: &[Step]) -> Vec<&str> {
     let mut names: Vec<&str> = Vec::new();
     for s in steps.iter().filter(|s| s.kept) {
-        names.extend(s.named_effect());
+        names.extend(s.named_effects());
         for r in &s.removed {
             match &r.replaced_by {
                 Some(by) => {
@@ -410,7 +416,7 @@ pub fn indistinguishable(steps: &[Step], confounding: &[Confound]) -> Vec<Indist
         }
     };
     for s in steps {
-        if let Some(named) = s.named_effect() {
+        for named in s.named_effects() {
             out.push(Indistinguishable {
                 effect: named.to_string(),
                 step: s.number,
@@ -459,7 +465,10 @@ fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
             format!(
                 "step {}: {} ({})",
                 s.number,
-                s.named_effect().unwrap_or("none"),
+                match s.named_effects().join(" and ") {
+                    n if n.is_empty() => "none".to_string(),
+                    n => n,
+                },
                 s.reason
             )
         })
@@ -471,7 +480,12 @@ fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
         format!("step {}: {}", last.number, last.reason)
     };
     let names = final_effects(steps);
-    let model = if names.len() == kept {
+    let entered: usize = steps
+        .iter()
+        .filter(|s| s.kept)
+        .map(|s| s.named_effects().len())
+        .sum();
+    let model = if names.len() == entered {
         String::new()
     } else {
         format!(
@@ -482,8 +496,14 @@ fn overall(steps: &[Step], kept: usize) -> (Verdict, String) {
     (
         Verdict::Named,
         format!(
-            "{kept} effect{} added in turn{model}. {}. Finally, {end}",
-            if kept == 1 { "" } else { "s" },
+            "{entered} effect{} added in {}{model}. {}. Finally, {end}",
+            if entered == 1 { "" } else { "s" },
+            match kept {
+                1 if entered == 1 => "turn".to_string(),
+                1 => "one step, as a pair whose effects act together".to_string(),
+                k if entered == k => "turn".to_string(),
+                k => format!("{k} steps (a pair together in one)"),
+            },
             added.join(". ")
         ),
     )
@@ -515,6 +535,8 @@ mod tests {
             verdict: Verdict::Named,
             reason: String::new(),
             named: Some(0),
+            partner: None,
+            pair: None,
             kept,
             indistinguishable: Vec::new(),
             candidates: vec![CandidateScore::of_test(named, 1, -10.0, true)],

@@ -71,6 +71,22 @@ pub trait Candidate: Send + Sync {
     fn mistaken_without_members(&self, _rival: Trace) -> bool {
         false
     }
+    /// The candidates (by name) whose effect this one's changes, so that the two may show
+    /// only together: each alone fits the data poorly, both fitted at once fit well
+    /// (backlash with a diagonal pretension: the pretension sets how far the joints are
+    /// pulled into contact). The selection fits such a pair jointly when one of the two is
+    /// significant at a step and neither is named ([`crate::selection::pair`]). Declared
+    /// on both sides ([`interact`] asks either); the default is none.
+    fn interacts_with(&self) -> &'static [&'static str] {
+        &[]
+    }
+}
+
+/// Whether `a` and `b` declare that their effects interact ([`Candidate::interacts_with`],
+/// either side).
+pub fn interact(a: &dyn Candidate, b: &dyn Candidate) -> bool {
+    a.name() != b.name()
+        && (a.interacts_with().contains(&b.name()) || b.interacts_with().contains(&a.name()))
 }
 
 /// The measurement that tells `a` from `b` when node positions cannot: the one either

@@ -6,6 +6,7 @@
 //! end of the range, where P(χ²₁ ≥ Λ) is conservative: the null distribution is
 //! ½χ²₀ + ½χ²₁.
 
+use super::backlash::Backlash;
 use super::candidate::{Candidate, MEMBER_LENGTHS, Registration, Trace, member_groups};
 use super::length_bias::shifted;
 use super::parameter::Parameter;
@@ -79,5 +80,10 @@ impl Candidate for DiagonalPretension {
             Trace::BarLengths | Trace::JointPlay => Some(MEMBER_LENGTHS),
             Trace::Orientation | Trace::CableLengths | Trace::LengthScatter => None,
         }
+    }
+    /// The pretension sets how far pin joints with free play are pulled into contact
+    /// ([`Backlash`]'s side of it).
+    fn interacts_with(&self) -> &'static [&'static str] {
+        &[Backlash::NAME]
     }
 }

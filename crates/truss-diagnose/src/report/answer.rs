@@ -12,7 +12,7 @@
 //! temperature in K, a gradient in K/mm, self-weight in g; a scatter's factor as the
 //! fitted scatter in µm.
 
-use super::wording::{code_list, effect};
+use super::wording::{code_list, effect, rival_effects};
 use crate::candidates::candidate::{Candidate, separating_measurement};
 use crate::candidates::parameter::two_digit_decimals;
 use crate::comparison::measured::Measured;
@@ -261,10 +261,13 @@ fn cannot_tell_apart(d: &Diagnosis) -> Vec<CannotTellApart> {
         for o in &r.rivals {
             if !entry.rivals.contains(o) {
                 entry.rivals.push(o.clone());
-                entry.separate_by.push(format!(
-                    "from `{o}`, {}",
-                    separating_measurement(a, effect(d, o))
-                ));
+                let by: Vec<&str> = rival_effects(d, o, &r.effect)
+                    .into_iter()
+                    .map(|b| separating_measurement(a, b))
+                    .collect();
+                entry
+                    .separate_by
+                    .push(format!("from `{o}`, {}", by.join("; and ")));
             }
         }
     }
@@ -281,8 +284,9 @@ fn next_steps(measured: &Measured, d: &Diagnosis, apart: &[CannotTellApart]) -> 
             .rivals
             .iter()
             .filter(|o| {
-                let b = effect(d, o);
-                a.mistaken_without_members(b.trace()) || b.mistaken_without_members(a.trace())
+                rival_effects(d, o, &k.effect).iter().any(|b| {
+                    a.mistaken_without_members(b.trace()) || b.mistaken_without_members(a.trace())
+                })
             })
             .collect();
         if !mistaken.is_empty() && measured.members.is_none() {

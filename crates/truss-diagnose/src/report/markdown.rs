@@ -90,7 +90,7 @@ fn verdict_section(m: &mut String, baseline: &Baseline, d: &Diagnosis) {
             .steps
             .iter()
             .filter(|s| s.kept)
-            .find(|s| s.named_effect() == Some(e.name.as_str()));
+            .find(|s| s.named_effects().contains(&e.name.as_str()));
         let joint = d.final_fit.len() > 1
             || step.is_none_or(|s| {
                 s.named_score().is_none_or(|n| {

@@ -115,6 +115,17 @@ pub(super) fn code_list(names: &[impl std::fmt::Display], separator: &str) -> St
         .join(separator)
 }
 
+/// The effects a rival stands for: itself, or each member of a pair listed as an
+/// alternative reading (`a + b`, [`crate::selection::pair::label`]), less `of` (a rival
+/// pair that shares a member with the effect it is listed against).
+pub(super) fn rival_effects<'a>(d: &'a Diagnosis, rival: &str, of: &str) -> Vec<&'a dyn Candidate> {
+    rival
+        .split(" + ")
+        .filter(|&r| r != of)
+        .map(|r| effect(d, r))
+        .collect()
+}
+
 /// The library's candidate named `name`: every effect a report names is one of them.
 pub(super) fn effect<'a>(d: &'a Diagnosis, name: &str) -> &'a dyn Candidate {
     d.candidate(name)

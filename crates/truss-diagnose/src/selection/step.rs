@@ -11,7 +11,10 @@
 //!    maximised and tested against the current model ([`crate::likelihood::score`]).
 //! 3. **decide** (`decide_and_profile`): the verdict of [`decide`]; the candidate it names
 //!    and those indistinguishable from it get profile-likelihood intervals, and should a
-//!    profile find a higher maximum the verdict is decided again on the new fits.
+//!    profile find a higher maximum the verdict is decided again on the new fits. Then a
+//!    pair of candidates whose effects interact, one of them significant and neither named,
+//!    is fitted jointly and may be named in the named one's place, or be listed as an
+//!    alternative reading ([`crate::selection::pair`]).
 //! 4. **update** ([`crate::selection::update`]): the named candidate is added at its fitted values, every
 //!    effect of the model is re-fitted jointly and each effect added in an earlier step is
 //!    tested for removal given the others and tried swapped for a rival; the updated
@@ -46,13 +49,15 @@ use crate::errors::DiagnoseError;
 use crate::likelihood::derivatives::Terms;
 use crate::likelihood::joint::JointFit;
 use crate::likelihood::score::{
-    CandidateScore, Evaluator, Fitted, Test, fit_candidate, p_is, p_text, profile_candidate,
+    CandidateScore, Evaluator, Fitted, FittedParameter, Test, fit_candidate, p_is, p_text,
+    profile_candidate,
 };
 use crate::selection::decide::{Decision, Verdict, decide, vuong};
 use crate::selection::eliminate::Removal;
 use crate::selection::model::{
     ComparedModel, Context, ModelEffect, Pool, RefitEffect, compare_model,
 };
+use crate::selection::pair::{self, PairOutcome, PairScore};
 use crate::selection::update::update;
 use std::cell::RefCell;
 use std::time::Instant;
@@ -72,6 +77,12 @@ pub struct Step {
     pub reason: String,
     /// The named candidate's index in `candidates`.
     pub named: Option<usize>,
+    /// The candidate named with it as a pair whose effects act together
+    /// ([`crate::selection::pair`]), its index in `candidates`.
+    pub partner: Option<usize>,
+    /// The pair of interacting candidates fitted jointly at this step, if one was
+    /// ([`crate::selection::pair`]), and what became of it.
+    pub pair: Option<PairScore>,
     /// Whether the named effect is kept (the false discovery rate over the steps; see
     /// [`crate::selection`]). A named effect that is not kept ends the selection.
     pub kept: bool,
@@ -111,6 +122,25 @@ impl Step {
         self.named.map(|i| self.candidates[i].name.as_str())
     }
 
+    /// The effects that enter the model at this step: the named one, and its partner when
+    /// a pair is named.
+    pub fn named_effects(&self) -> Vec<&str> {
+        self.named
+            .into_iter()
+            .chain(self.partner)
+            .map(|i| self.candidates[i].name.as_str())
+            .collect()
+    }
+
+    /// The named effect's parameters as it entered the model: its own fit's, or for a
+    /// pair named together the pair's joint fit's; empty when nothing was named.
+    pub fn named_parameters(&self) -> &[FittedParameter] {
+        match (&self.pair, self.partner) {
+            (Some(p), Some(_)) => &p.parameters[0],
+            _ => self.named_score().map_or(&[][..], |c| &c.parameters),
+        }
+    }
+
     /// The named effect's score.
     pub fn named_score(&self) -> Option<&CandidateScore> {
         self.named.map(|i| &self.candidates[i])
@@ -133,7 +163,10 @@ pub(crate) fn compare(
     ctx.progress.note(&format!(
         "step {}: with {}: energy distance {:.3} (p = {:.3}), was {:.3}",
         step.number,
-        step.named_effect().unwrap_or("none"),
+        match step.named_effects().join(" and ") {
+            n if n.is_empty() => "none".to_string(),
+            n => n,
+        },
         model.comparison.energy,
         model.comparison.energy_p,
         before.comparison.energy
@@ -237,6 +270,33 @@ pub(crate) fn run(
             )
         },
     );
+    // 3b. A pair whose effects act together, fitted jointly when one of the two was
+    // significant and neither named (selection::pair).
+    let mut decision = decision;
+    let pairs = pair::pairs_of(candidates, &scores, decision.named);
+    let note = |m: &str| ctx.progress.note(m);
+    let pair = (!pairs.is_empty())
+        .then(|| {
+            ctx.timed(
+                format!("step {number}: fit an interacting pair"),
+                Some(&ev),
+                || {
+                    pair::consider(
+                        &ev,
+                        candidates,
+                        &pairs,
+                        &scores,
+                        decision.named,
+                        &test,
+                        &note,
+                    )
+                },
+            )
+        })
+        .flatten();
+    let partner = pair
+        .as_ref()
+        .and_then(|p| pair::settle(&mut decision, p, &scores));
     ctx.count(&ev);
     let Decision {
         verdict,
@@ -246,16 +306,38 @@ pub(crate) fn run(
     } = decision;
     ctx.progress
         .note(&format!("step {number}: {}: {reason}", verdict.words()));
-    let adjusted_p = named.map(|i| (scores[i].p_value * candidates.len() as f64).min(1.0));
-    let indistinguishable = indistinguishable
+    let p_named = match (&pair, partner) {
+        (Some(p), Some(_)) => Some(p.p_value),
+        _ => named.map(|i| scores[i].p_value),
+    };
+    let adjusted_p = p_named.map(|p| (p * candidates.len() as f64).min(1.0));
+    let mut indistinguishable: Vec<String> = indistinguishable
         .iter()
         .map(|&j| scores[j].name.clone())
         .collect();
-    // 4. Update.
+    if let Some(p) = pair
+        .as_ref()
+        .filter(|p| p.outcome == PairOutcome::Alternative)
+    {
+        indistinguishable.push(p.label());
+    }
+    // 4. Update: the named effect, or the pair, at its fitted values.
+    let entering: Vec<(usize, Vec<f64>)> = match (&pair, partner) {
+        (Some(p), Some(_)) => p
+            .members
+            .iter()
+            .zip(&p.parameters)
+            .map(|(&i, ps)| (i, ps.iter().map(|x| x.value).collect()))
+            .collect(),
+        _ => named
+            .map(|i| (i, scores[i].parameters.iter().map(|p| p.value).collect()))
+            .into_iter()
+            .collect(),
+    };
     let up = named
-        .map(|i| {
+        .map(|_| {
             ctx.timed(format!("step {number}: update the model"), None, || {
-                update(ctx, number, pool, i, &scores)
+                update(ctx, number, pool, &entering, &scores)
             })
         })
         .transpose()?;
@@ -264,6 +346,8 @@ pub(crate) fn run(
         verdict,
         reason,
         named,
+        partner,
+        pair,
         kept: named.is_some(),
         indistinguishable,
         adjusted_p,

@@ -5,8 +5,9 @@
 //!
 //! ## Backward elimination
 //!
-//! For each effect e added in an earlier step (not the one just added, which its own step
-//! has just tested given all the others), the model without e is re-fitted jointly, and e
+//! For each effect e added in an earlier step (not the one just added, nor a pair just
+//! named together, [`crate::selection::pair`], which their own step has just tested given
+//! all the others), the model without e is re-fitted jointly, and e
 //! is tested as a candidate is, against that reduced model: Λₑ = 2(ℓ̂ − ℓ̂₋ₑ)/(c·λₑ),
 //! p = P(χ²_{kₑ} ≥ Λₑ), ΔBICₑ = λₑ·(kₑ ln n − Λₑ), with c = 1 + n/N and λₑ = max(1, the mean
 //! over e's parameters of the one-parameter misspecification factor (A⁻¹BA⁻¹)ⱼⱼ/(A⁻¹)ⱼⱼ of
@@ -65,6 +66,9 @@ pub(crate) struct Update {
     pub joint: Option<JointFit>,
 }
 
+/// An entering effect's rivals for a later swap: each name and its fitted values.
+type Rivals = Vec<(String, Vec<f64>)>;
+
 /// An effect of the model during the update: the candidate, its values, the step that added
 /// it.
 type Member<'a> = (&'a dyn Candidate, Vec<f64>, usize);
@@ -81,32 +85,36 @@ pub(crate) fn fit_jointly(
     fit
 }
 
-/// Stage 4, update: candidate `named` of the pool (scored in `scores`, the step's scores
-/// of the pool's candidates in order) added to the model at its fitted values, every effect
-/// re-fitted jointly, the earlier effects tested for removal given the others, the least
-/// needed removed while it is not needed, then the best swap for a rival (module doc); the
-/// pool follows (the named one and a swapped-in rival leave the candidates still to try; the
-/// model's effects take their new values). A joint fit that fails leaves the values as they
-/// were (and nothing is removed), with a note.
+/// Stage 4, update: the candidates `entering` of the pool (each its index and values: the
+/// named one at its fitted values, or a pair named together at their joint fit's,
+/// [`crate::selection::pair`]; `scores`, the step's scores of the pool's candidates in
+/// order) added to the model, every effect re-fitted jointly, the earlier effects tested
+/// for removal given the others, the least needed removed while it is not needed, then the
+/// best swap for a rival (module doc); the pool follows (the entering ones and a
+/// swapped-in rival leave the candidates still to try; the model's effects take their new
+/// values). A joint fit that fails leaves the values as they were (and nothing is
+/// removed), with a note.
 pub(crate) fn update(
     ctx: &Context,
     number: usize,
     pool: &mut Pool,
-    named: usize,
+    entering: &[(usize, Vec<f64>)],
     scores: &[CandidateScore],
 ) -> Result<Update, DiagnoseError> {
-    let values: Vec<f64> = scores[named].parameters.iter().map(|p| p.value).collect();
     let (members, refitted, removed, edit, joint) = {
         let rivals: Vec<&dyn Candidate> = pool
             .remaining
             .iter()
             .enumerate()
-            .filter(|&(j, _)| j != named)
+            .filter(|&(j, _)| !entering.iter().any(|e| e.0 == j))
             .map(|(_, c)| c.as_ref())
             .collect();
-        let new = pool.remaining[named].as_ref();
+        let new: Vec<(&dyn Candidate, &[f64])> = entering
+            .iter()
+            .map(|(i, v)| (pool.remaining[*i].as_ref(), v.as_slice()))
+            .collect();
         let (members, refitted, removed, joint) =
-            refit_and_eliminate(ctx, number, &pool.added, (new, &values), &rivals)?;
+            refit_and_eliminate(ctx, number, &pool.added, &new, &rivals)?;
         let mut edit = ctx.baseline.derived_case();
         for m in &members {
             m.0.apply(&m.1, &mut edit)?;
@@ -117,7 +125,8 @@ pub(crate) fn update(
             .collect();
         (members, refitted, removed, edit, joint)
     };
-    admit(pool, number, named, scores, &removed);
+    let named: Vec<usize> = entering.iter().map(|e| e.0).collect();
+    admit(pool, number, &named, scores, &removed);
     for (a, (name, v)) in pool.added.iter_mut().zip(&members) {
         debug_assert_eq!(a.candidate.name(), name);
         a.values.clone_from(v);
@@ -145,38 +154,55 @@ pub(crate) fn update(
     })
 }
 
-/// The pool after a step: the named candidate joins the model with its rivals for a later
-/// swap (the other candidates significant at this step that explained at least half as
-/// much), a swapped-in rival takes the place of the effect it replaced, and removed effects
-/// leave.
+/// The pool after a step: the named candidates (one, or a pair named together) join the
+/// model in order, each with its rivals for a later swap (the other candidates significant
+/// at this step that explained at least half as much as it did alone; none for a member of
+/// a pair that alone explained nothing, ΔBIC ≥ 0), a swapped-in rival
+/// takes the place of the effect it replaced, and removed effects leave.
 fn admit(
     pool: &mut Pool,
     number: usize,
-    named: usize,
+    named: &[usize],
     scores: &[CandidateScore],
     removed: &[Removal],
 ) {
-    let best = &scores[named];
-    let rivals = scores
+    let rivals = |i: usize| -> Rivals {
+        let best = &scores[i];
+        scores
+            .iter()
+            .enumerate()
+            .filter(|&(j, c)| {
+                best.delta_bic < 0.0
+                    && !named.contains(&j)
+                    && c.significant
+                    && c.error.is_none()
+                    && c.delta_bic <= 0.5 * best.delta_bic
+            })
+            .map(|(_, c)| {
+                (
+                    c.name.clone(),
+                    c.parameters.iter().map(|p| p.value).collect(),
+                )
+            })
+            .collect()
+    };
+    let entering: Vec<(String, Rivals)> = named
         .iter()
-        .enumerate()
-        .filter(|&(j, c)| {
-            j != named && c.significant && c.error.is_none() && c.delta_bic <= 0.5 * best.delta_bic
-        })
-        .map(|(_, c)| {
-            (
-                c.name.clone(),
-                c.parameters.iter().map(|p| p.value).collect(),
-            )
-        })
+        .map(|&i| (scores[i].name.clone(), rivals(i)))
         .collect();
-    let candidate = pool.remaining.remove(named);
-    pool.added.push(Added {
-        candidate,
-        values: Vec::new(),
-        step: number,
-        rivals,
-    });
+    for (name, rivals) in entering {
+        let i = pool
+            .remaining
+            .iter()
+            .position(|c| c.name() == name)
+            .expect("a named candidate was remaining");
+        pool.added.push(Added {
+            candidate: pool.remaining.remove(i),
+            values: Vec::new(),
+            step: number,
+            rivals,
+        });
+    }
     for r in removed {
         let Some(by) = &r.replaced_by else { continue };
         let e = pool
@@ -203,15 +229,15 @@ fn admit(
     });
 }
 
-/// The model's effects with the new one, re-fitted jointly, the earlier ones eliminated
-/// while not needed and the best swap made: the members at their values, the joint fit's
-/// effects, the removals, and the last joint fit.
+/// The model's effects with the new ones (one, or a pair named together), re-fitted
+/// jointly, the earlier ones eliminated while not needed and the best swap made: the
+/// members at their values, the joint fit's effects, the removals, and the last joint fit.
 #[allow(clippy::type_complexity)]
 fn refit_and_eliminate<'a>(
     ctx: &Context,
     number: usize,
     added: &'a [Added],
-    (new, new_values): (&'a dyn Candidate, &[f64]),
+    new: &[(&'a dyn Candidate, &[f64])],
     pool: &[&'a dyn Candidate],
 ) -> Result<
     (
@@ -226,8 +252,9 @@ fn refit_and_eliminate<'a>(
     let mut members: Vec<Member> = added
         .iter()
         .map(|a| (a.candidate.as_ref(), a.values.clone(), a.step))
-        .chain(std::iter::once((new, new_values.to_vec(), number)))
+        .chain(new.iter().map(|&(c, v)| (c, v.to_vec(), number)))
         .collect();
+    let fresh = new.len();
     let fit_of = |members: &[Member], steps: Option<&[f64]>| {
         let effects: Vec<(&dyn Candidate, &[f64])> =
             members.iter().map(|m| (m.0, m.1.as_slice())).collect();
@@ -242,9 +269,9 @@ fn refit_and_eliminate<'a>(
         }
     }
     let mut removed = Vec::new();
-    joint = joint.map(|full| eliminate(ctx, &mut members, full, &mut removed));
+    joint = joint.map(|full| eliminate(ctx, &mut members, fresh, full, &mut removed));
     if let Some(full) = joint.take() {
-        let (fit, swap) = best_swap(ctx, &members, added, pool, full);
+        let (fit, swap) = best_swap(ctx, &members, fresh, added, pool, full);
         if let Some((e, r, lr, delta_bic)) = swap {
             let gone = members[e].0;
             note(&format!(
@@ -265,7 +292,7 @@ fn refit_and_eliminate<'a>(
             members[e] = (r, Vec::new(), number);
             // The swapped model may leave another earlier effect unneeded (a stand-in for
             // the swapped-in effect's part): eliminate again from its fit.
-            joint = Some(eliminate(ctx, &mut members, fit, &mut removed));
+            joint = Some(eliminate(ctx, &mut members, fresh, fit, &mut removed));
         } else {
             joint = Some(fit);
         }
@@ -289,12 +316,14 @@ fn refit_and_eliminate<'a>(
     Ok((members, refitted, removed, joint))
 }
 
-/// Backward elimination (module doc) from the joint fit `full` of `members` (the last one
-/// just added, never tested): the least needed earlier effect removed while it is not
-/// needed, each removal added to `removed`; returns the joint fit of the members left.
+/// Backward elimination (module doc) from the joint fit `full` of `members` (the last
+/// `fresh` just added, tested by their own step): the least needed earlier effect removed
+/// while it is not needed, each removal added to `removed`; returns the joint fit of the
+/// members left.
 fn eliminate<'a>(
     ctx: &Context,
     members: &mut Vec<Member<'a>>,
+    fresh: usize,
     full: JointFit,
     removed: &mut Vec<Removal>,
 ) -> JointFit {
@@ -310,7 +339,7 @@ fn eliminate<'a>(
             m.1.clone_from(v);
         }
         let mut worst: Option<(usize, JointFit, (f64, f64, f64))> = None;
-        for e in 0..members.len() - 1 {
+        for e in 0..members.len() - fresh {
             let rest: Vec<Member> = members
                 .iter()
                 .enumerate()
@@ -385,20 +414,22 @@ fn eliminate<'a>(
             explained_by: explained_by.map(|x| x.name().to_string()),
         });
         joint = Some(reduced);
-        if members.len() == 1 {
+        if members.len() == fresh {
             break;
         }
     }
     joint.expect("the loop leaves the last joint fit")
 }
 
-/// The best swap of an earlier effect for one of its rivals still in the pool (module doc):
-/// the joint fit to go on with (the swapped model's, or `full`), and the swap made (the
-/// effect's index, the rival, 2(ℓ̂_swap − ℓ̂)/c, the BIC difference).
+/// The best swap of an earlier effect (not one of the last `fresh`, just added) for one of
+/// its rivals still in the pool (module doc): the joint fit to go on with (the swapped
+/// model's, or `full`), and the swap made (the effect's index, the rival,
+/// 2(ℓ̂_swap − ℓ̂)/c, the BIC difference).
 #[allow(clippy::type_complexity)]
 fn best_swap<'a>(
     ctx: &Context,
     members: &[Member<'a>],
+    fresh: usize,
     added: &[Added],
     pool: &[&'a dyn Candidate],
     full: JointFit,
@@ -406,7 +437,7 @@ fn best_swap<'a>(
     let (n, c) = (ctx.measured.n(), ctx.inflation());
     let now = bic(&full, n, ctx.samples);
     let mut best: Option<(usize, &dyn Candidate, JointFit, f64)> = None;
-    for (e, m) in members[..members.len() - 1].iter().enumerate() {
+    for (e, m) in members[..members.len() - fresh].iter().enumerate() {
         let Some(a) = added.iter().find(|a| a.candidate.name() == m.0.name()) else {
             continue;
         };
@@ -442,5 +473,49 @@ fn best_swap<'a>(
             (fit, Some((e, r, lr, delta)))
         }
         None => (full, None),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A pair named together joins the model in the step's order, both leaving the
+    /// candidates still to try: backlash (alone ΔBIC −8) keeps as rivals the significant
+    /// candidates that explained at least half as much (length_bias at −20), the
+    /// pretension (alone +1, explaining nothing) none, and neither has the other as a
+    /// rival.
+    #[test]
+    fn a_pair_joins_the_model_each_with_its_own_rivals() {
+        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../jobs/diagnose-baseline.json");
+        let baseline = crate::comparison::baseline::Baseline::read(&job, "as-built").unwrap();
+        let (remaining, _) = crate::candidates::library(&baseline);
+        let order: Vec<&str> = remaining.iter().map(|c| c.name()).collect();
+        let scores: Vec<CandidateScore> = order
+            .iter()
+            .map(|&n| match n {
+                "backlash" => CandidateScore::of_test(n, 1, -8.0, true),
+                "length_bias" => CandidateScore::of_test(n, 3, -20.0, true),
+                "diagonal_pretension" => CandidateScore::of_test(n, 1, 1.0, false),
+                _ => CandidateScore::of_test(n, 3, 5.0, false),
+            })
+            .collect();
+        let at = |n: &str| order.iter().position(|&o| o == n).unwrap();
+        let mut pool = Pool {
+            remaining,
+            added: Vec::new(),
+        };
+        let named = [at("backlash"), at("diagonal_pretension")];
+        admit(&mut pool, 1, &named, &scores, &[]);
+        let added: Vec<&str> = pool.added.iter().map(|a| a.candidate.name()).collect();
+        assert_eq!(added, ["backlash", "diagonal_pretension"]);
+        assert_eq!(pool.remaining.len(), order.len() - 2);
+        assert!(pool.remaining.iter().all(|c| !added.contains(&c.name())));
+        let rivals =
+            |i: usize| -> Vec<&str> { pool.added[i].rivals.iter().map(|r| r.0.as_str()).collect() };
+        assert_eq!(rivals(0), ["length_bias"]);
+        assert!(rivals(1).is_empty());
+        assert!(pool.added.iter().all(|a| a.step == 1));
     }
 }

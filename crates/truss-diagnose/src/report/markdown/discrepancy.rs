@@ -5,12 +5,13 @@
 
 use crate::comparison::baseline::Baseline;
 use crate::comparison::statistics::Statistic;
-use crate::likelihood::score::CandidateScore;
+use crate::likelihood::score::{CandidateScore, FittedParameter};
 use crate::likelihood::score::{p_is, p_text};
 use crate::report::wording::{
-    effect, g, interval_text, parameter_text, plain_reading, push, spans,
+    code_list, effect, g, interval_text, parameter_text, plain_reading, push, spans,
 };
 use crate::selection::Diagnosis;
+use crate::selection::pair::PairOutcome;
 use crate::selection::step::Step;
 
 /// A statistic's row: id, unit, measured, simulated, comparison with its interval, verdict.
@@ -90,9 +91,10 @@ pub(super) fn disagreement_section(m: &mut String, d: &Diagnosis) {
 /// `## Step s`: the candidates against the current model, the decision, the fit, and the
 /// discrepancy before and after.
 pub(super) fn step_section(m: &mut String, baseline: &Baseline, d: &Diagnosis, s: &Step) {
+    let named = code_list(&s.named_effects(), " and ");
     let title = match (s.named_effect(), s.kept) {
-        (Some(n), true) => format!("`{n}` added"),
-        (Some(n), false) => format!("`{n}` named but not kept"),
+        (Some(_), true) => format!("{named} added"),
+        (Some(_), false) => format!("{named} named but not kept"),
         (None, _) => "nothing more to add".into(),
     };
     push(m, &format!("## Step {}: {title}\n", s.number));
@@ -139,18 +141,53 @@ pub(super) fn step_section(m: &mut String, baseline: &Baseline, d: &Diagnosis, s
         m,
         "\n\\* significant at 0.025/K (Bonferroni over this step's K candidates at α/2). ℓ, Λ and ΔBIC are dimensionless; ΔBIC against the model of this step's start (negative: better). Vuong z: how much closer the named effect fits than this one (below 1.96: not significantly).\n",
     );
-    if let Some(c) = s.named_score() {
+    if let Some(p) = &s.pair {
+        push(
+            m,
+            &format!(
+                "Fitted jointly, because their effects interact: `{}`, k = {}, Λ = {:.1}, {}, ΔBIC = {:.1} against the step's decision's {:.1}: {}.\n",
+                p.label(),
+                p.k,
+                p.lr_statistic,
+                p_is(p.p_value),
+                p.delta_bic,
+                p.decision_delta_bic,
+                match p.outcome {
+                    PairOutcome::Named => "named as a pair (both enter the model)",
+                    PairOutcome::Alternative =>
+                        "an alternative reading, within ΔBIC 2 of the named effect",
+                    PairOutcome::NotBetter => "not better than the step's decision",
+                }
+            ),
+        );
+    }
+    let entered: Vec<(&str, &[FittedParameter])> = match (&s.pair, s.partner) {
+        (Some(p), Some(_)) => p
+            .effects
+            .iter()
+            .map(String::as_str)
+            .zip(p.parameters.iter().map(Vec::as_slice))
+            .collect(),
+        _ => s
+            .named_score()
+            .map(|c| (c.name.as_str(), c.parameters.as_slice()))
+            .into_iter()
+            .collect(),
+    };
+    if !entered.is_empty() {
         let span = spans(baseline);
-        let effect = effect(d, &c.name);
-        for (j, p) in c.parameters.iter().enumerate() {
-            push(
-                m,
-                &format!(
-                    "- {}: {}",
-                    parameter_text(effect, j, p),
-                    plain_reading(effect, j, p, span)
-                ),
-            );
+        for (name, parameters) in entered {
+            let effect = effect(d, name);
+            for (j, p) in parameters.iter().enumerate() {
+                push(
+                    m,
+                    &format!(
+                        "- {}: {}",
+                        parameter_text(effect, j, p),
+                        plain_reading(effect, j, p, span)
+                    ),
+                );
+            }
         }
         push(m, "");
     }
