@@ -11,7 +11,6 @@
 
 use super::candidate::{Candidate, MEMBER_LENGTHS, Registration, Trace};
 use super::parameter::Parameter;
-use super::pretension::DiagonalPretension;
 use crate::comparison::baseline::{Baseline, CaseEdit};
 use crate::errors::DiagnoseError;
 use truss_core::prism::BacklashOptions;
@@ -140,13 +139,6 @@ impl Candidate for Backlash {
     /// Joint free play shortens the truss much as a member-length error does.
     fn mistaken_without_members(&self, rival: Trace) -> bool {
         matches!(rival, Trace::BarLengths | Trace::CableLengths)
-    }
-    /// A diagonal pretension pulls the joints into contact: with the diagonals short the
-    /// shafts bear on their holes and the play closes; with them slack the stages float
-    /// within it. Alone against slack diagonals the clearance loosens what the data show
-    /// tight, and alone against free play a pretension stiffens what floats.
-    fn interacts_with(&self) -> &'static [&'static str] {
-        &[DiagonalPretension::NAME]
     }
 }
 

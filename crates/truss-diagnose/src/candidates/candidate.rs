@@ -76,7 +76,7 @@ pub trait Candidate: Send + Sync {
     /// (backlash with a diagonal pretension: the pretension sets how far the joints are
     /// pulled into contact). The selection fits such a pair jointly when one of the two is
     /// significant at a step and neither is named ([`crate::selection::pair`]). Declared
-    /// on both sides ([`interact`] asks either); the default is none.
+    /// by one of the two ([`interact`] asks either); the default is none.
     fn interacts_with(&self) -> &'static [&'static str] {
         &[]
     }

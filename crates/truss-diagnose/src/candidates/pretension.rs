@@ -81,8 +81,12 @@ impl Candidate for DiagonalPretension {
             Trace::Orientation | Trace::CableLengths | Trace::LengthScatter => None,
         }
     }
-    /// The pretension sets how far pin joints with free play are pulled into contact
-    /// ([`Backlash`]'s side of it).
+    /// The pretension sets how far pin joints with free play ([`Backlash`]) are pulled into
+    /// contact: with the diagonals short the shafts bear on their holes and the play closes;
+    /// with them slack the stages float within it. Alone against slack diagonals the
+    /// clearance loosens what the data show tight, and alone against free play a
+    /// pretension stiffens what floats. (Declared here only: this module already names
+    /// backlash's, and the other way round the two files would import each other.)
     fn interacts_with(&self) -> &'static [&'static str] {
         &[Backlash::NAME]
     }
