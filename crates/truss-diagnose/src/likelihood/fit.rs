@@ -72,7 +72,8 @@ pub const TOLERANCE: f64 = 0.02;
 /// Most Newton iterations.
 pub const MAX_ITERATIONS: usize = 12;
 /// The factors by which the steps grow where the curvature at the maximum, measured at the
-/// likelihood's own standard error, is not positive definite (module doc).
+/// likelihood's own standard error, is not positive definite and a pair of its entries is
+/// inconsistent (module doc).
 pub const LONGER_STEPS: [f64; 2] = [2.0, 4.0];
 
 /// The result of a fit.
@@ -429,9 +430,7 @@ pub fn maximise(
     }
     let (curvature, variability) = if options.curvature {
         steps.clone_from(&d.steps);
-        let (curvature, variability) =
-            curvature_at_maximum(&t, &terms, d, options.clusters, f, &mut evaluations)?;
-        (curvature, variability)
+        curvature_at_maximum(&t, &terms, d, options.clusters, f, &mut evaluations)?
     } else {
         (DMatrix::zeros(0, 0), DMatrix::zeros(0, 0))
     };
