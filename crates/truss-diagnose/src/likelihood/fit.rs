@@ -5,7 +5,8 @@
 //! The parameters are mapped onto the unit cube ([`Parameter::internal`]: linear, or
 //! logarithmic for a scale), where the log-likelihood is smooth because every evaluation uses
 //! the same random numbers. From the best of the null point (the baseline) and a scan along
-//! each axis (`diagnose::SCAN`), a trust-region Newton method: gradient and Hessian by finite
+//! each axis ([`crate::likelihood::score::SCAN`]; an axis the null holds scanned again from
+//! the best point of the others), a trust-region Newton method: gradient and Hessian by finite
 //! differences with steps adapted to the likelihood's scale ([`crate::likelihood::derivatives`]), the step
 //! `s = (A + μI)⁻¹g` with `A = −H` and the smallest `μ ≥ 0` that makes `A + μI` positive
 //! definite and `|s|` at most the trust radius (0.3 at first, doubled after a good step,
