@@ -154,9 +154,7 @@ mod tests {
     /// Every registration makes the candidate of its own name, once.
     #[test]
     fn each_registration_makes_its_own_candidate() {
-        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../jobs/diagnose-baseline.json");
-        let baseline = Baseline::read(&job, "as-built").unwrap();
+        let baseline = Baseline::of_test();
         let (candidates, skipped) = library(&baseline);
         let listed: Vec<&str> = candidates.iter().map(|c| c.name()).collect();
         assert_eq!(listed.len() + skipped.len(), REGISTRY.len());
@@ -172,9 +170,7 @@ mod tests {
     /// The pairs the crate doc names get their own measurement, either way round.
     #[test]
     fn each_confusable_pair_names_its_measurement() {
-        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../jobs/diagnose-baseline.json");
-        let baseline = Baseline::read(&job, "as-built").unwrap();
+        let baseline = Baseline::of_test();
         let (candidates, _) = library(&baseline);
         let pick = |n: &str| {
             candidates
@@ -200,9 +196,7 @@ mod tests {
     /// contact), and no other two interact.
     #[test]
     fn interactions_name_registered_candidates_and_read_from_either_side() {
-        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../jobs/diagnose-baseline.json");
-        let baseline = Baseline::read(&job, "as-built").unwrap();
+        let baseline = Baseline::of_test();
         let (candidates, _) = library(&baseline);
         let mut pairs = Vec::new();
         for a in &candidates {

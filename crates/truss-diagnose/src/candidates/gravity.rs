@@ -144,9 +144,7 @@ mod tests {
             g.project(&mut v, fixed);
             assert_eq!(v, [0.6, 0.8, 0.6], "held {fixed:?}");
         }
-        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../jobs/diagnose-baseline.json");
-        let baseline = Baseline::read(&job, "as-built").unwrap();
+        let baseline = Baseline::of_test();
         let applied = |v: [f64; 3]| {
             let mut edit = baseline.derived_case();
             g.apply(&v, &mut edit).unwrap();

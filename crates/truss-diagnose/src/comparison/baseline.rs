@@ -64,6 +64,16 @@ impl CaseEdit {
     }
 }
 
+/// The unit tests' baseline: case `as-built` of `jobs/diagnose-baseline.json`.
+#[cfg(test)]
+impl Baseline {
+    pub(crate) fn of_test() -> Self {
+        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../jobs/diagnose-baseline.json");
+        Self::read(&job, "as-built").expect("the test job reads")
+    }
+}
+
 impl Baseline {
     /// Reads the job file and finds the case.
     pub fn read(path: &Path, case: &str) -> Result<Self, DiagnoseError> {

@@ -177,9 +177,7 @@ mod tests {
     /// parameter indexed within the whole.
     #[test]
     fn combined_effects_apply_in_turn() {
-        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../jobs/diagnose-baseline.json");
-        let baseline = crate::comparison::baseline::Baseline::read(&job, "as-built").unwrap();
+        let baseline = crate::comparison::baseline::Baseline::of_test();
         let (candidates, _) = crate::candidates::library(&baseline);
         let pick = |n: &str| {
             candidates

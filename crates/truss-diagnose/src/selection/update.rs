@@ -487,9 +487,7 @@ mod tests {
     /// rival.
     #[test]
     fn a_pair_joins_the_model_each_with_its_own_rivals() {
-        let job = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../jobs/diagnose-baseline.json");
-        let baseline = crate::comparison::baseline::Baseline::read(&job, "as-built").unwrap();
+        let baseline = crate::comparison::baseline::Baseline::of_test();
         let (remaining, _) = crate::candidates::library(&baseline);
         let order: Vec<&str> = remaining.iter().map(|c| c.name()).collect();
         let scores: Vec<CandidateScore> = order
