@@ -88,7 +88,9 @@ class Samples:
     record has none), ``reason`` (empty unless failed), and any other field the lines carry,
     such as ``floating`` (a boolean: 1.0 or 0.0, NaN where a line has none) and
     ``holding_force`` [N] (the largest force on a top node that, to first order, moves
-    θ_P by at most 1 % and lets no bearing member go; NaN where a line has none). Read a field as
+    θ_P by at most 1 % and lets no bearing member go; NaN where a line has none) and
+    ``limit_ratio`` (where the solve at the limit did not converge, the compression ratio of
+    the continuation's stage that stands for it; NaN where a line has none). Read a field as
     an attribute (``samples.theta_p``) or an item (``samples["theta_p"]``)."""
 
     def __init__(

@@ -121,6 +121,17 @@ pub fn caveats(case: &CaseData, tail: f64, holding: &HoldingForces) -> Vec<Strin
             100.0 * tail
         ));
     }
+    let (stages, largest) = case.limit_stages();
+    if stages > 0 {
+        out.push(format!(
+            "in {stages} of {} converged samples the solve at the limit (slack members carrying \
+             nothing) did not converge, and the equilibrium recorded is the last stage of the \
+             continuation towards it, where the slack members keep a compression ratio of at \
+             most {largest:.1e} (`limit_ratio`): their θ_P is the limit's only as far as that \
+             stiffness holds nothing (see the README, \"Slack cables\")",
+            case.converged()
+        ));
+    }
     if case.present < case.info.samples {
         out.push(format!(
             "partial: {} of {} samples of this case present ({:.1} %)",

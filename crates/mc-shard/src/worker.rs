@@ -71,6 +71,7 @@ pub fn record(job: &Job, r: &SampleResult) -> Sample {
         loose_joints: None,
         floating: None,
         holding_force: None,
+        limit_ratio: None,
         reason: None,
     };
     match &r.outcome {
@@ -87,6 +88,7 @@ pub fn record(job: &Job, r: &SampleResult) -> Sample {
             loose_joints: c.loose_joints,
             floating: c.floating,
             holding_force: c.holding_force,
+            limit_ratio: c.limit_ratio,
             ..base
         },
         Outcome::Failed(reason) => Sample {

@@ -11,6 +11,7 @@
 //! | `type` | one name or a list: `object`, `array`, `string`, `number`, `integer`, `boolean`, `null` |
 //! | `const`, `enum` | equality |
 //! | `minimum`, `maximum` | numbers, inclusive |
+//! | `exclusiveMinimum` | numbers, exclusive |
 //! | `required`, `properties`, `additionalProperties` | objects (`additionalProperties` `false`, `true` or a schema) |
 //! | `items`, `minItems`, `maxItems` | arrays |
 //! | `$ref` | `#/$defs/NAME` only |
@@ -30,11 +31,12 @@
 use serde_json::Value;
 
 /// The keywords [`errors`] checks.
-pub const KEYWORDS: [&str; 15] = [
+pub const KEYWORDS: [&str; 16] = [
     "type",
     "const",
     "enum",
     "minimum",
+    "exclusiveMinimum",
     "maximum",
     "required",
     "properties",
@@ -133,6 +135,11 @@ fn check(root: &Value, schema: &Value, value: &Value, at: &str, errors: &mut Vec
         {
             errors.push(format!("{at}: {v} is below {min}"));
         }
+        if let Some(min) = s.get("exclusiveMinimum").and_then(Value::as_f64)
+            && v <= min
+        {
+            errors.push(format!("{at}: {v} is not above {min}"));
+        }
         if let Some(max) = s.get("maximum").and_then(Value::as_f64)
             && v > max
         {
@@ -208,12 +215,13 @@ mod tests {
                 "kind": {"enum": ["a", "b"]},
                 "v": {"const": 1},
                 "x": {"type": ["number", "null"]},
+                "r": {"type": "number", "exclusiveMinimum": 0},
                 "list": {"type": "array", "minItems": 1, "maxItems": 2, "items": {"type": "string"}},
                 "sha": {"$ref": "#/$defs/digest"},
                 "either": {"oneOf": [{"type": "string"}, {"type": "integer"}]}
             }
         });
-        let good = json!({"n": 3, "kind": "a", "v": 1, "x": null, "list": ["s"],
+        let good = json!({"n": 3, "kind": "a", "v": 1, "x": null, "r": 1e-9, "list": ["s"],
                           "sha": "0".repeat(64), "either": 2});
         assert_eq!(errors(&schema, &good), Vec::<String>::new());
         for (bad, at) in [
@@ -223,6 +231,10 @@ mod tests {
             (json!({"n": 1.5, "kind": "a"}), "/n: 1.5 is not of type"),
             (json!({"n": 1, "kind": "c"}), "/kind: \"c\" is not one of"),
             (json!({"n": 1, "kind": "a", "v": 2}), "/v: 2 is not 1"),
+            (
+                json!({"n": 1, "kind": "a", "r": 0.0}),
+                "/r: 0 is not above 0",
+            ),
             (
                 json!({"n": 1, "kind": "a", "x": "s"}),
                 "/x: \"s\" is not of type",

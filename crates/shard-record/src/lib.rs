@@ -44,7 +44,11 @@
 //!      not frame the top surface's tilt, such as the prism with pin joints in free play)
 //!      and, where `floating` is written, `holding_force` (N: the smallest force on one
 //!      node of the top surface that moves θ_P by 1 %, in the linear response at the
-//!      equilibrium; 0 where that equilibrium is not stable against some small load);
+//!      equilibrium; 0 where that equilibrium is not stable against some small load)
+//!      and, only where the limit solver's last attempt at `ρ = 0` did not converge,
+//!      `limit_ratio` (the compression ratio, > 0, of the one-sided members at the
+//!      equilibrium reported instead: the last stage of the continuation, which stands
+//!      for the limit; see the README, "Slack cables");
 //!    - when failed: `reason`, a sentence saying why.
 //!
 //!    A failed solve is a line with its status, never a missing line.
@@ -381,6 +385,12 @@ pub struct Sample {
     /// stable against some small load); written where `floating` is.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub holding_force: Option<f64>,
+    /// Where the limit solver's last attempt at `ρ = 0` did not converge: the compression
+    /// ratio (dimensionless, > 0) of the one-sided members at the equilibrium reported,
+    /// the continuation's last converged stage, which stands for the limit. Absent where
+    /// the equilibrium is the limit's own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limit_ratio: Option<f64>,
     /// Why the solve failed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
@@ -493,6 +503,13 @@ impl Sample {
                         .is_some_and(|f| !(f.is_finite() && f >= 0.0)) =>
                 {
                     Err("holding_force must be a finite number of newtons ≥ 0".into())
+                }
+                Some(_)
+                    if self
+                        .limit_ratio
+                        .is_some_and(|r| !(r.is_finite() && r > 0.0)) =>
+                {
+                    Err("limit_ratio must be a finite compression ratio > 0".into())
                 }
                 Some(_) if placement_fields != 0 && placement_fields != 4 => {
                     Err("decenter_x, decenter_y, decenter and despace come all four or none".into())

@@ -53,6 +53,7 @@ fn sample(index: u64, theta: f64) -> Sample {
         loose_joints: None,
         floating: None,
         holding_force: None,
+        limit_ratio: None,
         reason: None,
     }
 }
@@ -192,6 +193,21 @@ fn a_holding_force_that_is_no_force_is_refused() {
         s.holding_force = Some(bad);
         let err = s.check().unwrap_err();
         assert!(err.contains("holding_force"), "{bad}: {err}");
+    }
+}
+
+/// A limit ratio must be a finite compression ratio > 0 where a sample has one.
+#[test]
+fn a_limit_ratio_that_is_no_ratio_is_refused() {
+    let mut s = sample(0, 1e-5);
+    for ok in [None, Some(1e-12), Some(2.0e-7)] {
+        s.limit_ratio = ok;
+        assert!(s.check().is_ok(), "{ok:?}");
+    }
+    for bad in [0.0, -1e-9, f64::NAN, f64::INFINITY] {
+        s.limit_ratio = Some(bad);
+        let err = s.check().unwrap_err();
+        assert!(err.contains("limit_ratio"), "{bad}: {err}");
     }
 }
 

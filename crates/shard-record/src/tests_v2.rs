@@ -48,6 +48,7 @@ fn sample(index: u64) -> Sample {
         loose_joints: None,
         floating: None,
         holding_force: None,
+        limit_ratio: None,
         reason: (index == 3).then(|| "Newton did not converge".to_string()),
     }
 }

@@ -30,6 +30,10 @@ pub struct Converged {
     /// The holding force \[N\]: the smallest force on one top-surface node that moves θ_P
     /// by 1 % (see [`truss_core::SolveReport::holding_force`]); where `floating` is given.
     pub holding_force: Option<f64>,
+    /// Where the limit's last attempt did not converge, the compression ratio of the
+    /// one-sided members at the equilibrium that stands for it (see
+    /// [`truss_core::SolveReport::limit_ratio`]).
+    pub limit_ratio: Option<f64>,
 }
 
 /// How a sample ended.
@@ -153,6 +157,7 @@ impl<'j> SampleSolver<'j> {
                         loose_joints: has_joints.then_some(report.loose_joints),
                         floating: (!case.structure.tilt_framed()).then_some(report.floating),
                         holding_force: report.holding_force,
+                        limit_ratio: report.limit_ratio,
                     }),
                     (Some(_), _) => {
                         Outcome::Failed("the top surface's angles are not finite".into())

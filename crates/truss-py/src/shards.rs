@@ -213,6 +213,7 @@ mod tests {
             loose_joints: None,
             floating: None,
             holding_force: None,
+            limit_ratio: None,
             reason: None,
         };
         let line = sample.to_line();

@@ -90,11 +90,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "c841f1faea978a80a1e0005834c2ae9fc860ea118f36a7c8a7bfad9594fbba8a",
+        "da93f3687be958e677c11f76ef90a0f1ff255d7da7bc0d3fffdd36c62414c224",
         "94ce944399e4677c5705bde025cc92a70f975a9f2ab7c855a7e8f13ecf665d24",
         "546cf9d696c4c41815489fa90b763f7db5a7158a8fe8896316e035a3f1ee86a1",
         "7b94c46945c2820f627e0bdcc5aa42e331a0f6fe76f9a1cbbfa384b72441d183",
-        "dc75524d6de0594a35efb531f5cd4a5d22e273b2fe5eb0b0a60f9ba7652097b6",
+        "a713dd80a90a7d8c0747950cd645303dca7ff71c6778ef6d0e9c4dcbcd19f979",
     ];
     for (what, (g, w)) in [
         "job id",

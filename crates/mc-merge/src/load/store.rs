@@ -83,6 +83,8 @@ struct Columns {
     floating: Vec<u8>,
     /// The holding force \[N\]; NaN: not recorded.
     holding: Vec<f64>,
+    /// The compression ratio of the stage that stands for the limit; NaN: the limit's own.
+    limit_ratio: Vec<f64>,
     /// decenter_x, decenter_y, despace \[mm\]; NaN: not recorded.
     decenter_x: Vec<f64>,
     decenter_y: Vec<f64>,
@@ -108,6 +110,7 @@ impl Columns {
             loose: zeroed(n, 0)?,
             floating: zeroed(n, 0)?,
             holding: zeroed(n, f64::NAN)?,
+            limit_ratio: zeroed(n, f64::NAN)?,
             decenter_x: zeroed(n, f64::NAN)?,
             decenter_y: zeroed(n, f64::NAN)?,
             despace: zeroed(n, f64::NAN)?,
@@ -210,6 +213,24 @@ impl CaseData {
     /// floating stage).
     pub fn floating(&self) -> (u64, u64) {
         self.flag_counts(|c| &c.floating)
+    }
+
+    /// Converged samples whose equilibrium is a stage of the limit's continuation, not the
+    /// limit itself (`limit_ratio` recorded: the last attempt at `ρ = 0` did not
+    /// converge), and the largest such ratio (0 where there are none).
+    pub fn limit_stages(&self) -> (u64, f64) {
+        let Some(c) = &self.columns else {
+            return (0, 0.0);
+        };
+        let mut count = 0;
+        let mut largest: f64 = 0.0;
+        for (s, r) in c.state.iter().zip(&c.limit_ratio) {
+            if *s == CONVERGED && r.is_finite() {
+                count += 1;
+                largest = largest.max(*r);
+            }
+        }
+        (count, largest)
     }
 
     /// (converged samples whose flag column is recorded, those whose flag is set) for a
@@ -321,6 +342,8 @@ pub(super) struct Rec {
     floating: u8,
     /// The holding force \[N\]; NaN: not recorded.
     holding: f64,
+    /// The compression ratio of the stage that stands for the limit; NaN: not recorded.
+    limit_ratio: f64,
     /// decenter_x, decenter_y, despace \[mm\]; NaN: not recorded.
     placement: [f64; 3],
     /// `Some` for a failed sample.
@@ -348,6 +371,7 @@ impl Rec {
                 Some(true) => 2,
             },
             holding: s.holding_force.unwrap_or(f64::NAN),
+            limit_ratio: s.limit_ratio.unwrap_or(f64::NAN),
             placement: s
                 .placement()
                 .map_or([f64::NAN; 3], |p| [p.decenter_x, p.decenter_y, p.despace]),
@@ -428,6 +452,7 @@ impl Store {
         cols.loose[k] = r.loose;
         cols.floating[k] = r.floating;
         cols.holding[k] = r.holding;
+        cols.limit_ratio[k] = r.limit_ratio;
         [cols.decenter_x[k], cols.decenter_y[k], cols.despace[k]] = r.placement;
         match r.reason {
             None => cols.state[k] = CONVERGED,

@@ -590,6 +590,46 @@ fn holding_forces_are_summarised_and_a_loosely_held_tail_is_named() {
     assert!(md.contains("Holding forces [N]"), "{md}");
 }
 
+/// Samples whose line records a `limit_ratio` (the solve at the limit did not converge and
+/// a stage of the continuation stands for it) are counted in a caveat naming the largest
+/// ratio; a case without them has no such caveat.
+#[test]
+fn samples_whose_limit_stands_at_a_stage_are_named_in_a_caveat() {
+    let mut staged = SynthCase::rayleigh("staged", 400, 2e-5, &[("sigma", 0.0063)]);
+    staged.floating_every = Some(2);
+    staged.limit_stage_every = Some(25);
+    let plain = SynthCase::rayleigh("plain", 400, 2e-5, &[("sigma", 0.0067)]);
+    let job = SynthJob::new(11, vec![staged, plain]);
+    let (_dir, _, run, v) = merged(&job, 2);
+    let caveats = |i: usize| -> Vec<String> {
+        v["cases"][i]["caveats"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_str().unwrap().to_string())
+            .collect()
+    };
+    // Samples 0, 25, ..., 375: 16, with ratios 1e-12 × (1 + k % 7); the largest 7e-12.
+    let staged = caveats(0);
+    let named = staged
+        .iter()
+        .find(|c| c.starts_with("in 16 of 400 converged samples the solve at the limit"))
+        .unwrap_or_else(|| panic!("{staged:?}"));
+    assert!(named.contains("at most 7.0e-12"), "{named}");
+    assert!(
+        !caveats(1)
+            .iter()
+            .any(|c| c.contains("the solve at the limit")),
+        "{:?}",
+        caveats(1)
+    );
+    assert!(
+        run.stdout.contains("staged: CAVEAT in 16 of 400"),
+        "{}",
+        run.stdout
+    );
+}
+
 /// The fraction of samples with a floating stage, per case, with its Clopper–Pearson
 /// interval; where it exceeds the 5 % tail that θ_P95 reads, a caveat says that the upper
 /// percentiles rest on what the model leaves out and names the lever. Cases whose lines do

@@ -146,7 +146,7 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "cf0c384e5c35c2f4e0087ae9c368e946e3993e87a2f5b159bb91729201b39e15"
+        "dca02604eee905e55936475f1550a2587d1021496f8230a2a356ac42a622a9b7"
     );
     assert_eq!(
         digest,
@@ -254,7 +254,8 @@ fn a_tall_truss_in_free_play_reaches_the_limit_where_tenfold_stages_stall() {
 ///   sweep) had not finished after 20 minutes. An attempt with more than `MAX_REDUCED`
 ///   (256) is now abandoned, and the last stage (`ρ = 1e-12`) stands for the limit.
 ///
-/// Both now converge, floating. The solve runs on a thread of its own so that a
+/// Both now converge, floating: sample 0 at the limit itself, sample 18 at the 1e-12 stage,
+/// which its line names (`limit_ratio`). The solve runs on a thread of its own so that a
 /// regression of the second fails here after 10 minutes instead of holding the run.
 /// (About 40 s in release.)
 #[test]
@@ -270,24 +271,60 @@ fn tall_free_play_stalls_at_the_rounding_floor_and_wide_floating_sets_end() {
             }
         }
     });
-    for sample in [0, 18] {
+    for (sample, stands_at) in [(0, None), (18, Some(1e-12))] {
         let line = rx
             .recv_timeout(std::time::Duration::from_secs(600))
             .unwrap_or_else(|_| panic!("sample {sample} did not end in 10 minutes"));
         let v: serde_json::Value = serde_json::from_str(&line).unwrap();
         assert_eq!(v["status"], "converged", "{line}");
+        assert_eq!(v["limit_ratio"].as_f64(), stands_at, "{line}");
         assert_eq!(v["floating"], true, "{line}");
         let theta = v["theta_p"].as_f64().unwrap();
         assert!(theta.is_finite() && theta > 0.0, "{line}");
     }
 }
 
+/// Samples 47 and 127 of the same job failed under numerics 10, as did 6 others of the
+/// first 200 (68, 73, 158, 178, 185, 187): below `ρ = 1e-7` the continuation's steps of the
+/// ratio all failed down to 1/128 of a decade (sample 127 at `ρ ≈ 4.1e-9`: "Newton did not
+/// converge in 19 iterations (out-of-balance force 7.870e-7 N, last step 2.500e-18 mm)";
+/// sample 47 at `ρ ≈ 2.0e-7`, 120 iterations at 4.2e-6 N). A stalled continuation now ends
+/// at the stage it reached: the last attempt at `ρ = 0` starts from there, and where that
+/// does not converge either (in all 8), the stage stands for the limit and the line says at
+/// which ratio (`limit_ratio`), an equilibrium at that ratio. Whether it floats is the
+/// limit's: at `ρ = 2e-7` the slack diagonals hold sample 47's floating stages by 3e-12 N,
+/// which read as "held" until the holding force was taken at the limit. (About 10 s in
+/// release.)
+#[test]
+#[ignore = "slow: two 300-stage solves at the limit (run in release with --ignored)"]
+fn a_stalled_continuation_ends_at_the_stage_it_reached_and_says_so() {
+    let job = Job::from_json(&tall_free_play_job(), Path::new(".")).unwrap();
+    for sample in [47, 127] {
+        let line = mc_shard::reproduce::reproduce(&job, 0, sample, false);
+        let v: serde_json::Value = serde_json::from_str(&line).unwrap();
+        assert_eq!(v["status"], "converged", "{line}");
+        let ratio = v["limit_ratio"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{line}"));
+        // Above the continuation's last stage (1e-12), below its first (1e-5).
+        assert!(ratio > 1e-12 && ratio < 1e-5, "{line}");
+        // An equilibrium at that ratio: the force test's floor there is 1,000 times the
+        // rounding floor of displacements of tens of mm (about 2e-10 N).
+        let residual = v["residual"].as_f64().unwrap();
+        assert!(residual < 1e-6, "{line}");
+        assert_eq!(v["floating"], true, "{line}");
+        assert_eq!(v["holding_force"], 0.0, "{line}");
+        let theta = v["theta_p"].as_f64().unwrap();
+        assert!(theta.is_finite() && theta > 0.0, "{line}");
+    }
+}
+
 /// The 300-stage prism with free play of the README's figures (the case's name, `tb`,
-/// seeds the draws).
+/// seeds the draws; the count does not).
 fn tall_free_play_job() -> String {
     format!(
         r#"{{"model": {{"prism": {{"stages": 300, "backlash": true}}}}, "seed": 20210325, "cases": [
-  {{"name": "tb", "samples": 24, {CLEARANCE},
+  {{"name": "tb", "samples": 200, {CLEARANCE},
     "length_errors": {{"batten": {{"normal": {{"sigma": 0.0063}}}}, "longeron": {{"normal": {{"sigma": 0.0063}}}},
                       "diagonal": {{"uniform": {{"low": -0.0189, "high": 0}}}}}}}}]}}"#
     )

@@ -66,6 +66,10 @@ fn real_shard_lines_validate_against_the_schema() {
             (s.decenter_x, s.decenter_y, s.decenter, s.despace) = (None, None, None, None);
             s.reason = Some("Newton did not converge in 60 iterations".into());
         }
+        // A converged sample whose limit stands at a stage of the continuation.
+        if s.index == 6 {
+            s.limit_ratio = Some(2.0e-7);
+        }
     });
     let mut lines: Vec<String> = std::fs::read_to_string(&path)
         .unwrap()
@@ -120,12 +124,18 @@ fn real_shard_lines_validate_against_the_schema() {
         "no line says floating"
     );
 
+    let staged = lines
+        .iter()
+        .find(|l| l.contains("\"limit_ratio\":2e-7"))
+        .expect("no line with limit_ratio");
+
     // Lines that break the format are refused.
     let sample = lines.iter().find(|l| l.contains("\"converged\"")).unwrap();
     for bad in [
         sample.replace("\"converged\"", "\"ok\""),
         sample.replace("\"index\":", "\"indx\":"),
         sample.replace("\"theta_p\":", "\"reason\":\"x\",\"theta_p\":"),
+        staged.replace("\"limit_ratio\":2e-7", "\"limit_ratio\":0.0"),
         lines[0].replace("\"format_version\":2", "\"format_version\":1"),
         lines
             .last()

@@ -182,6 +182,12 @@ pub struct SolveReport {
     /// [`Solver::holding`]). Computed, like [`SolveReport::floating`], only where the
     /// model's bars do not frame the tilt.
     pub holding_force: Option<f64>,
+    /// Where the limit solver's last attempt at `ρ = 0` did not converge, the compression
+    /// ratio `ρ` of the one-sided members at the equilibrium reported instead: the last
+    /// stage the continuation reached, which stands for the limit (see [`crate::limit`] and
+    /// the `limit` module of the solver). `None` where the equilibrium is the limit's own
+    /// (`ρ = 0`) or the model is solved at its own ratios.
+    pub limit_ratio: Option<f64>,
 }
 
 /// One Newton iteration, recorded when [`SolveOptions::record_iterations`] is set.

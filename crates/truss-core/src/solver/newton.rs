@@ -266,6 +266,7 @@ impl Solver {
             soft_directions: p.soft_directions,
             floating,
             holding_force: self.holding.map(|h| h.force),
+            limit_ratio: None,
         })
     }
 

@@ -42,6 +42,9 @@ pub struct SynthCase {
     pub loose: bool,
     /// If set, samples record `floating`, true for every n-th sample within the case.
     pub floating_every: Option<u64>,
+    /// If set, every n-th converged sample within the case records a `limit_ratio` (its
+    /// equilibrium a stage of the limit's continuation: 1e-12 times 1 to 7).
+    pub limit_stage_every: Option<u64>,
 }
 
 impl SynthCase {
@@ -56,6 +59,7 @@ impl SynthCase {
             fail_every: None,
             loose: false,
             floating_every: None,
+            limit_stage_every: None,
         }
     }
 }
@@ -173,6 +177,10 @@ impl SynthJob {
                 let scale = if k.is_multiple_of(n) { 1e-9 } else { 1e-3 };
                 scale * (1 + k % 7) as f64
             }),
+            limit_ratio: case
+                .limit_stage_every
+                .filter(|n| !failed && k.is_multiple_of(*n))
+                .map(|_| 1e-12 * (1 + k % 7) as f64),
             reason: failed
                 .then(|| format!("Newton did not converge in 60 iterations (sample {k})")),
         }
