@@ -10,9 +10,11 @@ const MAX_SWEEPS: usize = 60;
 /// writes the eigenvectors into `v` (row-major, column `i` the vector of eigenvalue
 /// `a[i*p+i]`); returns the eigenvalues in `values`.
 pub(super) fn symmetric_eigen(a: &mut [f64], v: &mut [f64], values: &mut [f64], p: usize) {
-    v[..p * p].fill(0.0);
+    // The eigenvectors are accumulated transposed (row i of `vt` is column i of `v`), so
+    // that a rotation updates two contiguous rows; the arithmetic is the same.
+    let mut vt = vec![0.0; p * p];
     for i in 0..p {
-        v[i * p + i] = 1.0;
+        vt[i * p + i] = 1.0;
     }
     for _ in 0..MAX_SWEEPS {
         let mut off = 0.0;
@@ -54,16 +56,21 @@ pub(super) fn symmetric_eigen(a: &mut [f64], v: &mut [f64], values: &mut [f64], 
                     a[i * p + k] = c * aik - s * ajk;
                     a[j * p + k] = s * aik + c * ajk;
                 }
-                for k in 0..p {
-                    let (vki, vkj) = (v[k * p + i], v[k * p + j]);
-                    v[k * p + i] = c * vki - s * vkj;
-                    v[k * p + j] = s * vki + c * vkj;
+                let (head, tail) = vt.split_at_mut(j * p);
+                let (vi, vj) = (&mut head[i * p..i * p + p], &mut tail[..p]);
+                for (vki, vkj) in vi.iter_mut().zip(vj.iter_mut()) {
+                    let (x, y) = (*vki, *vkj);
+                    *vki = c * x - s * y;
+                    *vkj = s * x + c * y;
                 }
             }
         }
     }
     for i in 0..p {
         values[i] = a[i * p + i];
+        for k in 0..p {
+            v[k * p + i] = vt[i * p + k];
+        }
     }
 }
 

@@ -366,7 +366,7 @@ impl Solver {
             red.force[k] = dot_n(&w[..n], &self.limit.rhs[..n]);
         }
         let mut along = vec![0.0; p + 1];
-        let mut delta = vec![[0.0; 3]; p + 1];
+        let mut delta: [Vec<f64>; 3] = std::array::from_fn(|_| vec![0.0; p + 1]);
         for m in 0..mm {
             let c = &s.members[m];
             let st = &self.work.states[m];
@@ -395,7 +395,9 @@ impl Solver {
                 ];
                 along[j] =
                     st.direction[0] * dv[0] + st.direction[1] * dv[1] + st.direction[2] * dv[2];
-                delta[j] = dv;
+                for (d, x) in delta.iter_mut().zip(dv) {
+                    d[j] = x;
+                }
             }
             red.add_member(k, n_over_l, &along, &delta, kq, st.elongation);
         }

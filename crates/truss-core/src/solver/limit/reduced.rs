@@ -114,25 +114,39 @@ impl Reduced {
         k: f64,
         n_over_l: f64,
         along: &[f64],
-        delta: &[[f64; 3]],
+        delta: &[Vec<f64>; 3],
         kq: f64,
         e: f64,
     ) {
         let p = self.p;
-        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let [dx, dy, dz] = delta;
+        let (along, dx, dy, dz) = (&along[..=p], &dx[..=p], &dy[..=p], &dz[..=p]);
         for i in 0..p {
-            let kid = k * along[i] * along[p]
-                + n_over_l * (dot(delta[i], delta[p]) - along[i] * along[p]);
+            let dot_p = dx[i] * dx[p] + dy[i] * dy[p] + dz[i] * dz[p];
+            let kid = k * along[i] * along[p] + n_over_l * (dot_p - along[i] * along[p]);
             self.force[i] -= kid;
             if kq != 0.0 {
                 self.selection_force[i] += kq * along[i] * (e + along[p]);
             }
-            for j in 0..=i {
-                let kij = k * along[i] * along[j]
-                    + n_over_l * (dot(delta[i], delta[j]) - along[i] * along[j]);
-                self.stiffness[i * p + j] += kij;
-                if kq != 0.0 {
-                    self.selection[i * p + j] += kq * along[i] * along[j];
+            // Row i's lower triangle, j = 0..=i: the same expressions, in the same order, as
+            // one entry at a time, over columns the compiler can run side by side.
+            let (ka, a) = (k * along[i], along[i]);
+            let (xi, yi, zi) = (dx[i], dy[i], dz[i]);
+            let row = &mut self.stiffness[i * p..=i * p + i];
+            for ((((s, &aj), &xj), &yj), &zj) in row
+                .iter_mut()
+                .zip(&along[..=i])
+                .zip(&dx[..=i])
+                .zip(&dy[..=i])
+                .zip(&dz[..=i])
+            {
+                *s += ka * aj + n_over_l * ((xi * xj + yi * yj + zi * zj) - a * aj);
+            }
+            if kq != 0.0 {
+                let kqa = kq * along[i];
+                let row = &mut self.selection[i * p..=i * p + i];
+                for (s, &aj) in row.iter_mut().zip(&along[..=i]) {
+                    *s += kqa * aj;
                 }
             }
         }
@@ -203,20 +217,25 @@ impl Reduced {
             let h_held: Vec<f64> = (0..p)
                 .map(|k| (0..p).map(|l| self.selection[k * p + l] * held[l]).sum())
                 .collect();
+            // (H·V)[k][jj] over the free columns first: p²·q products, not p²·q² (each
+            // entry summed in the same order as in the product below, so the same bits).
+            let mut hv_free = vec![0.0; p * q];
+            for k in 0..p {
+                for (jj, &j) in free.iter().enumerate() {
+                    hv_free[k * q + jj] = (0..p)
+                        .map(|l| self.selection[k * p + l] * self.vectors[l * p + j])
+                        .sum::<f64>();
+                }
+            }
             let vhv = &mut self.scratch_pp;
             let mut rhs = vec![0.0; q];
             for (ii, &i) in free.iter().enumerate() {
                 rhs[ii] = -(0..p)
                     .map(|k| self.vectors[k * p + i] * (h_held[k] + self.selection_force[k]))
                     .sum::<f64>();
-                for (jj, &j) in free.iter().enumerate() {
+                for jj in 0..q {
                     vhv[ii * q + jj] = (0..p)
-                        .map(|k| {
-                            self.vectors[k * p + i]
-                                * (0..p)
-                                    .map(|l| self.selection[k * p + l] * self.vectors[l * p + j])
-                                    .sum::<f64>()
-                        })
+                        .map(|k| self.vectors[k * p + i] * hv_free[k * q + jj])
                         .sum();
                 }
             }
