@@ -493,9 +493,10 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
 }
 
 /// Profile-likelihood intervals for a fitted candidate ([`crate::likelihood::profile`]); where a profile
-/// finds a higher point the candidate is fitted again from there and scored anew (at most
-/// twice). A profile that fails, or still finds a higher point after that, leaves the Wald
-/// intervals and says why in the progress notes.
+/// finds a higher point the candidate is fitted again from there and scored anew (see
+/// [`profile_and_refit`]). A profile that fails, or still finds a higher point after two
+/// new fits, leaves the Wald intervals (at the highest fit) and says why in the progress
+/// notes.
 pub(crate) fn profile_candidate(
     ev: &Evaluator,
     c: &dyn Candidate,
@@ -504,77 +505,40 @@ pub(crate) fn profile_candidate(
     note: &dyn Fn(&str),
 ) {
     fitted.profiled = true;
-    let Some(mut fit) = fitted.fit.take() else {
+    let Some(fit) = fitted.fit.take() else {
         return;
     };
     let clock = Instant::now();
     let (mut objective, project) = (objective(ev, c), projection(c));
     let clusters = ev.measured.clusters();
-    let mut spent = 0;
-    let mut refitted = false;
-    let mut outcome = None;
-    for attempt in 0..3 {
-        let problem = Problem {
-            parameters: c.parameters(),
-            project: &project,
-            inflation: test.inflation,
-        };
-        match profile_intervals(&fit, &problem, &mut objective, true) {
-            Ok(Profile::Intervals(iv)) => {
-                spent += iv.evaluations;
-                outcome = Some(iv);
-                break;
-            }
-            Ok(Profile::Higher(_, n)) if attempt == 2 => {
-                spent += n;
-                note(&format!(
-                    "  {}: the profile still finds higher points after two new fits; Wald intervals kept",
-                    c.name()
-                ));
-            }
-            Ok(Profile::Higher(t, n)) => {
-                spent += n;
-                note(&format!(
-                    "  {}: the profile found a higher point; fitting again from there",
-                    c.name()
-                ));
-                let options = Options {
-                    steps: Some(&fit.steps),
-                    curvature: true,
-                    clusters: Some(&clusters),
-                };
-                match maximise(&t, options, &|t| project(t, None), &mut objective) {
-                    Ok(better) if better.log_likelihood > fit.log_likelihood => {
-                        spent += better.evaluations;
-                        fit = better;
-                        refitted = true;
-                    }
-                    Ok(other) => {
-                        spent += other.evaluations;
-                        note(&format!(
-                            "  {}: fitting again found no higher maximum; Wald intervals kept",
-                            c.name()
-                        ));
-                        break;
-                    }
-                    Err(e) => {
-                        note(&format!(
-                            "  {}: fitting again failed ({e}); Wald intervals kept",
-                            c.name()
-                        ));
-                        break;
-                    }
-                }
-            }
-            Err(e) => {
-                note(&format!(
-                    "  {}: profile failed ({e}); Wald intervals kept",
-                    c.name()
-                ));
-                break;
-            }
-        }
-    }
+    let settled = profile_and_refit(
+        fit,
+        &mut objective,
+        |fit, objective| {
+            let problem = Problem {
+                parameters: c.parameters(),
+                project: &project,
+                inflation: test.inflation,
+            };
+            profile_intervals(fit, &problem, objective, true)
+        },
+        |t, fit, objective| {
+            let options = Options {
+                steps: Some(&fit.steps),
+                curvature: true,
+                clusters: Some(&clusters),
+            };
+            maximise(t, options, &|t| project(t, None), objective)
+        },
+        c.name(),
+        note,
+    );
+    let Settled {
+        fit,
+        outcome,
+        refitted,
+        spent,
+    } = settled;
     let (evaluations, seconds) = (fitted.score.evaluations, fitted.score.seconds);
     if refitted {
         fitted.score = score_of(c, &fit, test);
@@ -600,6 +564,91 @@ pub(crate) fn profile_candidate(
     fitted.score.profile_evaluations = spent;
     fitted.score.seconds = seconds + clock.elapsed().as_secs_f64();
     fitted.fit = Some(fit);
+}
+
+/// What [`profile_and_refit`] settled on.
+struct Settled {
+    /// The highest fit reached.
+    fit: Fit,
+    /// The profile intervals at that fit, where a profile completed there.
+    outcome: Option<Intervals>,
+    /// Whether `fit` is a new fit (to be scored anew).
+    refitted: bool,
+    /// Evaluations of ℓ spent in profiles and new fits.
+    spent: usize,
+}
+
+/// The profile step of [`profile_candidate`]: profiles `fit` (`profile`); where a profile
+/// finds a point higher than the fit, fits again from it (`refit`) and, if that fit is
+/// higher, profiles the new fit, at most three profiles in all. A higher point found by the
+/// third profile is still fitted from, and the higher fit kept with its Wald intervals: a
+/// fit that its own profile showed lower is never the answer. Both run on `objective` (ℓ);
+/// `name` and `note` as for the progress notes.
+fn profile_and_refit<O: ?Sized>(
+    mut fit: Fit,
+    objective: &mut O,
+    mut profile: impl FnMut(&Fit, &mut O) -> Result<Profile, DiagnoseError>,
+    mut refit: impl FnMut(&[f64], &Fit, &mut O) -> Result<Fit, DiagnoseError>,
+    name: &str,
+    note: &dyn Fn(&str),
+) -> Settled {
+    const PROFILES: usize = 3;
+    let mut spent = 0;
+    let mut refitted = false;
+    let mut outcome = None;
+    for attempt in 0..PROFILES {
+        match profile(&fit, objective) {
+            Ok(Profile::Intervals(iv)) => {
+                spent += iv.evaluations;
+                outcome = Some(iv);
+                break;
+            }
+            Ok(Profile::Higher(t, n)) => {
+                spent += n;
+                let last = attempt + 1 == PROFILES;
+                note(&format!(
+                    "  {name}: the profile found a higher point; fitting again from there"
+                ));
+                match refit(&t, &fit, objective) {
+                    Ok(better) if better.log_likelihood > fit.log_likelihood => {
+                        spent += better.evaluations;
+                        fit = better;
+                        refitted = true;
+                        if last {
+                            note(&format!(
+                                "  {name}: the profile still found higher points after two new fits; the highest fit kept, with Wald intervals"
+                            ));
+                        }
+                    }
+                    Ok(other) => {
+                        spent += other.evaluations;
+                        note(&format!(
+                            "  {name}: fitting again found no higher maximum; Wald intervals kept"
+                        ));
+                        break;
+                    }
+                    Err(e) => {
+                        note(&format!(
+                            "  {name}: fitting again failed ({e}); Wald intervals kept"
+                        ));
+                        break;
+                    }
+                }
+            }
+            Err(e) => {
+                note(&format!(
+                    "  {name}: profile failed ({e}); Wald intervals kept"
+                ));
+                break;
+            }
+        }
+    }
+    Settled {
+        fit,
+        outcome,
+        refitted,
+        spent,
+    }
 }
 
 /// A score of `k` parameters with ΔBIC `delta_bic`, significant (p = 1e-6) or not (p = 0.5),
@@ -631,6 +680,62 @@ impl CandidateScore {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A fit at `x` with ℓ = `l` (one parameter), as a profile's tests need it.
+    fn fit_at(x: f64, l: f64) -> Fit {
+        Fit {
+            internal: vec![x],
+            log_likelihood: l,
+            curvature: nalgebra::DMatrix::zeros(0, 0),
+            variability: nalgebra::DMatrix::zeros(0, 0),
+            steps: vec![0.01],
+            evaluations: 10,
+            iterations: 3,
+        }
+    }
+
+    /// A profile that finds a higher point every time (ℓ rising along a ridge that each fit
+    /// stops short of): the candidate is fitted again after each of the three profiles, and
+    /// the highest fit, the third, is kept with its Wald intervals. Before, the point the
+    /// third profile found was dropped and the second fit kept, although its own profile had
+    /// shown it lower (the fault of `paper-backlash+mm` before the spread's start scan).
+    #[test]
+    fn a_higher_point_from_the_last_profile_is_fitted_from_and_kept() {
+        let mut profiles = 0;
+        let settled = profile_and_refit(
+            fit_at(0.0, 0.0),
+            &mut profiles,
+            |fit, profiles| {
+                *profiles += 1;
+                Ok(Profile::Higher(vec![fit.internal[0] + 1.0], 5))
+            },
+            |t, _, _| Ok(fit_at(t[0], 10.0 * t[0])),
+            "test",
+            &|_| {},
+        );
+        assert_eq!(profiles, 3);
+        assert!(settled.refitted && settled.outcome.is_none());
+        assert_eq!(settled.fit.internal, vec![3.0]);
+        assert_eq!(settled.fit.log_likelihood, 30.0);
+        // Three profiles of 5 evaluations, three fits of 10.
+        assert_eq!(settled.spent, 45);
+    }
+
+    /// A new fit that is not higher than the old one ends the step with the old fit.
+    #[test]
+    fn a_new_fit_no_higher_leaves_the_old_one() {
+        let settled = profile_and_refit(
+            fit_at(0.0, 1.0),
+            &mut (),
+            |_, _| Ok(Profile::Higher(vec![1.0], 5)),
+            |t, _, _| Ok(fit_at(t[0], 0.5)),
+            "test",
+            &|_| {},
+        );
+        assert!(!settled.refitted && settled.outcome.is_none());
+        assert_eq!(settled.fit.internal, vec![0.0]);
+        assert_eq!(settled.spent, 15);
+    }
 
     /// A parameter held to another (h ≤ m, as the backlash spread to its clearance) whose ℓ
     /// is even about its null and rises away from it: ℓ = −100(m − 0.4)² + 50h² − 200h⁴
