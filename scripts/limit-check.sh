@@ -65,9 +65,12 @@ def quantile(sorted_values, p):
     return sorted_values[max(math.ceil(p * n), 1) - 1]
 def paired_figures(report, values):
     """The case figures of `report`, recomputed from `values` (one run's samples)."""
+    by_case = {}
+    for (case, _), v in values.items():
+        by_case.setdefault(case, []).append(v)
     out = {}
     for c in report["cases"]:
-        rows = [v for (case, _), v in sorted(values.items()) if case == c["name"]]
+        rows = by_case.get(c["name"])
         if not rows:
             continue
         thetas = sorted(r[0] for r in rows)

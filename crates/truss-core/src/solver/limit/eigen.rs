@@ -10,9 +10,11 @@ const MAX_SWEEPS: usize = 60;
 /// writes the eigenvectors into `v` (row-major, column `i` the vector of eigenvalue
 /// `a[i*p+i]`); returns the eigenvalues in `values`.
 pub(super) fn symmetric_eigen(a: &mut [f64], v: &mut [f64], values: &mut [f64], p: usize) {
-    // The eigenvectors are accumulated transposed (row i of `vt` is column i of `v`), so
-    // that a rotation updates two contiguous rows; the arithmetic is the same.
-    let mut vt = vec![0.0; p * p];
+    // The eigenvectors are accumulated transposed in `v` (row i the vector of column i),
+    // so that a rotation updates two contiguous rows, and transposed at the end; the
+    // arithmetic is the same.
+    let vt = &mut v[..p * p];
+    vt.fill(0.0);
     for i in 0..p {
         vt[i * p + i] = 1.0;
     }
@@ -68,8 +70,8 @@ pub(super) fn symmetric_eigen(a: &mut [f64], v: &mut [f64], values: &mut [f64], 
     }
     for i in 0..p {
         values[i] = a[i * p + i];
-        for k in 0..p {
-            v[k * p + i] = vt[i * p + k];
+        for k in 0..i {
+            v.swap(i * p + k, k * p + i);
         }
     }
 }

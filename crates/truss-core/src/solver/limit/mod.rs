@@ -111,19 +111,21 @@ impl Solver {
     /// `log₁₀ ρ` that halve where Newton at the next ratio does not converge from the last
     /// converged point (restored), and grow by half again after a success, down to
     /// [`MIN_LOG_STEP`] decades. Each stage is [`Solver::newton_warm`], so the equilibrium
-    /// reached at `to` is that of the tenfold path wherever both converge.
+    /// reached at `to` is that of the tenfold path wherever both converge. Where the steps
+    /// fail down to [`MIN_LOG_STEP`], the point and the ratio are the last converged
+    /// stage's, and the error carries that ratio.
     async fn continue_down(
         &mut self,
         from: f64,
         to: f64,
         counts: &mut Counts,
         kernels: Kernels<'_>,
-    ) -> Result<(), SolveError> {
+    ) -> Result<(), (SolveError, f64)> {
         let n = self.structure.free;
-        // The last converged point, restored where a step fails.
+        // The last converged point and its ratio, restored where a step fails.
         self.limit.saved[..n].copy_from_slice(&self.work.u[..n]);
         let (mut at, end) = (from.log10(), to.log10());
-        self.limit.reached = from;
+        let mut reached = from;
         let mut step: f64 = 0.5;
         loop {
             let next = (at - step).max(end);
@@ -136,7 +138,7 @@ impl Solver {
                         return Ok(());
                     }
                     at = next;
-                    self.limit.reached = 10f64.powf(next);
+                    reached = 10f64.powf(next);
                     self.limit.saved[..n].copy_from_slice(&self.work.u[..n]);
                     step = (step * 1.5).min(1.0);
                 }
@@ -147,8 +149,8 @@ impl Solver {
                     self.work.u[..n].copy_from_slice(&self.limit.saved[..n]);
                     step *= 0.5;
                     if step < MIN_LOG_STEP {
-                        self.set_limit_ratio(self.limit.reached);
-                        return Err(e);
+                        self.set_limit_ratio(reached);
+                        return Err((e, reached));
                     }
                 }
             }
@@ -176,7 +178,8 @@ impl Solver {
             // anchor instead (see `continue_down`).
             self.anchor_at(FALLBACK_RATIO, &mut counts, kernels).await?;
             self.continue_down(FALLBACK_RATIO, FIRST_RATIO, &mut counts, kernels)
-                .await?;
+                .await
+                .map_err(|(e, _)| e)?;
         }
         let stages = (FIRST_RATIO / LAST_RATIO).log10().round() as i32;
         let mut limit_ratio = None;
@@ -214,14 +217,12 @@ impl Solver {
                 Err(_) => {
                     self.work.u[..n].copy_from_slice(&self.limit.saved[..n]);
                     let from = ratio * 10.0;
-                    if self
-                        .continue_down(from, ratio, &mut counts, kernels)
-                        .await
-                        .is_err()
+                    if let Err((_, reached)) =
+                        self.continue_down(from, ratio, &mut counts, kernels).await
                     {
                         // Stalled between two stages: the stage reached is the last, and
                         // the last attempt at 0 starts from it.
-                        standing = self.limit.reached;
+                        standing = reached;
                     }
                 }
             }

@@ -21,8 +21,6 @@ pub(crate) struct LimitWork {
     pub rhs: Vec<f64>,
     /// The point of the last converged stage.
     pub saved: Vec<f64>,
-    /// The ratio of the last converged stage of [`Solver::continue_down`](super::super::Solver).
-    pub reached: f64,
     /// The reduced problem.
     pub reduced: Reduced,
 }
@@ -35,7 +33,6 @@ impl LimitWork {
             w: Vec::new(),
             rhs: vec![0.0; free + 1],
             saved: vec![0.0; free + 1],
-            reached: 0.0,
             reduced: Reduced::default(),
         }
     }
