@@ -116,6 +116,14 @@ pub struct SolveOptions {
     pub chord_secant: bool,
     /// Record every iteration (residual, step, slack cables) for debugging.
     pub record_iterations: bool,
+    /// After a solve at the limit of one-sided members, compute how firmly the top surface
+    /// is held ([`SolveReport::holding_force`], [`SolveReport::floating`]): a factorisation
+    /// of the true tangent and nine solves with it, about a quarter of a sample with taut
+    /// diagonals (the default: true). Off for callers that read only the displacements (the
+    /// diagnosis's simulations); the displacements are the same bits either way, and the
+    /// report then says `floating: false` and `holding_force: None`, as for a model whose
+    /// bars frame the tilt.
+    pub holding: bool,
 }
 
 impl Default for SolveOptions {
@@ -128,6 +136,7 @@ impl Default for SolveOptions {
             reuse_contraction: 0.05,
             chord_secant: true,
             record_iterations: false,
+            holding: true,
         }
     }
 }

@@ -110,3 +110,55 @@ fn the_holding_force_bounds_a_load_that_moves_theta_by_one_percent() {
     );
     assert!(above as f64 >= 0.9 * checked as f64, "{above} of {checked}");
 }
+
+/// `SolveOptions::holding` off (the diagnosis's simulations) skips the holding force and
+/// nothing else: on 20 draws of the Fig. 16 case (σ = 0.0067 mm, the paper's clearances),
+/// every node's displacement and the report's counts are the same bits as with it on, and
+/// the report says `floating: false` and `holding_force: None`, where with it on every
+/// sample has a holding force and some float (the check would miss nothing it skips).
+#[test]
+fn without_the_holding_force_a_limit_solve_gives_the_same_displacements() {
+    let model = PrismOptions {
+        backlash: Some(BacklashOptions::default()),
+        ..PrismOptions::with_stages(5)
+    }
+    .model()
+    .unwrap();
+    let mut rng = Normals::new(11);
+    let mut with = Solver::new(&model, SolveOptions::default()).unwrap();
+    let mut without = Solver::new(
+        &model,
+        SolveOptions {
+            holding: false,
+            ..SolveOptions::default()
+        },
+    )
+    .unwrap();
+    let mut floating = 0;
+    for _ in 0..20 {
+        let (errors, clearances) = fig16_draw(&model, 0.0067, &mut rng);
+        let p = Perturbation {
+            length_errors: &errors,
+            clearances: &clearances,
+            ..Perturbation::default()
+        };
+        let a = with.solve_perturbed(p).unwrap();
+        let b = without.solve_perturbed(p).unwrap();
+        assert!(a.holding_force.is_some(), "{a:?}");
+        floating += usize::from(a.floating);
+        assert_eq!((b.holding_force, b.floating), (None, false), "{b:?}");
+        assert!(without.holding().is_none());
+        assert_eq!(
+            (a.iterations, a.factorisations, a.residual.to_bits()),
+            (b.iterations, b.factorisations, b.residual.to_bits())
+        );
+        for node in 0..model.nodes().len() {
+            let (x, y) = (with.displacement(node), without.displacement(node));
+            assert_eq!(x.map(f64::to_bits), y.map(f64::to_bits), "node {node}");
+        }
+    }
+    assert!(
+        floating > 0,
+        "no sample floated: the draws test less than they should"
+    );
+}

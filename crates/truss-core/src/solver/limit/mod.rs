@@ -236,7 +236,11 @@ impl Solver {
             self.set_limit_ratio(0.0);
             self.evaluate_current(kernels).await;
         }
-        self.holding = self.compute_holding(floor, kernels).await;
+        self.holding = if self.options.holding {
+            self.compute_holding(floor, kernels).await
+        } else {
+            None
+        };
         // Floating: the members that carry force do not hold the top surface.
         let floating = self
             .holding
