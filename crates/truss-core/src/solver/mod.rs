@@ -183,13 +183,14 @@ pub struct SolveReport {
     /// bear (and the geometric stiffness of their forces) is not positive definite, so a
     /// stage moves under an arbitrarily small load (a *floating* stage; see
     /// [`crate::limit`]): the answer then rests on effects the model leaves out. Never where
-    /// the model's bars frame the tilt.
+    /// the model's bars frame the tilt, nor where [`SolveOptions::holding`] is off (not
+    /// computed).
     pub floating: bool,
     /// The holding force \[N\]: the largest force on one node of the top surface that, to
     /// first order, moves θ_P by at most 1 % and makes no bearing one-sided member let go
     /// (0 where the equilibrium is not stable against some small load; see
     /// [`Solver::holding`]). Computed, like [`SolveReport::floating`], only where the
-    /// model's bars do not frame the tilt.
+    /// model's bars do not frame the tilt, and [`SolveOptions::holding`] is on.
     pub holding_force: Option<f64>,
     /// Where the limit solver's last attempt at `ρ = 0` did not converge, the compression
     /// ratio `ρ` of the one-sided members at the equilibrium reported instead: the last
