@@ -116,8 +116,9 @@ pub struct SolveOptions {
     pub chord_secant: bool,
     /// Record every iteration (residual, step, slack cables) for debugging.
     pub record_iterations: bool,
-    /// After a solve at the limit of one-sided members, compute how firmly the top surface
-    /// is held ([`SolveReport::holding_force`], [`SolveReport::floating`]): a factorisation
+    /// After a solve whose tilt the bars do not frame (pin joints), compute whether a stage
+    /// floats and how firmly the top surface is held ([`SolveReport::floating`],
+    /// [`SolveReport::holding_force`]); at the limit of one-sided members, a factorisation
     /// of the true tangent and nine solves with it, about a quarter of a sample with taut
     /// diagonals (the default: true). Off for callers that read only the displacements (the
     /// diagnosis's simulations); the displacements are the same bits either way, and the

@@ -250,7 +250,7 @@ impl Solver {
             }
         }
         let mut floating = false;
-        if assess {
+        if assess && self.options.holding {
             floating = self.floating();
             let floor = self.force_floor(&p.eval);
             self.holding = self.compute_holding(floor, kernels).await;
