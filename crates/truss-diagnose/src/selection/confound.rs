@@ -266,10 +266,7 @@ fn profile_cut(
     ));
     let ev = ctx.evaluator(&ctx.baseline.derived_case());
     let project = projection(&combined);
-    let mut objective = |t: &[f64]| {
-        let v: Vec<f64> = params.iter().zip(t).map(|(p, &x)| p.value(x)).collect();
-        ev.terms_at(&combined, &v)
-    };
+    let mut objective = ev.objective(&combined, &params);
     let problem = Problem {
         parameters: &params,
         project: &project,
