@@ -14,10 +14,7 @@
 //! solver that produced it, for what the result does not carry: the drawn length errors,
 //! the displacements). The calling thread receives the chunks and hands them to `take` in
 //! position order, each once. A sample's result depends only on the job and its index, so
-//! what `take` sees never depends on the thread count or the scheduling. (An engine given
-//! start points, [`Engine::with_starts`], for the diagnosis's finite differences, solves
-//! each sample from its start: its result then depends on the start too, still not on the
-//! threads.)
+//! what `take` sees never depends on the thread count or the scheduling.
 //!
 //! While it waits, the calling thread calls `take(None)` once every [`TICK`], for a caller
 //! that must check for an interrupt on its own thread (Python's signal handlers). An error
@@ -131,7 +128,6 @@ pub struct Engine<'a> {
     options: SolveOptions,
     halt: Option<&'a (dyn Fn() -> bool + Sync)>,
     lanes: bool,
-    starts: Option<crate::solve::Starts>,
 }
 
 impl<'a> Engine<'a> {
@@ -145,22 +141,7 @@ impl<'a> Engine<'a> {
             options: SolveOptions::default(),
             halt: None,
             lanes: std::env::var_os("TRUSS_LANES").is_none_or(|v| v != "off"),
-            starts: None,
         }
-    }
-
-    /// Each sample solved from its start in `starts` ([`SampleSolver::with_starts`]): for
-    /// the diagnosis's finite differences only. A result then depends on the start too (within
-    /// the solver's tolerance where the sample's equilibrium is unique); still not on the
-    /// thread count or the scheduling.
-    pub fn with_starts(mut self, starts: crate::solve::Starts) -> Self {
-        self.starts = Some(starts);
-        self
-    }
-
-    /// A sample solver with the engine's options and starts.
-    fn sample_solver(&self) -> SampleSolver<'a> {
-        SampleSolver::with_options(self.job, self.options.clone()).with_starts(self.starts.clone())
     }
 
     /// Whether each worker solves [`LANES`] samples side by side, their kernels batched
@@ -220,7 +201,7 @@ impl<'a> Engine<'a> {
                 let tx = tx.clone();
                 let (next, each, halted, indices) = (&next, &each, &halted, &indices);
                 scope.spawn(move || {
-                    let mut pool = vec![self.sample_solver()];
+                    let mut pool = vec![SampleSolver::with_options(self.job, self.options.clone())];
                     let mut kernels = BatchKernels::default();
                     loop {
                         let start = next.fetch_add(chunk_size, Ordering::Relaxed);
@@ -232,7 +213,8 @@ impl<'a> Engine<'a> {
                         let mut done = 0;
                         if self.lanes {
                             let mut work = InOrder {
-                                engine: self,
+                                job: self.job,
+                                options: &self.options,
                                 indices,
                                 next: start,
                                 end,
@@ -337,7 +319,8 @@ impl<'a> Engine<'a> {
 /// ends before one issued earlier waits, with its solver, until that one has ended. Each
 /// lane takes a solver from the pool (a new one when all are waiting).
 struct InOrder<'e, 'a, C, F, H> {
-    engine: &'e Engine<'a>,
+    job: &'a Job,
+    options: &'e SolveOptions,
     indices: &'e Indices<'e>,
     /// The next position to issue.
     next: u64,
@@ -371,7 +354,7 @@ where
         let mut solver = self
             .pool
             .pop()
-            .unwrap_or_else(|| self.engine.sample_solver());
+            .unwrap_or_else(|| SampleSolver::with_options(self.job, self.options.clone()));
         Some(Box::pin(async move {
             let result = solver.solve_in(index, kernels).await;
             (p, solver, result)
@@ -391,7 +374,6 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solve::Outcome;
     use std::sync::atomic::AtomicUsize;
 
     fn job(samples: u64) -> Job {
@@ -467,68 +449,6 @@ mod tests {
                 bits(&parts),
                 reference,
                 "split at {cut}, {threads} threads first"
-            );
-        }
-    }
-
-    /// Started from the anchors of a nearby job's samples (the diagnosis's stencils: every
-    /// length error 0.1 % larger; cases solved by Newton alone, and one with pin joints
-    /// solved at the limit of its one-sided members), the results are the same bits for
-    /// 1, 2 and 3 threads, in lanes or not, as a sample solver with the same starts gives
-    /// them one at a time; and θ_P is that of the solves from rest within 1e-9 of it.
-    #[test]
-    fn from_starts_the_same_bits_for_any_thread_count() {
-        let scaled = |f: f64| {
-            let text = format!(
-                r#"{{"model": {{"prism": {{"stages": 1}}}}, "seed": 3, "cases": [
-                    {{"name": "a", "samples": 90,
-                      "length_errors": {{"longeron": {{"normal": {{"sigma": {}}}}}}}}},
-                    {{"name": "b", "samples": 50,
-                      "length_errors": {{"batten": {{"uniform": {{"low": {}, "high": {}}}}}}}}},
-                    {{"name": "c", "samples": 60, "model": {{"prism": {{"stages": 2, "backlash": true}}}},
-                      "backlash": {{"clearance": {{"uniform": {{"low": 0.004, "high": 0.017}}}}}},
-                      "length_errors": {{"batten": {{"normal": {{"sigma": {}}}}},
-                        "longeron": {{"normal": {{"sigma": {}}}}},
-                        "diagonal": {{"uniform": {{"low": {}, "high": 0}}}}}}}}]}}"#,
-                0.01 * f,
-                -0.01 * f,
-                0.01 * f,
-                0.033 * f,
-                0.033 * f,
-                -0.099 * f
-            );
-            Job::from_json(&text, std::path::Path::new(".")).unwrap()
-        };
-        let (near, job) = (scaled(1.0), scaled(1.001));
-        let n = job.samples();
-        let starts: crate::solve::Starts = std::sync::Arc::new(
-            Engine::new(&near, 2).map(0..n, |s, r| s.solver(r.case).unwrap().anchor().to_vec()),
-        );
-        let mut alone = SampleSolver::new(&job).with_starts(Some(starts.clone()));
-        let one_by_one: Vec<SampleResult> = (0..n).map(|i| alone.solve(i)).collect();
-        for threads in [1, 2, 3] {
-            for lanes in [true, false] {
-                let got = Engine::new(&job, threads)
-                    .in_lanes(lanes)
-                    .with_starts(starts.clone())
-                    .results(0..n);
-                assert_eq!(
-                    bits(&got),
-                    bits(&one_by_one),
-                    "{threads} threads, lanes {lanes}"
-                );
-            }
-        }
-        let from_rest = Engine::new(&job, 2).results(0..n);
-        let theta = |r: &SampleResult| match &r.outcome {
-            Outcome::Converged(c) => c.distortion.theta_p,
-            Outcome::Failed(e) => panic!("sample {}: {e}", r.index),
-        };
-        for (a, b) in one_by_one.iter().zip(&from_rest) {
-            let (a, b) = (theta(a), theta(b));
-            assert!(
-                (a - b).abs() <= 1e-9 * b.abs(),
-                "{a} from the start, {b} from rest"
             );
         }
     }

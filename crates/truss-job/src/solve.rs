@@ -69,14 +69,7 @@ pub struct SampleSolver<'j> {
     clearances: Vec<f64>,
     lots: Vec<f64>,
     options: SolveOptions,
-    starts: Option<Starts>,
 }
-
-/// Start points of samples ([`SampleSolver::with_starts`]): entry `i` is the start of the
-/// job's global sample `i` \[mm\], one displacement per free degree of freedom of its case's
-/// model (typically the [`truss_core::Solver::anchor`] of the same sample in a nearby job);
-/// an empty entry, or none, means a solve from rest.
-pub type Starts = std::sync::Arc<Vec<Vec<f64>>>;
 
 impl<'j> SampleSolver<'j> {
     /// A sample solver for `job`.
@@ -98,19 +91,7 @@ impl<'j> SampleSolver<'j> {
             clearances: Vec::new(),
             lots: Vec::new(),
             options,
-            starts: None,
         }
-    }
-
-    /// Solves each sample from its start in `starts` where it has one, continuing that
-    /// equilibrium ([`truss_core::Solver::set_start`]): the same result within the
-    /// solver's tolerance where a sample's equilibrium is unique, the branch nearest the
-    /// start where it is not. For the diagnosis's finite differences only: a shard's
-    /// samples are solved from rest, so that they depend on nothing but the job and the
-    /// index.
-    pub fn with_starts(mut self, starts: Option<Starts>) -> Self {
-        self.starts = starts;
-        self
     }
 
     /// The job.
@@ -150,18 +131,6 @@ impl<'j> SampleSolver<'j> {
         let options = &self.options;
         let solver = self.solvers[c]
             .get_or_insert_with(|| Solver::with_structure(case.structure.clone(), options.clone()));
-        if let Some(start) = self.starts.as_ref().and_then(|s| s.get(index as usize))
-            && !start.is_empty()
-            && let Err(e) = solver.set_start(start)
-        {
-            return SampleResult {
-                index,
-                case: c,
-                sample: k,
-                iterations: 0,
-                outcome: Outcome::Failed(format!("sample {index}'s start: {e}")),
-            };
-        }
         let result = solver
             .solve_perturbed_in(
                 Perturbation {

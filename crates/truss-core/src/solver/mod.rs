@@ -282,10 +282,6 @@ pub struct Solver {
     /// Which sample the solver holds, for the batched kernels' buffers: a number unique to
     /// this solver in the process, and its count of samples set.
     sample_key: (usize, u64),
-    /// The next solve's start, where one is set ([`Solver::set_start`]).
-    start: Option<Vec<f64>>,
-    /// The last solve's anchor ([`Solver::anchor`]).
-    anchor: Vec<f64>,
 }
 
 /// The next solver's number (see `Solver::sample_key`).
@@ -425,8 +421,6 @@ impl Solver {
             evaluations: 0,
             chord_secant: f64::NAN,
             sample_key: (SOLVERS.fetch_add(1, Ordering::Relaxed) as usize, 0),
-            start: None,
-            anchor: vec![0.0; n],
             structure,
         }
     }
@@ -468,68 +462,13 @@ impl Solver {
         self.evaluations = 0;
         self.sample_key.1 += 1;
         self.set_sample(p)?;
-        let start = self.start.take();
-        let n = self.structure.free;
         let report = if self.structure.near_the_limit() {
-            self.solve_limit(start.as_deref(), kernels).await?
+            self.solve_limit(kernels).await?
         } else {
-            let warm = match &start {
-                Some(u) => {
-                    self.work.u[..n].copy_from_slice(u);
-                    self.newton_warm_assessed(true, kernels).await.ok()
-                }
-                None => None,
-            };
-            match warm {
-                Some(report) => report,
-                None => self.newton(kernels).await?,
-            }
+            self.newton(kernels).await?
         };
-        if !self.structure.near_the_limit() {
-            self.anchor.copy_from_slice(&self.work.u[..n]);
-        }
         self.last = Some(report);
         Ok(report)
-    }
-
-    /// Starts the next solve from `u` \[mm\] (one displacement per free degree of freedom,
-    /// [`crate::Structure::free_dofs`]), typically another sample's [`Solver::anchor`]: a
-    /// nearby problem's equilibrium, so that the solve continues it instead of starting
-    /// from rest. Newton at the first ratio of the limit's continuation (or, for a model
-    /// not solved at the limit, Newton itself) starts there instead of at the linearised
-    /// start, and the rest of the solve is as usual; where that Newton does not converge,
-    /// the solve starts from rest as without a start.
-    ///
-    /// Where the equilibrium is unique the result is the same within the solver's
-    /// tolerance, not the same bits; where a sample has several (a panel that can rack
-    /// either way), the start picks the branch nearest it. So a start belongs where the
-    /// caller wants the branch of a nearby solution (the diagnosis's finite differences,
-    /// see `truss-diagnose`), never in a shard's samples, which depend only on the job,
-    /// the seed and the index. Used by the next solve only.
-    ///
-    /// # Errors
-    /// [`SolveError::Input`] if `u` does not have one finite entry per free degree of
-    /// freedom.
-    pub fn set_start(&mut self, u: &[f64]) -> Result<(), SolveError> {
-        let n = self.structure.free;
-        if u.len() != n || u.iter().any(|x| !x.is_finite()) {
-            return Err(SolveError::Input(format!(
-                "a start needs {n} finite displacements; got {} (finite: {})",
-                u.len(),
-                u.iter().all(|x| x.is_finite())
-            )));
-        }
-        self.start = Some(u.to_vec());
-        Ok(())
-    }
-
-    /// The last solve's anchor \[mm\], one displacement per free degree of freedom: for a
-    /// model solved at the limit of its one-sided members, the equilibrium at the first
-    /// ratio of the continuation, where the approach to the limit starts (see
-    /// [`crate::limit`]); otherwise the converged point. A start for a nearby sample
-    /// ([`Solver::set_start`]). Zero before the first solve.
-    pub fn anchor(&self) -> &[f64] {
-        &self.anchor
     }
 
     /// Sets the per-sample member constants and loads, checking the input.

@@ -169,17 +169,6 @@ impl Solver {
         &mut self,
         kernels: Kernels<'_>,
     ) -> Result<SolveReport, SolveError> {
-        self.newton_warm_assessed(false, kernels).await
-    }
-
-    /// [`Solver::newton_warm`]; with `assess`, the converged point's floating flag and
-    /// holding force as [`Solver::newton`] gives them (a solve started from
-    /// [`Solver::set_start`]).
-    pub(super) async fn newton_warm_assessed(
-        &mut self,
-        assess: bool,
-        kernels: Kernels<'_>,
-    ) -> Result<SolveReport, SolveError> {
         let structure = Arc::clone(&self.structure);
         let eval = self.evaluate_current(kernels).await;
         self.chord_secant = f64::NAN;
@@ -200,7 +189,7 @@ impl Solver {
             u_max: max_abs(&self.work.u[..structure.free]),
             soft_directions: 0,
         };
-        self.iterate(p, assess, kernels).await
+        self.iterate(p, false, kernels).await
     }
 
     /// The iteration of [`Solver::newton`] from `p`; with `assess`, the converged point's

@@ -1,6 +1,6 @@
 //! truss-core's integration tests, one binary (as ripgrep does): verification against
 //! hand solutions and the paper, invariances, model faults, the prism, decenter and
-//! despace, backlash, and solves started from a nearby sample's anchor.
+//! despace, and backlash.
 
 mod backlash;
 mod common;
@@ -11,4 +11,3 @@ mod limit;
 mod model_errors;
 mod placement;
 mod prism;
-mod start;

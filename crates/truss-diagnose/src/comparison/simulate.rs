@@ -50,10 +50,6 @@ pub struct Simulation {
     pub failed: usize,
     /// The first failure's reason.
     pub first_failure: Option<String>,
-    /// Each sample's anchor, where asked ([`simulate_from`]): entry `k` is sample `k`'s
-    /// [`truss_core::Solver::anchor`] \[mm\] (empty where it failed), a start for the
-    /// same sample of a nearby case.
-    pub anchors: Option<truss_job::solve::Starts>,
 }
 
 /// What to simulate besides the noise-free displacements.
@@ -88,7 +84,6 @@ pub fn top_indices(coords: &[Coordinate], top: [usize; 3]) -> Option<[[usize; 3]
 
 struct Row {
     x: Vec<f64>,
-    anchor: Vec<f64>,
     failure: Option<String>,
 }
 
@@ -101,21 +96,6 @@ pub fn simulate(
     samples: usize,
     noise: Option<(Noise, [[usize; 3]; 3])>,
     threads: usize,
-) -> Result<Simulation, DiagnoseError> {
-    simulate_from(job, coords, samples, noise, threads, None, false)
-}
-
-/// [`simulate`], each sample solved from its start in `starts` where given (the anchors of
-/// a nearby case's simulation: see [`truss_job::solve::SampleSolver::with_starts`]), and
-/// with `capture` each sample's anchor kept in [`Simulation::anchors`].
-pub fn simulate_from(
-    job: &Job,
-    coords: &[Coordinate],
-    samples: usize,
-    noise: Option<(Noise, [[usize; 3]; 3])>,
-    threads: usize,
-    starts: Option<&truss_job::solve::Starts>,
-    capture: bool,
 ) -> Result<Simulation, DiagnoseError> {
     let d = coords.len();
     // The coordinates name nodes of the baseline's model; a derived case's model may number
@@ -136,18 +116,14 @@ pub fn simulate_from(
         .collect::<Result<_, _>>()?;
     // The comparison reads displacements only: the holding force, a quarter of a sample
     // whose diagonals are taut, is not computed (the displacements are the same bits).
-    let mut engine = Engine::new(job, threads).with_options(SolveOptions {
+    let engine = Engine::new(job, threads).with_options(SolveOptions {
         holding: false,
         ..SolveOptions::default()
     });
-    if let Some(starts) = starts {
-        engine = engine.with_starts(starts.clone());
-    }
     let rows = engine.map(0..samples as u64, |solver, result| {
         if let Outcome::Failed(reason) = result.outcome {
             return Row {
                 x: Vec::new(),
-                anchor: Vec::new(),
                 failure: Some(reason),
             };
         }
@@ -157,11 +133,6 @@ pub fn simulate_from(
                 .iter()
                 .map(|&(node, axis)| solver.displacement(node)[axis])
                 .collect(),
-            anchor: if capture {
-                solver.anchor().to_vec()
-            } else {
-                Vec::new()
-            },
             failure: None,
         }
     });
@@ -170,11 +141,7 @@ pub fn simulate_from(
         d,
         ..Simulation::default()
     };
-    let mut anchors = Vec::with_capacity(if capture { samples } else { 0 });
-    for (k, mut row) in rows.into_iter().enumerate() {
-        if capture {
-            anchors.push(std::mem::take(&mut row.anchor));
-        }
+    for (k, row) in rows.into_iter().enumerate() {
         if let Some(reason) = row.failure {
             sim.failed += 1;
             sim.first_failure.get_or_insert(reason);
@@ -199,9 +166,6 @@ pub fn simulate_from(
         sim.x.extend(row.x);
         sim.indices.push(k as u64);
         sim.n += 1;
-    }
-    if capture {
-        sim.anchors = Some(std::sync::Arc::new(anchors));
     }
     if sim.n == 0 || sim.failed * 20 > samples {
         return Err(DiagnoseError::Simulation {

@@ -45,47 +45,7 @@ use nalgebra::{DMatrix, DVector};
 pub type Terms = Vec<f64>;
 
 /// ℓ's terms as a function of internal coordinates.
-pub trait Objective {
-    /// The terms at `t`.
-    fn at(&mut self, t: &[f64]) -> Result<Terms, DiagnoseError>;
-
-    /// The terms at `t`, a point of a stencil around `centre` (whose terms `at` gave): an
-    /// objective may evaluate it by continuing the centre's solutions (the diagnosis's
-    /// simulations do: [`crate::likelihood::score`]); by default, as `at`.
-    fn around(&mut self, t: &[f64], centre: &[f64]) -> Result<Terms, DiagnoseError> {
-        let _ = centre;
-        self.at(t)
-    }
-}
-
-impl<F: FnMut(&[f64]) -> Result<Terms, DiagnoseError>> Objective for F {
-    fn at(&mut self, t: &[f64]) -> Result<Terms, DiagnoseError> {
-        self(t)
-    }
-}
-
-/// An objective of two closures: `at` for points, `around` for a stencil's points
-/// (`around(t, centre)`).
-pub struct Continued<A, B> {
-    /// The terms at a point.
-    pub at: A,
-    /// The terms at a point of a stencil around a centre.
-    pub around: B,
-}
-
-impl<A, B> Objective for Continued<A, B>
-where
-    A: FnMut(&[f64]) -> Result<Terms, DiagnoseError>,
-    B: FnMut(&[f64], &[f64]) -> Result<Terms, DiagnoseError>,
-{
-    fn at(&mut self, t: &[f64]) -> Result<Terms, DiagnoseError> {
-        (self.at)(t)
-    }
-
-    fn around(&mut self, t: &[f64], centre: &[f64]) -> Result<Terms, DiagnoseError> {
-        (self.around)(t, centre)
-    }
-}
+pub type Objective<'a> = dyn FnMut(&[f64]) -> Result<Terms, DiagnoseError> + 'a;
 
 /// First step in internal coordinates (a fiftieth of the range).
 pub const INITIAL_STEP: f64 = 0.02;
@@ -117,10 +77,8 @@ pub struct Derivatives {
 }
 
 /// Evaluations of the objective within one call, each point evaluated once.
-/// Every point but the stencil's own centre `seen[0]` is evaluated around it
-/// ([`Objective::around`]).
 struct Memo<'f, 'a> {
-    f: &'f mut (dyn Objective + 'a),
+    f: &'f mut Objective<'a>,
     seen: Vec<(Vec<f64>, Terms)>,
     evaluations: usize,
 }
@@ -131,8 +89,7 @@ impl Memo<'_, '_> {
             Some(i) => i,
             None => {
                 self.evaluations += 1;
-                let centre = self.seen[0].0.clone();
-                let terms = self.f.around(p, &centre)?;
+                let terms = (self.f)(p)?;
                 self.seen.push((p.to_vec(), terms));
                 self.seen.len() - 1
             }
@@ -187,7 +144,7 @@ pub fn derivatives(
     f_t: &Terms,
     steps: &[f64],
     clusters: Option<&[usize]>,
-    f: &mut dyn Objective,
+    f: &mut Objective,
     evaluations: &mut usize,
 ) -> Result<Derivatives, DiagnoseError> {
     stencil(t, f_t, steps, clusters, None, f, evaluations)
@@ -203,7 +160,7 @@ pub fn derivatives_along_axes(
     steps: &[f64],
     clusters: Option<&[usize]>,
     cross: &DMatrix<f64>,
-    f: &mut dyn Objective,
+    f: &mut Objective,
     evaluations: &mut usize,
 ) -> Result<Derivatives, DiagnoseError> {
     stencil(t, f_t, steps, clusters, Some(cross), f, evaluations)
@@ -217,7 +174,7 @@ pub fn derivatives_at_steps(
     f_t: &Terms,
     steps: &[f64],
     clusters: Option<&[usize]>,
-    f: &mut dyn Objective,
+    f: &mut Objective,
     evaluations: &mut usize,
 ) -> Result<Derivatives, DiagnoseError> {
     let fixed: Vec<f64> = steps.iter().map(|h| h.clamp(MIN_STEP, MAX_STEP)).collect();
@@ -231,7 +188,7 @@ fn stencil(
     steps: &[f64],
     clusters: Option<&[usize]>,
     cross: Option<&DMatrix<f64>>,
-    f: &mut dyn Objective,
+    f: &mut Objective,
     evaluations: &mut usize,
 ) -> Result<Derivatives, DiagnoseError> {
     stencil_with(t, f_t, steps, clusters, cross, true, f, evaluations)
@@ -246,7 +203,7 @@ fn stencil_with(
     clusters: Option<&[usize]>,
     cross: Option<&DMatrix<f64>>,
     adapt_steps: bool,
-    f: &mut dyn Objective,
+    f: &mut Objective,
     evaluations: &mut usize,
 ) -> Result<Derivatives, DiagnoseError> {
     let k = t.len();

@@ -318,7 +318,7 @@ fn curvature_at_maximum(
     terms: &Terms,
     d: Derivatives,
     clusters: Option<&[usize]>,
-    f: &mut dyn Objective,
+    f: &mut Objective,
     evaluations: &mut usize,
 ) -> Result<(DMatrix<f64>, DMatrix<f64>), DiagnoseError> {
     let a = -&d.hessian;
@@ -342,12 +342,12 @@ pub fn maximise(
     start: &[f64],
     options: Options,
     project: &dyn Fn(&mut [f64]),
-    f: &mut dyn Objective,
+    f: &mut Objective,
 ) -> Result<Fit, DiagnoseError> {
     let k = start.len();
     let mut t = start.to_vec();
     let mut evaluations = 1;
-    let mut terms = f.at(&t)?;
+    let mut terms = f(&t)?;
     let mut f0 = total(&terms);
     let mut steps = options
         .steps
@@ -397,7 +397,7 @@ pub fn maximise(
             break;
         }
         evaluations += 1;
-        let next_terms = f.at(&next)?;
+        let next_terms = f(&next)?;
         let f1 = total(&next_terms);
         let gain = f1 - f0;
         if gain > 0.0 {

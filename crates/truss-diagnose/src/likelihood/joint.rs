@@ -130,7 +130,10 @@ pub(crate) fn joint_fit(
         .collect();
     let project = projection(&combined);
     let clusters = ev.measured.clusters();
-    let mut objective = ev.objective(&combined, &params);
+    let mut objective = |t: &[f64]| {
+        let v: Vec<f64> = params.iter().zip(t).map(|(p, &x)| p.value(x)).collect();
+        ev.terms_at(&combined, &v)
+    };
     let options = Options {
         steps,
         curvature: true,

@@ -62,7 +62,7 @@
 
 use crate::candidates::parameter::Parameter;
 use crate::errors::DiagnoseError;
-use crate::likelihood::derivatives::{MAX_STEP, Objective, Terms, total};
+use crate::likelihood::derivatives::{MAX_STEP, Objective, total};
 use crate::likelihood::fit::{Fit, Interval, Options, TOLERANCE, adjustments, maximise};
 use nalgebra::{DMatrix, DVector};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -125,26 +125,10 @@ enum End {
     Higher(Vec<f64>),
 }
 
-/// The objective of the other parameters, one held fixed: `full` puts it back.
-struct Fixed<'f, 'a, G> {
-    f: &'f mut (dyn Objective + 'a),
-    full: G,
-}
-
-impl<G: Fn(&[f64]) -> Vec<f64>> Objective for Fixed<'_, '_, G> {
-    fn at(&mut self, s: &[f64]) -> Result<Terms, DiagnoseError> {
-        self.f.at(&(self.full)(s))
-    }
-
-    fn around(&mut self, s: &[f64], centre: &[f64]) -> Result<Terms, DiagnoseError> {
-        self.f.around(&(self.full)(s), &(self.full)(centre))
-    }
-}
-
 struct Profiler<'p, 'f, 'a> {
     fit: &'p Fit,
     problem: &'p Problem<'p>,
-    f: &'f mut (dyn Objective + 'a),
+    f: &'f mut Objective<'a>,
     evaluations: usize,
 }
 
@@ -160,7 +144,7 @@ impl Profiler<'_, '_, '_> {
         start[j] = x;
         if k == 1 {
             self.evaluations += 1;
-            return Ok((total(&self.f.at(&start)?), start));
+            return Ok((total(&(self.f)(&start)?), start));
         }
         let full = |s: &[f64]| -> Vec<f64> {
             let mut t = Vec::with_capacity(k);
@@ -181,10 +165,8 @@ impl Profiler<'_, '_, '_> {
             project(&mut t, Some(j));
             s.copy_from_slice(&drop_j(&t));
         };
-        let mut sub_f = Fixed {
-            f: &mut *self.f,
-            full,
-        };
+        let f = &mut *self.f;
+        let mut sub_f = |s: &[f64]| f(&full(s));
         let steps = drop_j(&self.fit.steps);
         let inner = maximise(
             &drop_j(&start),
@@ -398,7 +380,7 @@ fn next_trial(
 pub fn profile_intervals(
     fit: &Fit,
     problem: &Problem,
-    f: &mut dyn Objective,
+    f: &mut Objective,
     joint: bool,
 ) -> Result<Profile, DiagnoseError> {
     let all: Vec<usize> = (0..fit.internal.len()).collect();
@@ -409,7 +391,7 @@ pub fn profile_intervals(
 pub fn profile_some(
     fit: &Fit,
     problem: &Problem,
-    f: &mut dyn Objective,
+    f: &mut Objective,
     joint: bool,
     which: &[usize],
 ) -> Result<Profile, DiagnoseError> {

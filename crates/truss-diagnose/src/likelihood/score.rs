@@ -1,36 +1,14 @@
 //! One candidate at a time: ℓ of the data under an edited case, the candidate's maximum, its
 //! likelihood-ratio test against the baseline, and its intervals (Wald for every candidate,
 //! profile likelihood for those the verdict rests on).
-//!
-//! ## A stencil's simulations
-//!
-//! A finite-difference stencil ([`crate::likelihood::derivatives`]) evaluates ℓ at points a
-//! step of at most a twentieth of the range away from its centre. For a model solved at the
-//! limit of its one-sided members (pin joints in free play), each such point within
-//! [`CONTINUED_STEP`] of its centre is simulated with every sample started from that
-//! sample's anchor in the centre's simulation ([`truss_core::Solver::anchor`]: the
-//! equilibrium from which its approach to the limit starts), not from rest: the solver
-//! continues a nearby equilibrium, without the linearised start and with fewer Newton
-//! iterations. Other models are solved from rest (see `continued` for why, with the
-//! measurements). Where a sample's equilibrium is unique the result is the one from rest
-//! within the solver's tolerance (the σ = 0.033 mm prism with pin joints, 300 draws, a
-//! 0.1 % step of every length error: θ_P within 3e-8; a 1 % step: 2 draws beyond 1e-6, the
-//! worst 7e-5); where a sample has several, it stays on the centre's branch, so that a
-//! difference measures the branch's slope rather than a jump to another branch. A stencil
-//! point's terms are a function of the point and its centre, remembered under both; the
-//! centres themselves, the scan and the trial steps are simulated from rest, so that ℓ at a
-//! point a fit stands on does not depend on the path to it. The centre's anchors are kept
-//! for the last cases simulated from rest, up to [`ANCHOR_BYTES`]; a stencil whose
-//! centre's were dropped simulates the centre again (the same terms, from the same random
-//! numbers).
 
 use crate::candidates::candidate::Candidate;
 use crate::candidates::parameter::Parameter;
 use crate::comparison::baseline::{Baseline, CaseEdit};
 use crate::comparison::measured::Measured;
-use crate::comparison::simulate::{Simulation, simulate_from};
+use crate::comparison::simulate::{Simulation, simulate};
 use crate::errors::DiagnoseError;
-use crate::likelihood::derivatives::{Continued, Objective, Terms};
+use crate::likelihood::derivatives::Terms;
 use crate::likelihood::fit::{Fit, Interval, Options, adjustments, maximise, wald_intervals};
 use crate::likelihood::gaussian::{Gaussian, member_log_likelihood};
 use crate::likelihood::power::{DetectionLimit, detection_limit};
@@ -183,72 +161,18 @@ pub fn p_is(p: f64) -> String {
 /// With common random numbers a case's terms are a function of its job alone, so a
 /// remembered value is exactly the one a new simulation would give. At most
 /// [`MEMO_CASES`] are kept, the oldest forgotten first.
-///
-/// It also keeps the samples' anchors of the last cases simulated from rest (up to
-/// [`ANCHOR_BYTES`]): the starts of their stencils' points (module doc).
 #[derive(Default)]
 pub(crate) struct Memo {
     terms: std::cell::RefCell<(
         std::collections::HashMap<String, Terms>,
         std::collections::VecDeque<String>,
     )>,
-    anchors: std::cell::RefCell<std::collections::VecDeque<(String, truss_job::solve::Starts)>>,
 }
 
 /// Most cases the memo of ℓ's terms keeps (each n + member-observation values).
 pub const MEMO_CASES: usize = 512;
 
-/// Whether a stencil's points of `job`'s model are solved from their centre's anchors: where
-/// the model is solved at the limit of its one-sided members (pin joints in free play). There
-/// a sample's linearised start and Newton at the continuation's first ratio are most of its
-/// cost, and a start from the centre's anchor skips them: cachegrind, 2,000 samples of the
-/// 5-stage prism with pin joints at σ = 0.033 mm, the diagonals' upper bound moved by 1 µm
-/// and 5 µm, 41 % and 32 % fewer instructions. A model whose bars frame the tilt is solved
-/// from the linearised start by chord steps with the shared nominal factorisation, which
-/// Newton from a nearby point beats only for nearly the same problem: the rigid prism with
-/// every σ 0.0016 % larger, 55 % fewer instructions; 1.6 % larger, 5 %; 4.8 % larger, 19 %
-/// more; and a diagnosis of the rigid prism at σ = 6.3 µm (`scripts/diagnose-check.sh`'s
-/// bias-202), 22 % more CPU. (At σ = 0.033 mm, most diagonals slack, the same prism's
-/// candidates fitted in 34 s from the anchors against 51 s from rest: a rule by each
-/// sample's own cost at the centre would serve both; not built.)
-fn continued(job: &truss_job::Job) -> bool {
-    job.cases[0].structure.near_the_limit()
-}
-
-/// The largest step from its centre (internal coordinates, along any axis) at which a
-/// stencil's point is solved from the centre's anchors; beyond, from rest.
-pub const CONTINUED_STEP: f64 = 0.01;
-
-/// The memory the memo's anchors may take \[bytes\] (each case N × the model's free degrees
-/// of freedom × 8, 2.1 MB for 4,000 samples of the 5-stage prism with pin joints, so 32 such
-/// cases: more than the points of an axis scan, which a fit's first stencil is centred on);
-/// at least the newest case is kept, the oldest dropped first.
-pub const ANCHOR_BYTES: usize = 64 << 20;
-
 impl Memo {
-    /// The samples' anchors of job `id`, if kept.
-    pub fn anchors(&self, id: &str) -> Option<truss_job::solve::Starts> {
-        self.anchors
-            .borrow()
-            .iter()
-            .find(|(k, _)| k == id)
-            .map(|(_, a)| a.clone())
-    }
-
-    /// Keeps the samples' anchors of job `id`.
-    pub fn put_anchors(&self, id: &str, anchors: truss_job::solve::Starts) {
-        let mut kept = self.anchors.borrow_mut();
-        kept.retain(|(k, _)| k != id);
-        kept.push_back((id.to_string(), anchors));
-        let bytes = |a: &truss_job::solve::Starts| 8 * a.iter().map(Vec::len).sum::<usize>();
-        let mut total: usize = kept.iter().map(|(_, a)| bytes(a)).sum();
-        while total > ANCHOR_BYTES && kept.len() > 1 {
-            if let Some((_, a)) = kept.pop_front() {
-                total -= bytes(&a);
-            }
-        }
-    }
-
     /// The terms of job `id`, if remembered.
     pub fn get(&self, id: &str) -> Option<Terms> {
         self.terms.borrow().0.get(id).cloned()
@@ -297,79 +221,18 @@ impl Evaluator<'_> {
         if let Some(terms) = self.memo.and_then(|m| m.get(&job.id)) {
             return Ok(terms);
         }
-        self.simulate_from_rest(&job)
-    }
-
-    /// Simulates `job` from rest and scores it; where there is a memo, remembers the terms
-    /// and keeps the samples' anchors.
-    fn simulate_from_rest(&self, job: &truss_job::Job) -> Result<Terms, DiagnoseError> {
-        let sim = simulate_from(
-            job,
-            &self.measured.coords,
-            self.samples,
-            None,
-            self.threads,
-            None,
-            self.memo.is_some() && continued(job),
-        )?;
-        self.simulations.set(self.simulations.get() + 1);
-        let terms = self.score(job, &sim)?;
-        if let Some(m) = self.memo {
-            m.put(&job.id, &terms);
-            if let Some(anchors) = sim.anchors {
-                m.put_anchors(&job.id, anchors);
-            }
-        }
-        Ok(terms)
-    }
-
-    /// ℓ's terms under `edit`, a point of a finite-difference stencil around `centre`: each
-    /// sample solved from its anchor in the centre's simulation, continuing the centre's
-    /// equilibria (see the module doc). Without a memo, or where the two models differ in
-    /// their unknowns (a backlash candidate at a clearance of 0 has no joints), as
-    /// [`Evaluator::log_likelihood`].
-    fn log_likelihood_around(
-        &self,
-        edit: &CaseEdit,
-        centre: &CaseEdit,
-    ) -> Result<Terms, DiagnoseError> {
-        let Some(memo) = self.memo else {
-            return self.log_likelihood(edit);
-        };
-        let job = self.job(edit)?;
-        let from = self.job(centre)?;
-        let free = |j: &truss_job::Job| j.cases[0].structure.free_dofs();
-        if job.id == from.id || !continued(&job) || free(&job) != free(&from) {
-            return self.log_likelihood(edit);
-        }
-        let key = format!("{} around {}", job.id, from.id);
-        if let Some(terms) = memo.get(&key) {
-            return Ok(terms);
-        }
-        let anchors = match memo.anchors(&from.id) {
-            Some(a) => a,
-            None => {
-                // The centre's terms were remembered, its anchors not: simulate it again
-                // (the same terms, from the same random numbers).
-                self.simulate_from_rest(&from)?;
-                match memo.anchors(&from.id) {
-                    Some(a) => a,
-                    None => return self.log_likelihood(edit),
-                }
-            }
-        };
-        let sim = simulate_from(
+        let sim = simulate(
             &job,
             &self.measured.coords,
             self.samples,
             None,
             self.threads,
-            Some(&anchors),
-            false,
         )?;
         self.simulations.set(self.simulations.get() + 1);
         let terms = self.score(&job, &sim)?;
-        memo.put(&key, &terms);
+        if let Some(m) = self.memo {
+            m.put(&job.id, &terms);
+        }
         Ok(terms)
     }
 
@@ -402,44 +265,6 @@ impl Evaluator<'_> {
     /// ℓ's per-unit terms with the candidate at `values` (one simulation).
     pub fn terms_at(&self, c: &dyn Candidate, values: &[f64]) -> Result<Terms, DiagnoseError> {
         self.log_likelihood(&self.edit(c, values)?)
-    }
-
-    /// [`Evaluator::terms_at`] for a point of a stencil around the candidate at `centre`
-    /// ([`Evaluator::log_likelihood_around`]).
-    pub fn terms_around(
-        &self,
-        c: &dyn Candidate,
-        values: &[f64],
-        centre: &[f64],
-    ) -> Result<Terms, DiagnoseError> {
-        self.log_likelihood_around(&self.edit(c, values)?, &self.edit(c, centre)?)
-    }
-
-    /// The objective of candidate `c` whose parameters are `params` (a candidate's, or a
-    /// combination's): ℓ's terms at internal coordinates, a stencil's points continued from
-    /// their centre.
-    pub fn objective<'e>(
-        &'e self,
-        c: &'e dyn Candidate,
-        params: &'e [Parameter],
-    ) -> impl Objective + 'e {
-        let values = move |t: &[f64]| -> Vec<f64> {
-            params.iter().zip(t).map(|(p, &x)| p.value(x)).collect()
-        };
-        Continued {
-            at: move |t: &[f64]| self.terms_at(c, &values(t)),
-            around: move |t: &[f64], centre: &[f64]| {
-                let far = t
-                    .iter()
-                    .zip(centre)
-                    .any(|(a, b)| (a - b).abs() > CONTINUED_STEP);
-                if far {
-                    self.terms_at(c, &values(t))
-                } else {
-                    self.terms_around(c, &values(t), &values(centre))
-                }
-            },
-        }
     }
 
     /// The current model's case with the candidate applied at `values`.
@@ -480,9 +305,9 @@ pub const SCAN: [f64; 8] = [0.0, 0.125, 0.25, 0.375, 0.625, 0.75, 0.875, 1.0];
 fn best_start(
     null: &[f64],
     project: &dyn Fn(&mut [f64], Option<usize>),
-    f: &mut dyn Objective,
+    f: &mut dyn FnMut(&[f64]) -> Result<Terms, DiagnoseError>,
 ) -> Result<Vec<f64>, DiagnoseError> {
-    let mut best = (f.at(null)?.iter().sum::<f64>(), null.to_vec());
+    let mut best = (f(null)?.iter().sum::<f64>(), null.to_vec());
     let mut scan = |from: &[f64], i: usize, best: &mut (f64, Vec<f64>)| -> bool {
         let mut seen: Vec<Vec<f64>> = vec![from.to_vec()];
         for &x in &SCAN {
@@ -493,7 +318,7 @@ fn best_start(
                 continue;
             }
             seen.push(t.clone());
-            if let Ok(terms) = f.at(&t) {
+            if let Ok(terms) = f(&t) {
                 let l: f64 = terms.iter().sum();
                 if l > best.0 {
                     *best = (l, t);
@@ -535,8 +360,15 @@ pub(crate) struct Fitted {
 }
 
 /// A candidate's objective: ℓ's terms at internal coordinates.
-fn objective<'a>(ev: &'a Evaluator<'a>, c: &'a dyn Candidate) -> impl Objective + 'a {
-    ev.objective(c, c.parameters())
+fn objective<'a>(
+    ev: &'a Evaluator<'a>,
+    c: &'a dyn Candidate,
+) -> impl FnMut(&[f64]) -> Result<Terms, DiagnoseError> + 'a {
+    let params = c.parameters();
+    move |t: &[f64]| {
+        let v: Vec<f64> = params.iter().zip(t).map(|(p, &x)| p.value(x)).collect();
+        ev.log_likelihood(&ev.edit(c, &v)?)
+    }
 }
 
 /// A candidate's projection of internal coordinates onto its feasible set, leaving the
@@ -615,16 +447,10 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
     let params = c.parameters();
     let null: Vec<f64> = params.iter().map(|p| p.internal(p.null)).collect();
     let count = std::cell::Cell::new(0usize);
-    let (objective, project) = (std::cell::RefCell::new(objective(ev, c)), projection(c));
-    let mut counted = Continued {
-        at: |t: &[f64]| {
-            count.set(count.get() + 1);
-            objective.borrow_mut().at(t)
-        },
-        around: |t: &[f64], centre: &[f64]| {
-            count.set(count.get() + 1);
-            objective.borrow_mut().around(t, centre)
-        },
+    let (mut objective, project) = (objective(ev, c), projection(c));
+    let mut counted = |t: &[f64]| {
+        count.set(count.get() + 1);
+        objective(t)
     };
     let start = best_start(&null, &project, &mut counted).unwrap_or(null);
     let clusters = ev.measured.clusters();

@@ -266,7 +266,10 @@ fn profile_cut(
     ));
     let ev = ctx.evaluator(&ctx.baseline.derived_case());
     let project = projection(&combined);
-    let mut objective = ev.objective(&combined, &params);
+    let mut objective = |t: &[f64]| {
+        let v: Vec<f64> = params.iter().zip(t).map(|(p, &x)| p.value(x)).collect();
+        ev.terms_at(&combined, &v)
+    };
     let problem = Problem {
         parameters: &params,
         project: &project,

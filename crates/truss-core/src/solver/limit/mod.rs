@@ -24,9 +24,7 @@
 //! 1. **The anchor** at `ρ₀`: the linearised problem's one-sided solution from the rest
 //!    state ([`start`]: the bearing set found by primal–dual active-set rounds on the
 //!    linear problem), then the ordinary Newton iteration ([`Solver::newton_warm`]) at
-//!    `ρ₀`. Given a start ([`Solver::set_start`]: a nearby sample's anchor), Newton at `ρ₀`
-//!    starts there instead, and from rest as above only where it does not converge. The
-//!    point reached is the solve's anchor ([`Solver::anchor`]).
+//!    `ρ₀`.
 //! 2. **An attempt at `ρ = 0`** from the converged point ([`newton`]: a Newton iteration
 //!    whose steps are exact where the tangent is soft, [`reduced`]), watching the bearing
 //!    set: if no member changes side and nothing falls on the way, the branch reaches the
@@ -159,12 +157,9 @@ impl Solver {
         }
     }
 
-    /// The continuation of the module doc, from the linearised start at `ρ₀`, or from
-    /// `start` where one is given and Newton at `ρ₀` converges from it
-    /// ([`Solver::set_start`]).
+    /// The continuation of the module doc, from the linearised start at `ρ₀`.
     pub(super) async fn solve_limit(
         &mut self,
-        start: Option<&[f64]>,
         kernels: Kernels<'_>,
     ) -> Result<SolveReport, SolveError> {
         let s = Arc::clone(&self.structure);
@@ -174,21 +169,10 @@ impl Solver {
             iterations: 1,
             ..Counts::default()
         };
-        let mut anchored = false;
-        if let Some(u) = start {
-            self.set_limit_ratio(FIRST_RATIO);
-            self.work.u[..n].copy_from_slice(u);
-            if let Ok(r) = self.newton_warm(kernels).await {
-                counts.iterations += r.iterations;
-                counts.factorisations += r.factorisations;
-                anchored = true;
-            }
-        }
-        if !anchored
-            && self
-                .anchor_at(FIRST_RATIO, &mut counts, kernels)
-                .await
-                .is_err()
+        if self
+            .anchor_at(FIRST_RATIO, &mut counts, kernels)
+            .await
+            .is_err()
         {
             // A tall truss whose many panels rack at once: reach `ρ₀` from a stiffer
             // anchor instead (see `continue_down`).
@@ -197,7 +181,6 @@ impl Solver {
                 .await
                 .map_err(|(e, _)| e)?;
         }
-        self.anchor.copy_from_slice(&self.work.u[..n]);
         let stages = (FIRST_RATIO / LAST_RATIO).log10().round() as i32;
         let mut limit_ratio = None;
         // The ratio of the last converged stage, which stands for the limit where the last
