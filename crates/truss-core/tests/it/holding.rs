@@ -43,12 +43,7 @@ fn loaded(
 /// solve resolves (1e-10 N against a force floor of about 1e-13 N) are not re-solved.
 #[test]
 fn the_holding_force_bounds_a_load_that_moves_theta_by_one_percent() {
-    let model = PrismOptions {
-        backlash: Some(BacklashOptions::default()),
-        ..PrismOptions::with_stages(5)
-    }
-    .model()
-    .unwrap();
+    let model = fig16_model();
     let mut rng = Normals::new(7);
     let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
     let (mut below, mut above, mut checked, mut limits) = (vec![], 0, 0, [0; 2]);
@@ -120,10 +115,6 @@ fn the_holding_force_bounds_a_load_that_moves_theta_by_one_percent() {
 /// limit some float: the check would miss nothing it skips).
 #[test]
 fn without_the_holding_force_a_solve_gives_the_same_displacements() {
-    let at_limit = PrismOptions {
-        backlash: Some(BacklashOptions::default()),
-        ..PrismOptions::with_stages(5)
-    };
     let explicit = PrismOptions {
         compression_ratio: 1e-4,
         backlash: Some(BacklashOptions {
@@ -132,7 +123,7 @@ fn without_the_holding_force_a_solve_gives_the_same_displacements() {
         }),
         ..PrismOptions::with_stages(5)
     };
-    let floating = same_displacements_without_holding(&at_limit.model().unwrap());
+    let floating = same_displacements_without_holding(&fig16_model());
     assert!(
         floating > 0,
         "no sample floated at the limit: the draws test less than they should"

@@ -9,7 +9,7 @@
 //! floating one does.
 
 use crate::common::*;
-use truss_core::prism::{BacklashOptions, PrismOptions};
+use truss_core::prism::PrismOptions;
 use truss_core::solver::Perturbation;
 use truss_core::{SolveOptions, Solver, Structure};
 
@@ -19,12 +19,7 @@ use truss_core::{SolveOptions, Solver, Structure};
 fn the_rigid_prism_is_framed_by_its_bars_and_the_prism_with_joints_is_not() {
     let rigid = PrismOptions::with_stages(5).model().unwrap();
     assert!(Structure::new(&rigid).unwrap().tilt_framed());
-    let joints = PrismOptions {
-        backlash: Some(BacklashOptions::default()),
-        ..PrismOptions::with_stages(5)
-    }
-    .model()
-    .unwrap();
+    let joints = fig16_model();
     assert!(!Structure::new(&joints).unwrap().tilt_framed());
 }
 
@@ -77,12 +72,7 @@ fn the_framed_prism_gives_the_limits_theta() {
 /// fails (measured: 1 of 180).
 #[test]
 fn a_floating_sample_is_moved_by_a_micronewton_and_a_held_one_is_not() {
-    let model = PrismOptions {
-        backlash: Some(BacklashOptions::default()),
-        ..PrismOptions::with_stages(5)
-    }
-    .model()
-    .unwrap();
+    let model = fig16_model();
     let top = model.node_index("n5.0").unwrap();
     let mut nudge = vec![[0.0; 3]; model.nodes().len()];
     nudge[top] = [1e-6, 0.0, 0.0];

@@ -85,6 +85,17 @@ pub fn file(
     }
 }
 
+/// The model of Fig. 16 (section 4.2.3): the 5-stage prism with pin joints of the default
+/// clearance, its cables of ratio 0 solved at their limit.
+pub fn fig16_model() -> truss_core::Model {
+    truss_core::prism::PrismOptions {
+        backlash: Some(truss_core::prism::BacklashOptions::default()),
+        ..truss_core::prism::PrismOptions::with_stages(5)
+    }
+    .model()
+    .unwrap()
+}
+
 /// One sample of the paper's Fig. 16 case (§4.2.3) for a prism with backlash joints:
 /// battens and longerons N(0, σ²), diagonals U[−3σ, 0] (every member's numbers drawn in
 /// model order), then each joint's clearance U[0.004, 0.017] mm: (length errors, clearances)
