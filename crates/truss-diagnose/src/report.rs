@@ -94,8 +94,9 @@
 //!              (the first named effect's, as fitted in its step; for an effect swapped in,
 //!              the last joint re-fit's, Wald intervals)
 //!   interval   {lower, upper, lower_at_range_end, upper_at_range_end, method, threshold?}:
-//!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the named effect and those
-//!              indistinguishable from it, else "wald"; lower/upper null when not found;
+//!              method "profile" (2(ℓ̂ − ℓ_p) ≤ threshold) for the first step's named
+//!              effect and those indistinguishable from it, and for a later step's where its
+//!              update left it alone in the model; else "wald"; lower/upper null when not found;
 //!              an end at the range end is the range's (the interval is cut there)
 //!   determined false where the interval, or the Wald interval, covers at least half of the
 //!              plausible range (on the fit's scale): "not determined by these data", no
@@ -132,9 +133,16 @@
 //! timing      {simulations, solves, seconds, final_fit_seconds, threads (of the
 //!              simulations), stages [{stage, seconds, simulations}] (each stage in order:
 //!              the baseline's simulation and comparison; per step, fitting the
-//!              candidates, deciding with the profiles, updating the model, comparing the
-//!              updated model; the final fit; the confounding tests)}
+//!              candidates, deciding with the profiles, updating the model, profiling the
+//!              model's effect where the update left it alone (later steps only), comparing
+//!              the updated model; the final fit; the confounding tests)}
 //! ```
+//!
+//! Version 12 (from 11): a step after the first profiles its named effect (and the
+//! candidates indistinguishable from it) only where its update leaves that effect alone in
+//! the model, in a stage of its own (`step N: profile the model's effect`); elsewhere those
+//! candidates' `interval` is the Wald one (`method` "wald"), since the final numbers of a
+//! model of several effects are the joint re-fit's. The shape is unchanged.
 //!
 //! Version 11 (from 10): `steps[].pair`, the pair of interacting candidates fitted jointly
 //! at a step; a step that names a pair has both in `named_effects` and the verdicts'
@@ -219,7 +227,7 @@ pub use markdown::markdown;
 /// Format name.
 pub const FORMAT: &str = "truss-diagnose";
 /// Format version.
-pub const FORMAT_VERSION: u32 = 11;
+pub const FORMAT_VERSION: u32 = 12;
 
 #[derive(Serialize)]
 struct JobRef<'a> {

@@ -4,9 +4,10 @@
 //! Each step ([`step`]) passes through four stages in order: it compares the current model
 //! (the baseline with the effects added so far) with the measurements, fits and tests every
 //! remaining candidate against it ([`crate::likelihood::score`]), decides from the tests and
-//! BIC ([`decide`]; the named candidate and those indistinguishable from it get
+//! BIC ([`decide`]; at the first step, and at a later one whose update leaves its effect
+//! alone in the model, the named candidate and those indistinguishable from it get
 //! profile-likelihood intervals, [`crate::likelihood::profile`], and should a profile find a
-//! higher maximum the verdict is decided again on the new fits; then a pair of candidates
+//! higher maximum at the first step the verdict is decided again on the new fits; then a pair of candidates
 //! whose effects interact, one of them significant and neither named, is fitted jointly
 //! and named in the step's effect's place when it is significant and better by BIC, or
 //! listed as an alternative reading when as good, [`pair`]: forward selection adds one

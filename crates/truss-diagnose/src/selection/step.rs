@@ -9,9 +9,10 @@
 //! 2. **fit each candidate** (`fit_each`): every remaining candidate applied to the
 //!    current model's typed case ([`crate::comparison::baseline::CaseEdit`]), its ℓ
 //!    maximised and tested against the current model ([`crate::likelihood::score`]).
-//! 3. **decide** (`decide_and_profile`): the verdict of [`decide`]; the candidate it names
-//!    and those indistinguishable from it get profile-likelihood intervals, and should a
-//!    profile find a higher maximum the verdict is decided again on the new fits. Then a
+//! 3. **decide** (`decide_and_profile`): the verdict of [`decide`]; at the first step, the
+//!    candidate it names and those indistinguishable from it get profile-likelihood
+//!    intervals, and should a profile find a higher maximum the verdict is decided again on
+//!    the new fits (see *Profiles where they give the final numbers* below). Then a
 //!    pair of candidates whose effects interact, one of them significant and neither named,
 //!    is fitted jointly and may be named in the named one's place, or be listed as an
 //!    alternative reading ([`crate::selection::pair`]).
@@ -19,6 +20,24 @@
 //!    effect of the model is re-fitted jointly and each effect added in an earlier step is
 //!    tested for removal given the others and tried swapped for a rival; the updated
 //!    model is the next step's to compare.
+//!
+//! ## Profiles where they give the final numbers
+//!
+//! A step's profiles give the numbers read last only where its effect ends alone in the
+//! model ([`crate::selection::confound`]: a model of one effect reports its own step's fit
+//! and profile intervals; a model of several, the joint re-fit's). At the first step that
+//! is still open. At a later step the named effect joins the effects already in the model,
+//! and the update re-fits them jointly: its profiles there would be superseded, and they
+//! cost nearly as much as the rest of the step (327 of the 1,167 simulations of the second
+//! step of `scripts/bench-diagnose.sh`, a three-parameter scatter profiled with its joint
+//! region). So a later step profiles nothing while it decides, and its candidates keep
+//! their sandwich Wald intervals (`method` "wald" in the report; they are also the final
+//! numbers where the joint re-fit fails and each effect's own step's fit is all there is),
+//! unless the update removes every earlier effect: the named effect is then the model's
+//! only one, and it and the candidates indistinguishable from it are profiled after the
+//! update, on the same simulations. A profile that finds a higher maximum there raises the
+//! effect's reported fit and intervals, not the model the update made with the fit before
+//! it; the next step's comparison and fits start from that model.
 //!
 //! ## Does the added effect make the fit worse?
 //!
@@ -255,7 +274,8 @@ pub(crate) fn run(
         Some(&ev),
         || fit_each(ctx, &ev, candidates, &test),
     );
-    // 3. Decide.
+    // 3. Decide, with profiles where this step's fit may give the final numbers.
+    let profile_now = pool.added.is_empty();
     let (decision, scores) = ctx.timed(
         format!("step {number}: decide and profile"),
         Some(&ev),
@@ -267,6 +287,7 @@ pub(crate) fn run(
                 &mut fitted,
                 &test,
                 &current.comparison,
+                profile_now,
             )
         },
     );
@@ -297,7 +318,6 @@ pub(crate) fn run(
     let partner = pair
         .as_ref()
         .and_then(|p| pair::settle(&mut decision, p, &scores));
-    ctx.count(&ev);
     let Decision {
         verdict,
         reason,
@@ -341,6 +361,43 @@ pub(crate) fn run(
             })
         })
         .transpose()?;
+    let mut scores = scores;
+    if let (false, Some(i), Some(up)) = (profile_now, named, &up)
+        && up.effects.len() == 1
+    {
+        // The update left this step's effect alone in the model (it removed every earlier
+        // one): its own fit gives the final numbers, so it is profiled now (module doc).
+        let wanted: Vec<usize> = std::iter::once(i)
+            .chain(
+                scores
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, s)| indistinguishable.contains(&s.name))
+                    .map(|(j, _)| j),
+            )
+            .collect();
+        ctx.timed(
+            format!("step {number}: profile the model's effect"),
+            Some(&ev),
+            || {
+                for j in wanted {
+                    let name = scores[j].name.clone();
+                    let Some(c) = pool
+                        .added
+                        .iter()
+                        .map(|a| &a.candidate)
+                        .chain(&pool.remaining)
+                        .find(|c| c.name() == name)
+                    else {
+                        continue;
+                    };
+                    profile_one(ctx, &ev, c.as_ref(), &mut fitted[j], &test);
+                    scores[j] = fitted[j].score.clone();
+                }
+            },
+        );
+    }
+    ctx.count(&ev);
     let mut step = Step {
         number,
         verdict,
@@ -435,8 +492,8 @@ fn decide_and_profile(
     fitted: &mut [Fitted],
     test: &Test,
     before: &Comparison,
+    profile: bool,
 ) -> (Decision, Vec<CandidateScore>) {
-    let note = |m: &str| ctx.progress.note(m);
     let cache: TermsCache = RefCell::new(vec![None; candidates.len()]);
     let n = ctx.measured.n();
     let decision = loop {
@@ -452,33 +509,11 @@ fn decide_and_profile(
             .chain(d.indistinguishable.iter().copied())
             .filter(|&i| !fitted[i].profiled)
             .collect();
-        if wanted.is_empty() {
+        if wanted.is_empty() || !profile {
             break d;
         }
         for i in wanted {
-            note(&format!(
-                "profile-likelihood intervals of {}…",
-                candidates[i].name()
-            ));
-            profile_candidate(ev, candidates[i].as_ref(), &mut fitted[i], test, &note);
-            let s = &fitted[i].score;
-            note(&format!(
-                "  {}: {} profile evaluations, {:.1} s for the fit and profiles; {}",
-                s.name,
-                s.profile_evaluations,
-                s.seconds,
-                s.parameters
-                    .iter()
-                    .map(|p| format!(
-                        "{} {:.4e} [{}, {}]",
-                        p.name,
-                        p.value,
-                        p.interval.lower.map_or("?".into(), |v| format!("{v:.4e}")),
-                        p.interval.upper.map_or("?".into(), |v| format!("{v:.4e}"))
-                    ))
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
+            profile_one(ctx, ev, candidates[i].as_ref(), &mut fitted[i], test);
         }
     };
     let mut scores: Vec<CandidateScore> = fitted.iter().map(|f| f.score.clone()).collect();
@@ -490,6 +525,32 @@ fn decide_and_profile(
         }
     }
     (decision, scores)
+}
+
+/// Profile-likelihood intervals of one fitted candidate ([`profile_candidate`]), with its
+/// progress notes.
+fn profile_one(ctx: &Context, ev: &Evaluator, c: &dyn Candidate, fitted: &mut Fitted, test: &Test) {
+    let note = |m: &str| ctx.progress.note(m);
+    note(&format!("profile-likelihood intervals of {}…", c.name()));
+    profile_candidate(ev, c, fitted, test, &note);
+    let s = &fitted.score;
+    note(&format!(
+        "  {}: {} profile evaluations, {:.1} s for the fit and profiles; {}",
+        s.name,
+        s.profile_evaluations,
+        s.seconds,
+        s.parameters
+            .iter()
+            .map(|p| format!(
+                "{} {:.4e} [{}, {}]",
+                p.name,
+                p.value,
+                p.interval.lower.map_or("?".into(), |v| format!("{v:.4e}")),
+                p.interval.upper.map_or("?".into(), |v| format!("{v:.4e}"))
+            ))
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
 }
 
 /// Vuong's z of fitted candidate i against j ([`vuong`]), `inflation` = c = 1 + n/N;

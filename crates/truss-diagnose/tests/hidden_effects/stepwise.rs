@@ -42,6 +42,30 @@ fn check_truths(v: &serde_json::Value, truths: &[(&str, &str, f64)]) {
     }
 }
 
+/// Where each step's named effect is profiled (`selection::step`'s module doc): at step 1,
+/// and at a later step whose update leaves it alone in the model (no joint re-fit); a later
+/// step whose effect joins others keeps its Wald intervals, the joint re-fit giving the
+/// final numbers. Returns how many later steps skipped their profiles.
+fn check_profiles(v: &serde_json::Value) -> usize {
+    let mut skipped = 0;
+    for s in v["steps"].as_array().unwrap() {
+        if s["named_effect"] == "none" {
+            continue;
+        }
+        let alone = s["refitted"].as_array().is_none_or(|r| r.is_empty());
+        let want = if s["number"] == 1 || alone {
+            "profile"
+        } else {
+            "wald"
+        };
+        skipped += usize::from(want == "wald");
+        for p in s["parameters"].as_array().unwrap() {
+            assert_eq!(p["interval"]["method"], want, "step {}: {p}", s["number"]);
+        }
+    }
+    skipped
+}
+
 /// The diagnosis of 200 specimens (seed 301) with `effects` hidden, against `candidates`
 /// at N = 500, and the effects it names, sorted.
 fn diagnose_pair(
@@ -95,6 +119,7 @@ fn a_stand_in_is_swapped_for_the_effect_it_stood_for() {
     );
     let r = removal(&v, "length_bias");
     assert_eq!(r["replaced_by"], "diagonal_pretension", "{r}");
+    assert!(check_profiles(&v) >= 1, "{}", v["steps"]);
     assert!(r["delta_bic"].as_f64().unwrap() <= -2.0, "{r}");
     // One record of what cannot be told apart: the pretension, swapped in and named by no
     // step, lists the bias it took over from in its record, and so, as the final model's
@@ -144,6 +169,7 @@ fn an_effect_a_later_one_explains_is_removed() {
     );
     let r = removal(&v, "length_bias");
     assert!(r["replaced_by"].is_null(), "{r}");
+    assert!(check_profiles(&v) >= 1, "{}", v["steps"]);
     assert_eq!(r["explained_by"], "thermal_gradient", "{r}");
     check_truths(
         &v,
