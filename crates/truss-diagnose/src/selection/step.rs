@@ -276,7 +276,7 @@ pub(crate) fn run(
     );
     // 3. Decide, with profiles where this step's fit may give the final numbers.
     let profile_now = pool.added.is_empty();
-    let (decision, scores) = ctx.timed(
+    let (decision, mut scores) = ctx.timed(
         format!("step {number}: decide and profile"),
         Some(&ev),
         || {
@@ -322,7 +322,7 @@ pub(crate) fn run(
         verdict,
         reason,
         named,
-        indistinguishable,
+        indistinguishable: rivals,
     } = decision;
     ctx.progress
         .note(&format!("step {number}: {}: {reason}", verdict.words()));
@@ -331,10 +331,8 @@ pub(crate) fn run(
         _ => named.map(|i| scores[i].p_value),
     };
     let adjusted_p = p_named.map(|p| (p * candidates.len() as f64).min(1.0));
-    let mut indistinguishable: Vec<String> = indistinguishable
-        .iter()
-        .map(|&j| scores[j].name.clone())
-        .collect();
+    let mut indistinguishable: Vec<String> =
+        rivals.iter().map(|&j| scores[j].name.clone()).collect();
     if let Some(p) = pair
         .as_ref()
         .filter(|p| p.outcome == PairOutcome::Alternative)
@@ -361,21 +359,13 @@ pub(crate) fn run(
             })
         })
         .transpose()?;
-    let mut scores = scores;
-    if let (false, Some(i), Some(up)) = (profile_now, named, &up)
+    if !profile_now
+        && let (Some(i), Some(up)) = (named, &up)
         && up.effects.len() == 1
     {
         // The update left this step's effect alone in the model (it removed every earlier
         // one): its own fit gives the final numbers, so it is profiled now (module doc).
-        let wanted: Vec<usize> = std::iter::once(i)
-            .chain(
-                scores
-                    .iter()
-                    .enumerate()
-                    .filter(|(_, s)| indistinguishable.contains(&s.name))
-                    .map(|(j, _)| j),
-            )
-            .collect();
+        let wanted: Vec<usize> = std::iter::once(i).chain(rivals).collect();
         ctx.timed(
             format!("step {number}: profile the model's effect"),
             Some(&ev),
