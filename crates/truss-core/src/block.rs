@@ -8,7 +8,11 @@
 //! nodes meet all of the next level's), so factorising costs about `N·q²/2` block products
 //! of 27 multiply-adds and solving `2·N·q` block-vector products: linear in the number of
 //! stages. Fixed-size blocks let the compiler unroll every block product, which is what
-//! makes this several times faster than a scalar band of the same width.
+//! makes this several times faster than a scalar band of the same width. The factorisation
+//! computes the three rows of a block side by side (a block row's blocks kept as padded
+//! columns while the row is factorised: one AVX2 operation per column where the processor
+//! has it), each entry by the same expression in the same order as one entry at a time, so
+//! the bits do not depend on the instruction set.
 //!
 //! A fixed direction of a node that has free ones keeps its row, as an identity row with no
 //! coupling, so that all blocks are 3×3.
@@ -235,6 +239,17 @@ impl BlockBandMatrix {
     /// first); stops at the `max`-th. The matrix counts as factorised only if none failed;
     /// after failures, [`BlockBandMatrix::failed_pivot_direction`] works for each of them.
     pub fn factor_collecting(&mut self, failures: &mut Vec<PivotFailure>, max: usize) {
+        self.factor_collecting_with(arch(), failures, max);
+    }
+
+    /// [`BlockBandMatrix::factor_collecting`] with the kernels compiled for `arch`: the same
+    /// bits with any.
+    fn factor_collecting_with(
+        &mut self,
+        arch: pulp::Arch,
+        failures: &mut Vec<PivotFailure>,
+        max: usize,
+    ) {
         failures.clear();
         self.touched();
         let q = self.q;
@@ -243,66 +258,16 @@ impl BlockBandMatrix {
             let a = &row[q];
             *d = [a[0][0], a[1][1], a[2][2]];
         }
-        // Two block rows at a time where there are two: row i + 1's blocks left of column
-        // i need only the rows above i, so the two rows' chains of dependent block products
-        // interleave. Each block is the same expression, in the same order, as one row at a
-        // time: the same bits.
-        let mut i = 0;
-        while i < self.nb {
-            let pair = i + 1 < self.nb;
-            let (done, from_i) = self.a.split_at_mut(i * w);
-            let (row, below) = from_i.split_at_mut(w);
-            let mut next = if pair { Some(&mut below[..w]) } else { None };
-            let j0 = i.saturating_sub(q);
-            let j1 = (i + 1).saturating_sub(q);
-            for (n, (row_j, inv)) in done[j0 * w..]
-                .chunks_exact(w)
-                .zip(&self.inv_diag[j0..i])
-                .enumerate()
-            {
-                let j = j0 + n;
-                off_diagonal(row, q - (i - j0), n, row_j, inv, q);
-                if let Some(next) = next.as_deref_mut()
-                    && j >= j1
-                {
-                    off_diagonal(next, q - (i + 1 - j1), j - j1, row_j, inv, q);
-                }
-            }
-            let (stop, inv) = diagonal(
-                row,
-                q - (i - j0),
-                i,
-                self.diag[i],
-                self.tolerance,
-                failures,
-                max,
-            );
-            self.inv_diag[i] = inv;
-            if stop {
-                return;
-            }
-            if let Some(next) = next {
-                let first = q - (i + 1 - j1);
-                if i >= j1 {
-                    off_diagonal(next, first, i - j1, row, &self.inv_diag[i], q);
-                }
-                let (stop, inv) = diagonal(
-                    next,
-                    first,
-                    i + 1,
-                    self.diag[i + 1],
-                    self.tolerance,
-                    failures,
-                    max,
-                );
-                self.inv_diag[i + 1] = inv;
-                if stop {
-                    return;
-                }
-            }
-            i += 2;
-        }
-        self.factored = failures.is_empty();
+        let done = arch.dispatch(Factorise {
+            q,
+            a: &mut self.a,
+            diag: &self.diag,
+            inv_diag: &mut self.inv_diag,
+            tolerance: self.tolerance,
+            failures,
+            max,
+        });
+        self.factored = done && failures.is_empty();
     }
 
     /// After [`BlockBandMatrix::factor_collecting`] with failures: the factor is that of the
@@ -366,29 +331,35 @@ impl BlockBandMatrix {
         let w = q + 1;
         let (bi, di) = (i / 3, i % 3);
         v.fill(0.0);
+        let (x, _) = v[..3 * self.nb].as_chunks_mut::<3>();
         // y = L⁻¹b: row i of L, over blocks bi−q .. bi (the diagonal block's first di columns).
-        let ri = bi * w;
-        for k in bi.saturating_sub(q)..bi {
-            let l = &self.a[ri + k + q - bi];
-            v[3 * k..3 * k + 3].copy_from_slice(&l[di]);
+        let row = &self.a[bi * w..(bi + 1) * w];
+        let j0 = bi.saturating_sub(q);
+        for (xk, l) in x[j0..bi].iter_mut().zip(&row[q - (bi - j0)..q]) {
+            *xk = l[di];
         }
-        let lii = &self.a[ri + q];
-        v[3 * bi..3 * bi + di].copy_from_slice(&lii[di][..di]);
-        // Lᵀw = y over rows i−1 … 0.
+        x[bi][..di].copy_from_slice(&row[q][di][..di]);
+        // Lᵀw = y over rows i−1 … 0: block b's own rows first (from its last up), then its
+        // rows' parts in the blocks left of it, row by row from the last up, so that every
+        // entry takes the same subtractions in the same order as one scalar row at a time.
         for b in (0..=bi).rev() {
-            let rb = b * w;
-            let lbb = &self.a[rb + q];
+            let row = &self.a[b * w..(b + 1) * w];
+            let lbb = &row[q];
             let rows = if b == bi { di } else { 3 };
+            let mut xb = x[b];
             for rr in (0..rows).rev() {
-                let x = v[3 * b + rr] / lbb[rr][rr];
-                v[3 * b + rr] = x;
+                let t = xb[rr] / lbb[rr][rr];
+                xb[rr] = t;
                 for c in 0..rr {
-                    v[3 * b + c] -= lbb[rr][c] * x;
+                    xb[c] -= lbb[rr][c] * t;
                 }
-                for k in b.saturating_sub(q)..b {
-                    let l = &self.a[rb + k + q - b];
+            }
+            x[b] = xb;
+            let j0 = b.saturating_sub(q);
+            for (xk, l) in x[j0..b].iter_mut().zip(&row[q - (b - j0)..q]) {
+                for rr in (0..rows).rev() {
                     for c in 0..3 {
-                        v[3 * k + c] -= l[rr][c] * x;
+                        xk[c] -= l[rr][c] * xb[rr];
                     }
                 }
             }
@@ -413,101 +384,250 @@ impl BlockBandMatrix {
     }
 }
 
-/// Block `(i, j)` of the factor, `j = j0 + n`, in row `i`'s slots (`row[first ..]` holds
-/// blocks `j0 ..= i`): `L_ij = (A_ij − Σ_k L_ik·L_jkᵀ)·L_jj⁻ᵀ`, `k` from `j0` up, with row
-/// `j` (`row_j`, its diagonal's inverse pivots `inv`) already factorised.
-#[inline(always)]
-fn off_diagonal(
-    row: &mut [Block],
-    first: usize,
-    n: usize,
-    row_j: &[Block],
-    inv: &[f64; 3],
-    q: usize,
-) {
-    let (left, at) = row.split_at_mut(first + n);
-    let mut s = at[0];
-    for (x, y) in left[first..].iter().zip(&row_j[q - n..q]) {
-        sub_mul_t(&mut s, x, y);
-    }
-    let ljj = &row_j[q];
-    // Row by row: x·L_JJᵀ = s, i.e. L_JJ·xᵀ = sᵀ.
-    for r in &mut s {
-        let x0 = r[0] * inv[0];
-        let x1 = (r[1] - ljj[1][0] * x0) * inv[1];
-        let x2 = (r[2] - ljj[2][0] * x0 - ljj[2][1] * x1) * inv[2];
-        *r = [x0, x1, x2];
-    }
-    at[0] = s;
-}
-
-/// The diagonal block of row `i` (its other blocks factorised, from slot `first`):
-/// `L_ii = chol(A_ii − Σ_k L_ik·L_ikᵀ)`; a failed pivot is recorded and replaced by the row's
-/// original diagonal `diag`. Returns whether `max` failures are reached, and the inverse
-/// pivots.
-#[inline(always)]
-fn diagonal(
-    row: &mut [Block],
-    first: usize,
-    i: usize,
-    diag: [f64; 3],
-    tolerance: f64,
-    failures: &mut Vec<PivotFailure>,
-    max: usize,
-) -> (bool, [f64; 3]) {
-    let q = row.len() - 1;
-    let (left, at) = row.split_at_mut(q);
-    let mut s = at[0];
-    for l in &left[first..] {
-        sub_mul_t_lower(&mut s, l);
-    }
-    let mut pivot = |k: usize, p: f64| -> f64 {
-        if p > tolerance * diag[k] {
-            p
+/// The instruction set of the vector kernels (the factorisation here, and the batched
+/// kernels of `solver::lanes`): the best this processor has, unless `TRUSS_KERNELS=baseline`
+/// asks for baseline x86-64 (for the test that both give the same bytes, and for
+/// benchmarks). Every kernel performs the same IEEE operations in the same order with any.
+pub(crate) fn arch() -> pulp::Arch {
+    use std::sync::OnceLock;
+    static ARCH: OnceLock<pulp::Arch> = OnceLock::new();
+    *ARCH.get_or_init(|| {
+        if std::env::var_os("TRUSS_KERNELS").is_some_and(|v| v == "baseline") {
+            pulp::Arch::Scalar
         } else {
-            failures.push(PivotFailure {
-                index: 3 * i + k,
-                pivot: p,
-            });
-            diag[k].abs().max(f64::MIN_POSITIVE)
+            pulp::Arch::new()
         }
-    };
-    let mut l = ZERO;
-    l[0][0] = pivot(0, s[0][0]).sqrt();
-    let i0 = 1.0 / l[0][0];
-    l[1][0] = s[1][0] * i0;
-    l[2][0] = s[2][0] * i0;
-    l[1][1] = pivot(1, s[1][1] - l[1][0] * l[1][0]).sqrt();
-    let i1 = 1.0 / l[1][1];
-    l[2][1] = (s[2][1] - l[2][0] * l[1][0]) * i1;
-    l[2][2] = pivot(2, s[2][2] - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
-    at[0] = l;
-    (failures.len() >= max, [i0, i1, 1.0 / l[2][2]])
+    })
 }
 
-/// The lower triangle of `s −= l·lᵀ` for 3×3 blocks (the upper one is never read).
+/// A block's columns, each padded to four entries (`t[c][r] = b[r][c]`, `t[c][3] = 0`): the
+/// factorisation computes a block's three rows side by side, one column at a time, as one
+/// vector operation per column on AVX2.
+type Columns = [[f64; 4]; 3];
+
+/// The columns of `b`.
 #[inline(always)]
-fn sub_mul_t_lower(s: &mut Block, l: &Block) {
-    for r in 0..3 {
-        for c in 0..=r {
-            s[r][c] -= l[r][0] * l[c][0] + l[r][1] * l[c][1] + l[r][2] * l[c][2];
+fn columns(b: &Block) -> Columns {
+    std::array::from_fn(|c| [b[0][c], b[1][c], b[2][c], 0.0])
+}
+
+/// The block whose columns are `t`.
+#[inline(always)]
+fn block_of(t: &Columns) -> Block {
+    std::array::from_fn(|r| [t[0][r], t[1][r], t[2][r]])
+}
+
+/// `s −= x·yᵀ` with `s` and `x` as columns: entry `(r, c)` is
+/// `s_rc − ((x_r0·y_c0 + x_r1·y_c1) + x_r2·y_c2)`, each row `r` in a lane of its own.
+#[inline(always)]
+fn sub_mul_t(s: &mut Columns, x: &Columns, y: &Block) {
+    for (sc, yc) in s.iter_mut().zip(y) {
+        for r in 0..4 {
+            sc[r] -= x[0][r] * yc[0] + x[1][r] * yc[1] + x[2][r] * yc[2];
         }
     }
 }
 
-/// `s −= x·yᵀ` for 3×3 blocks.
-#[inline(always)]
-fn sub_mul_t(s: &mut Block, x: &Block, y: &Block) {
-    for r in 0..3 {
-        for c in 0..3 {
-            s[r][c] -= x[r][0] * y[c][0] + x[r][1] * y[c][1] + x[r][2] * y[c][2];
+/// The block Cholesky factorisation's arguments, for `pulp`'s dispatch (compiled once per
+/// instruction set).
+struct Factorise<'m> {
+    q: usize,
+    a: &'m mut [Block],
+    diag: &'m [[f64; 3]],
+    inv_diag: &'m mut [[f64; 3]],
+    tolerance: f64,
+    failures: &'m mut Vec<PivotFailure>,
+    max: usize,
+}
+
+impl pulp::WithSimd for Factorise<'_> {
+    /// Whether every block row was factorised (false: stopped at the `max`-th failure).
+    type Output = bool;
+
+    /// Block row by block row, as the module doc writes it (see
+    /// [`BlockBandMatrix::factor_collecting`]): each block of row `i` by its three rows side
+    /// by side, kept as columns while the row is factorised (its blocks are the left factors
+    /// of the row's later products); row `j`'s finished blocks are read as they are stored.
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) -> bool {
+        let (q, w) = (self.q, self.q + 1);
+        let nb = self.diag.len();
+        let zero: Columns = [[0.0; 4]; 3];
+        let mut cols: [Columns; 2 * LANE_ROW] = [zero; 2 * LANE_ROW];
+        let mut heap: Vec<Columns> = Vec::new();
+        let cols: &mut [Columns] = if w <= cols.len() {
+            &mut cols[..w]
+        } else {
+            heap.resize(w, zero);
+            &mut heap
+        };
+        for i in 0..nb {
+            let j0 = i.saturating_sub(q);
+            let first = q - (i - j0);
+            let (done, from_i) = self.a.split_at_mut(i * w);
+            let row = &mut from_i[..w];
+            // L_ij = (A_ij − Σ_k L_ik·L_jkᵀ)·L_jj⁻ᵀ, k from j0 up.
+            for (n, (row_j, inv)) in done[j0 * w..]
+                .chunks_exact(w)
+                .zip(&self.inv_diag[j0..i])
+                .enumerate()
+            {
+                let mut s = columns(&row[first + n]);
+                for (x, y) in cols[first..first + n].iter().zip(&row_j[q - n..q]) {
+                    sub_mul_t(&mut s, x, y);
+                }
+                // x·L_jjᵀ = s, column by column: L_jj·xᵀ = sᵀ for every row at once.
+                let ljj = &row_j[q];
+                let mut x = zero;
+                for r in 0..4 {
+                    x[0][r] = s[0][r] * inv[0];
+                }
+                for r in 0..4 {
+                    x[1][r] = (s[1][r] - ljj[1][0] * x[0][r]) * inv[1];
+                }
+                for r in 0..4 {
+                    x[2][r] = (s[2][r] - ljj[2][0] * x[0][r] - ljj[2][1] * x[1][r]) * inv[2];
+                }
+                cols[first + n] = x;
+                row[first + n] = block_of(&x);
+            }
+            // L_ii = chol(A_ii − Σ_k L_ik·L_ikᵀ); only the lower triangle is read.
+            let mut s = columns(&row[q]);
+            for (x, y) in cols[first..q].iter().zip(&row[first..q]) {
+                sub_mul_t(&mut s, x, y);
+            }
+            let (diag, tolerance, max) = (self.diag[i], self.tolerance, self.max);
+            let failures = &mut *self.failures;
+            let mut pivot = |k: usize, p: f64| -> f64 {
+                if p > tolerance * diag[k] {
+                    p
+                } else {
+                    failures.push(PivotFailure {
+                        index: 3 * i + k,
+                        pivot: p,
+                    });
+                    diag[k].abs().max(f64::MIN_POSITIVE)
+                }
+            };
+            // s[c][r] is entry (r, c).
+            let mut l = ZERO;
+            l[0][0] = pivot(0, s[0][0]).sqrt();
+            let i0 = 1.0 / l[0][0];
+            l[1][0] = s[0][1] * i0;
+            l[2][0] = s[0][2] * i0;
+            l[1][1] = pivot(1, s[1][1] - l[1][0] * l[1][0]).sqrt();
+            let i1 = 1.0 / l[1][1];
+            l[2][1] = (s[1][2] - l[2][0] * l[1][0]) * i1;
+            l[2][2] = pivot(2, s[2][2] - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
+            row[q] = l;
+            self.inv_diag[i] = [i0, i1, 1.0 / l[2][2]];
+            if self.failures.len() >= max {
+                return false;
+            }
         }
+        true
     }
 }
+
+/// Block rows whose column copies the factorisation keeps on the stack (the band of a
+/// bandwidth up to `2·LANE_ROW − 1`; wider ones use the heap).
+const LANE_ROW: usize = 8;
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Block `(i, j)` of the factor, `j = j0 + n`, in row `i`'s slots (`row[first ..]` holds
+    /// blocks `j0 ..= i`): `L_ij = (A_ij − Σ_k L_ik·L_jkᵀ)·L_jj⁻ᵀ`, `k` from `j0` up, with row
+    /// `j` (`row_j`, its diagonal's inverse pivots `inv`) already factorised.
+    #[inline(always)]
+    fn off_diagonal(
+        row: &mut [Block],
+        first: usize,
+        n: usize,
+        row_j: &[Block],
+        inv: &[f64; 3],
+        q: usize,
+    ) {
+        let (left, at) = row.split_at_mut(first + n);
+        let mut s = at[0];
+        for (x, y) in left[first..].iter().zip(&row_j[q - n..q]) {
+            sub_mul_t(&mut s, x, y);
+        }
+        let ljj = &row_j[q];
+        // Row by row: x·L_JJᵀ = s, i.e. L_JJ·xᵀ = sᵀ.
+        for r in &mut s {
+            let x0 = r[0] * inv[0];
+            let x1 = (r[1] - ljj[1][0] * x0) * inv[1];
+            let x2 = (r[2] - ljj[2][0] * x0 - ljj[2][1] * x1) * inv[2];
+            *r = [x0, x1, x2];
+        }
+        at[0] = s;
+    }
+
+    /// The diagonal block of row `i` (its other blocks factorised, from slot `first`):
+    /// `L_ii = chol(A_ii − Σ_k L_ik·L_ikᵀ)`; a failed pivot is recorded and replaced by the row's
+    /// original diagonal `diag`. Returns whether `max` failures are reached, and the inverse
+    /// pivots.
+    #[inline(always)]
+    fn diagonal(
+        row: &mut [Block],
+        first: usize,
+        i: usize,
+        diag: [f64; 3],
+        tolerance: f64,
+        failures: &mut Vec<PivotFailure>,
+        max: usize,
+    ) -> (bool, [f64; 3]) {
+        let q = row.len() - 1;
+        let (left, at) = row.split_at_mut(q);
+        let mut s = at[0];
+        for l in &left[first..] {
+            sub_mul_t_lower(&mut s, l);
+        }
+        let mut pivot = |k: usize, p: f64| -> f64 {
+            if p > tolerance * diag[k] {
+                p
+            } else {
+                failures.push(PivotFailure {
+                    index: 3 * i + k,
+                    pivot: p,
+                });
+                diag[k].abs().max(f64::MIN_POSITIVE)
+            }
+        };
+        let mut l = ZERO;
+        l[0][0] = pivot(0, s[0][0]).sqrt();
+        let i0 = 1.0 / l[0][0];
+        l[1][0] = s[1][0] * i0;
+        l[2][0] = s[2][0] * i0;
+        l[1][1] = pivot(1, s[1][1] - l[1][0] * l[1][0]).sqrt();
+        let i1 = 1.0 / l[1][1];
+        l[2][1] = (s[2][1] - l[2][0] * l[1][0]) * i1;
+        l[2][2] = pivot(2, s[2][2] - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
+        at[0] = l;
+        (failures.len() >= max, [i0, i1, 1.0 / l[2][2]])
+    }
+
+    /// The lower triangle of `s −= l·lᵀ` for 3×3 blocks (the upper one is never read).
+    #[inline(always)]
+    fn sub_mul_t_lower(s: &mut Block, l: &Block) {
+        for r in 0..3 {
+            for c in 0..=r {
+                s[r][c] -= l[r][0] * l[c][0] + l[r][1] * l[c][1] + l[r][2] * l[c][2];
+            }
+        }
+    }
+
+    /// `s −= x·yᵀ` for 3×3 blocks.
+    #[inline(always)]
+    fn sub_mul_t(s: &mut Block, x: &Block, y: &Block) {
+        for r in 0..3 {
+            for c in 0..3 {
+                s[r][c] -= x[r][0] * y[c][0] + x[r][1] * y[c][1] + x[r][2] * y[c][2];
+            }
+        }
+    }
 
     /// A random SPD block-band matrix: diagonally dominant with random couplings.
     fn spd(nb: usize, q: usize, seed: u64) -> BlockBandMatrix {
@@ -568,8 +688,9 @@ mod tests {
         }
     }
 
-    /// The factor one block row at a time, as the module doc writes it: the reference that
-    /// [`BlockBandMatrix::factor_collecting`]'s two rows at a time must match bit for bit.
+    /// The factor one block row at a time and one entry at a time, as the module doc writes
+    /// it: the reference that [`BlockBandMatrix::factor_collecting`]'s column kernels must
+    /// match bit for bit.
     fn one_row_at_a_time(m: &mut BlockBandMatrix, failures: &mut Vec<PivotFailure>, max: usize) {
         failures.clear();
         let (q, w) = (m.q, m.q + 1);
@@ -597,7 +718,7 @@ mod tests {
     }
 
     #[test]
-    fn two_rows_at_a_time_give_the_one_row_factor_bit_for_bit() {
+    fn the_column_kernels_give_the_one_entry_factor_bit_for_bit() {
         for (nb, q, indefinite) in [
             (1usize, 0usize, false),
             (5, 0, false),
@@ -613,25 +734,29 @@ mod tests {
                 a.block_mut(4, 4)[1][1] = -50.0;
                 a.block_mut(9, 9)[0][0] = -50.0;
             }
-            let (mut fast, mut slow) = (a.clone(), a.clone());
-            let (mut ff, mut fs) = (Vec::new(), Vec::new());
-            fast.factor_collecting(&mut ff, 2);
+            let mut slow = a.clone();
+            let mut fs = Vec::new();
             one_row_at_a_time(&mut slow, &mut fs, 2);
-            assert_eq!(ff, fs, "nb={nb} q={q}");
-            assert_eq!(ff.len(), if indefinite { 2 } else { 0 });
-            let rows = ff.last().map_or(nb, |f| f.index / 3 + 1);
-            for (k, (x, y)) in fast.a.iter().zip(&slow.a).take(rows * (q + 1)).enumerate() {
-                for (r, (xr, yr)) in x.iter().zip(y).enumerate() {
-                    for (c, (u, v)) in xr.iter().zip(yr).enumerate() {
-                        assert_eq!(
-                            u.to_bits(),
-                            v.to_bits(),
-                            "nb={nb} q={q} slot {k} [{r}][{c}]"
-                        );
+            for arch in [pulp::Arch::Scalar, pulp::Arch::new()] {
+                let mut fast = a.clone();
+                let mut ff = Vec::new();
+                fast.factor_collecting_with(arch, &mut ff, 2);
+                assert_eq!(ff, fs, "nb={nb} q={q}");
+                assert_eq!(ff.len(), if indefinite { 2 } else { 0 });
+                let rows = ff.last().map_or(nb, |f| f.index / 3 + 1);
+                for (k, (x, y)) in fast.a.iter().zip(&slow.a).take(rows * (q + 1)).enumerate() {
+                    for (r, (xr, yr)) in x.iter().zip(y).enumerate() {
+                        for (c, (u, v)) in xr.iter().zip(yr).enumerate() {
+                            assert_eq!(
+                                u.to_bits(),
+                                v.to_bits(),
+                                "nb={nb} q={q} slot {k} [{r}][{c}]"
+                            );
+                        }
                     }
                 }
+                assert_eq!(fast.inv_diag[..rows], slow.inv_diag[..rows]);
             }
-            assert_eq!(fast.inv_diag[..rows], slow.inv_diag[..rows]);
         }
     }
 
@@ -690,6 +815,47 @@ mod tests {
 
     /// The direction from a failed pivot has exactly the pivot as its curvature, for a
     /// failure in each of the three rows of a block.
+    /// [`BlockBandMatrix::failed_pivot_direction`] one scalar row at a time: the reference its
+    /// block rows must match bit for bit.
+    fn failed_pivot_direction_scalar(m: &BlockBandMatrix, i: usize, v: &mut [f64]) {
+        assert!(!m.factored && i < 3 * m.nb && v.len() >= 3 * m.nb);
+        let q = m.q;
+        let w = q + 1;
+        let (bi, di) = (i / 3, i % 3);
+        v.fill(0.0);
+        // y = L⁻¹b: row i of L, over blocks bi−q .. bi (the diagonal block's first di columns).
+        let ri = bi * w;
+        for k in bi.saturating_sub(q)..bi {
+            let l = &m.a[ri + k + q - bi];
+            v[3 * k..3 * k + 3].copy_from_slice(&l[di]);
+        }
+        let lii = &m.a[ri + q];
+        v[3 * bi..3 * bi + di].copy_from_slice(&lii[di][..di]);
+        // Lᵀw = y over rows i−1 … 0.
+        for b in (0..=bi).rev() {
+            let rb = b * w;
+            let lbb = &m.a[rb + q];
+            let rows = if b == bi { di } else { 3 };
+            for rr in (0..rows).rev() {
+                let x = v[3 * b + rr] / lbb[rr][rr];
+                v[3 * b + rr] = x;
+                for c in 0..rr {
+                    v[3 * b + c] -= lbb[rr][c] * x;
+                }
+                for k in b.saturating_sub(q)..b {
+                    let l = &m.a[rb + k + q - b];
+                    for c in 0..3 {
+                        v[3 * k + c] -= l[rr][c] * x;
+                    }
+                }
+            }
+        }
+        for x in &mut v[..i] {
+            *x = -*x;
+        }
+        v[i] = 1.0;
+    }
+
     #[test]
     fn failed_pivot_direction_has_the_pivot_as_curvature() {
         for row in [21, 22, 23] {
@@ -720,6 +886,27 @@ mod tests {
                 "{curvature} vs {}",
                 err.pivot
             );
+        }
+    }
+
+    /// The block rows give the scalar rows' direction bit for bit: at every scalar row of a
+    /// block, in the first block, and with bandwidths 0 to the whole matrix.
+    #[test]
+    fn failed_pivot_direction_by_block_rows_is_the_scalar_one_bit_for_bit() {
+        for (nb, q) in [(1usize, 0usize), (6, 0), (12, 3), (16, 5), (9, 8)] {
+            for row in [0, 1, 2, 3 * nb / 2, 3 * nb / 2 + 1, 3 * nb - 1] {
+                let mut a = spd(nb, q, 5 + row as u64);
+                let d = a.get(row, row);
+                a.block_mut(row / 3, row / 3)[row % 3][row % 3] = -0.5 * d;
+                let mut failures = vec![];
+                a.factor_collecting(&mut failures, usize::MAX);
+                let f = failures[0];
+                let (mut fast, mut slow) = (vec![7.0; 3 * nb], vec![7.0; 3 * nb]);
+                a.failed_pivot_direction(f.index, &mut fast);
+                failed_pivot_direction_scalar(&a, f.index, &mut slow);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&fast), bits(&slow), "nb={nb} q={q} row={row}");
+            }
         }
     }
 

@@ -3,8 +3,8 @@
 //!
 //! Each lane performs exactly the IEEE operations of [`BlockBandMatrix::factor`] and
 //! [`BlockBandMatrix::solve_in_place`], in the same order (the one-sample factorisation
-//! interleaves two block rows, but computes each block by the same expression as one row at
-//! a time, as this one does). A lane whose factorisation meets a pivot that is not safely
+//! computes a block's three rows side by side, but each entry by the same expression as one
+//! entry at a time, as this one does). A lane whose factorisation meets a pivot that is not safely
 //! positive is factorised again by the one-sample code from its own, untouched matrix: that
 //! rare case (a negative curvature, a damped step) keeps the one-sample path's bits and its
 //! record of failed pivots by construction.

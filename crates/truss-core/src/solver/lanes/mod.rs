@@ -55,19 +55,7 @@ use std::task::{Context, Poll, Waker};
 /// Lanes per batch: four f64 lanes fill an AVX2 register (two SSE2 ones).
 pub const LANES: usize = 4;
 
-/// The instruction set for the batched kernels: the best this processor has, unless
-/// `TRUSS_KERNELS=baseline` asks for baseline x86-64 (for the test that both give the same
-/// bytes, and for benchmarks).
-pub(crate) fn arch() -> pulp::Arch {
-    use std::sync::OnceLock;
-    static BASELINE: OnceLock<bool> = OnceLock::new();
-    if *BASELINE.get_or_init(|| std::env::var_os("TRUSS_KERNELS").is_some_and(|v| v == "baseline"))
-    {
-        pulp::Arch::Scalar
-    } else {
-        pulp::Arch::new()
-    }
-}
+pub(crate) use crate::block::arch;
 
 /// The instruction set the batched kernels use on this processor, in words.
 pub fn kernel_set() -> &'static str {
