@@ -453,7 +453,7 @@ impl pulp::WithSimd for Factorise<'_> {
         let (q, w) = (self.q, self.q + 1);
         let nb = self.diag.len();
         let zero: Columns = [[0.0; 4]; 3];
-        let mut cols: [Columns; 2 * LANE_ROW] = [zero; 2 * LANE_ROW];
+        let mut cols: [Columns; STACK_COLUMNS] = [zero; STACK_COLUMNS];
         let mut heap: Vec<Columns> = Vec::new();
         let cols: &mut [Columns] = if w <= cols.len() {
             &mut cols[..w]
@@ -529,9 +529,9 @@ impl pulp::WithSimd for Factorise<'_> {
     }
 }
 
-/// Block rows whose column copies the factorisation keeps on the stack (the band of a
-/// bandwidth up to `2·LANE_ROW − 1`; wider ones use the heap).
-const LANE_ROW: usize = 8;
+/// The blocks of one block row the factorisation keeps as columns on the stack (a block
+/// half-bandwidth up to 15; a wider band's go on the heap).
+const STACK_COLUMNS: usize = 16;
 
 #[cfg(test)]
 mod tests {
@@ -726,6 +726,7 @@ mod tests {
             (15, 5, false),
             (16, 5, false),
             (10, 9, false),
+            (20, 17, false),
             (15, 5, true),
         ] {
             let mut a = spd(nb, q, nb as u64 * 7 + q as u64);
