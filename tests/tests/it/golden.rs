@@ -90,11 +90,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "da93f3687be958e677c11f76ef90a0f1ff255d7da7bc0d3fffdd36c62414c224",
+        "ca2fc0bed8a566a6d94802440660f06dba9bef28dded83b4434bc05266272c0e",
         "94ce944399e4677c5705bde025cc92a70f975a9f2ab7c855a7e8f13ecf665d24",
         "546cf9d696c4c41815489fa90b763f7db5a7158a8fe8896316e035a3f1ee86a1",
         "7b94c46945c2820f627e0bdcc5aa42e331a0f6fe76f9a1cbbfa384b72441d183",
-        "a713dd80a90a7d8c0747950cd645303dca7ff71c6778ef6d0e9c4dcbcd19f979",
+        "978c87100c69c403af4bd7862dcbfcef14193fe23d707c09c5c3ff549e625ca7",
     ];
     for (what, (g, w)) in [
         "job id",

@@ -146,7 +146,7 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "dca02604eee905e55936475f1550a2587d1021496f8230a2a356ac42a622a9b7"
+        "a3d090067f7e7348d49477059da0a678ff4d5b57b8f06ee6a8ced901e10006d5"
     );
     assert_eq!(
         digest,

@@ -36,10 +36,11 @@ const MAX_ENGAGEMENTS: u32 = 8;
 const MAX_PIECES: u32 = 8;
 
 /// Most soft pivots (directions of the [`reduced`](super::reduced) problem) of one step.
-/// The reduced problem is dense and its eigen-decomposition (cyclic Jacobi) costs about
-/// `p³` per sweep: 9 directions at most in 2,000 samples of the paper's Fig. 16 case, up to
-/// 198 in a 300-stage prism with free play that solves in 303 iterations, and 1,653 in
-/// another's last attempt at `ρ = 0` (that sample had not finished after 20 minutes).
+/// The reduced problem is dense and its eigen-decomposition costs about `9p³` flops (see
+/// the `eigen` module): 9 directions at most in 2,000 samples of the paper's Fig. 16 case,
+/// up to 198 in a 300-stage prism with free play that solves in 303 iterations, and 1,653
+/// in another's last attempt at `ρ = 0` (that sample had not finished after 20 minutes,
+/// when the decomposition was all cyclic Jacobi).
 /// An attempt that meets more is abandoned as one that does not converge: a watched one
 /// as an event, the last one leaving the last stage to stand for the limit (see the
 /// module doc of `limit`).
