@@ -496,37 +496,57 @@ impl pulp::WithSimd for Factorise<'_> {
             for (x, y) in cols[first..q].iter().zip(&row[first..q]) {
                 sub_mul_t(&mut s, x, y);
             }
-            let (diag, tolerance, max) = (self.diag[i], self.tolerance, self.max);
-            let failures = &mut *self.failures;
-            let mut pivot = |k: usize, p: f64| -> f64 {
-                if p > tolerance * diag[k] {
-                    p
-                } else {
-                    failures.push(PivotFailure {
-                        index: 3 * i + k,
-                        pivot: p,
-                    });
-                    diag[k].abs().max(f64::MIN_POSITIVE)
-                }
-            };
             // s[c][r] is entry (r, c).
-            let mut l = ZERO;
-            l[0][0] = pivot(0, s[0][0]).sqrt();
-            let i0 = 1.0 / l[0][0];
-            l[1][0] = s[0][1] * i0;
-            l[2][0] = s[0][2] * i0;
-            l[1][1] = pivot(1, s[1][1] - l[1][0] * l[1][0]).sqrt();
-            let i1 = 1.0 / l[1][1];
-            l[2][1] = (s[1][2] - l[2][0] * l[1][0]) * i1;
-            l[2][2] = pivot(2, s[2][2] - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
+            let (l, inv) = cholesky_block(
+                |r, c| s[c][r],
+                i,
+                self.diag[i],
+                self.tolerance,
+                self.failures,
+            );
             row[q] = l;
-            self.inv_diag[i] = [i0, i1, 1.0 / l[2][2]];
-            if self.failures.len() >= max {
+            self.inv_diag[i] = inv;
+            if self.failures.len() >= self.max {
                 return false;
             }
         }
         true
     }
+}
+
+/// `L_ii = chol(S)` for a diagonal block whose lower triangle is `s(r, c)`, `c ≤ r` (the
+/// sum `A_ii − Σ_k L_ik·L_ikᵀ`), with the inverse pivots. A pivot not above `tolerance`
+/// times its row's original diagonal `diag` (NaN included) is recorded in `failures` (scalar
+/// row `3·i + k`) and replaced by that diagonal's magnitude.
+#[inline(always)]
+fn cholesky_block(
+    s: impl Fn(usize, usize) -> f64,
+    i: usize,
+    diag: [f64; 3],
+    tolerance: f64,
+    failures: &mut Vec<PivotFailure>,
+) -> (Block, [f64; 3]) {
+    let mut pivot = |k: usize, p: f64| -> f64 {
+        if p > tolerance * diag[k] {
+            p
+        } else {
+            failures.push(PivotFailure {
+                index: 3 * i + k,
+                pivot: p,
+            });
+            diag[k].abs().max(f64::MIN_POSITIVE)
+        }
+    };
+    let mut l = ZERO;
+    l[0][0] = pivot(0, s(0, 0)).sqrt();
+    let i0 = 1.0 / l[0][0];
+    l[1][0] = s(1, 0) * i0;
+    l[2][0] = s(2, 0) * i0;
+    l[1][1] = pivot(1, s(1, 1) - l[1][0] * l[1][0]).sqrt();
+    let i1 = 1.0 / l[1][1];
+    l[2][1] = (s(2, 1) - l[2][0] * l[1][0]) * i1;
+    l[2][2] = pivot(2, s(2, 2) - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
+    (l, [i0, i1, 1.0 / l[2][2]])
 }
 
 /// The blocks of one block row the factorisation keeps as columns on the stack (a block
@@ -585,28 +605,9 @@ mod tests {
         for l in &left[first..] {
             sub_mul_t_lower(&mut s, l);
         }
-        let mut pivot = |k: usize, p: f64| -> f64 {
-            if p > tolerance * diag[k] {
-                p
-            } else {
-                failures.push(PivotFailure {
-                    index: 3 * i + k,
-                    pivot: p,
-                });
-                diag[k].abs().max(f64::MIN_POSITIVE)
-            }
-        };
-        let mut l = ZERO;
-        l[0][0] = pivot(0, s[0][0]).sqrt();
-        let i0 = 1.0 / l[0][0];
-        l[1][0] = s[1][0] * i0;
-        l[2][0] = s[2][0] * i0;
-        l[1][1] = pivot(1, s[1][1] - l[1][0] * l[1][0]).sqrt();
-        let i1 = 1.0 / l[1][1];
-        l[2][1] = (s[2][1] - l[2][0] * l[1][0]) * i1;
-        l[2][2] = pivot(2, s[2][2] - l[2][0] * l[2][0] - l[2][1] * l[2][1]).sqrt();
+        let (l, inv) = cholesky_block(|r, c| s[r][c], i, diag, tolerance, failures);
         at[0] = l;
-        (failures.len() >= max, [i0, i1, 1.0 / l[2][2]])
+        (failures.len() >= max, inv)
     }
 
     /// The lower triangle of `s −= l·lᵀ` for 3×3 blocks (the upper one is never read).
