@@ -309,9 +309,10 @@ mod tests {
                     a[i * p + j] = (0..rank).map(|k| b[i * p + k] * b[j * p + k]).sum::<f64>();
                 }
             }
-            // Shift by one diagonal entry's worth to make it indefinite.
-            for i in 0..p {
-                if !singular {
+            // Shift by one diagonal entry's worth to make it indefinite (the singular ones
+            // keep their zero eigenvalues).
+            if !singular {
+                for i in 0..p {
                     a[i * p + i] -= 0.3;
                 }
             }
