@@ -52,6 +52,7 @@ use crate::comparison::measured::Measured;
 use crate::comparison::simulate::{Noise, Simulation, top_indices};
 use crate::comparison::statistics::Comparison;
 use crate::errors::DiagnoseError;
+use crate::likelihood::conditional::GaugeNoise;
 use crate::likelihood::score::p_text;
 use crate::settings::{NOISE_SEED, Progress, Settings};
 use confound::Confounding as Confound;
@@ -219,6 +220,7 @@ pub fn diagnose(
         progress,
         simulations: std::cell::Cell::new(0),
         memo: Default::default(),
+        gauge: GaugeNoise::new(samples, measured),
         stages: Default::default(),
     };
     progress.note(&format!(

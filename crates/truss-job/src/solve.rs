@@ -65,7 +65,14 @@ pub struct SampleSolver<'j> {
     job: &'j Job,
     keys: Vec<[u8; 32]>,
     solvers: Vec<Option<Solver>>,
+    /// The last sample's drawn length errors \[mm\].
     errors: Vec<f64>,
+    /// The drawn length errors plus the case's thermal length changes \[mm\], where it has
+    /// any (then what the solver is given).
+    changed: Vec<f64>,
+    /// Whether the last sample's case has thermal length changes (`changed` then holds
+    /// its length errors).
+    thermal: bool,
     clearances: Vec<f64>,
     lots: Vec<f64>,
     options: SolveOptions,
@@ -88,6 +95,8 @@ impl<'j> SampleSolver<'j> {
                 .collect(),
             solvers: job.cases.iter().map(|_| None).collect(),
             errors: Vec::new(),
+            changed: Vec::new(),
+            thermal: false,
             clearances: Vec::new(),
             lots: Vec::new(),
             options,
@@ -125,16 +134,23 @@ impl<'j> SampleSolver<'j> {
             &mut self.clearances,
             &mut self.lots,
         );
-        for (e, t) in self.errors.iter_mut().zip(&case.applied.length_changes) {
-            *e += t;
-        }
+        self.thermal = !case.applied.length_changes.is_empty();
+        let length_errors = if !self.thermal {
+            &self.errors
+        } else {
+            self.changed.clone_from(&self.errors);
+            for (e, t) in self.changed.iter_mut().zip(&case.applied.length_changes) {
+                *e += t;
+            }
+            &self.changed
+        };
         let options = &self.options;
         let solver = self.solvers[c]
             .get_or_insert_with(|| Solver::with_structure(case.structure.clone(), options.clone()));
         let result = solver
             .solve_perturbed_in(
                 Perturbation {
-                    length_errors: &self.errors,
+                    length_errors,
                     extra_loads: &case.applied.loads,
                     clearances: &self.clearances,
                 },
@@ -198,6 +214,17 @@ impl<'j> SampleSolver<'j> {
     /// The length errors of the last sample \[mm\], model order: the drawn ones plus any
     /// thermal length change.
     pub fn last_errors(&self) -> &[f64] {
+        if self.thermal {
+            &self.changed
+        } else {
+            &self.errors
+        }
+    }
+
+    /// The length errors the last sample drew \[mm\], model order, without its case's
+    /// thermal length changes: what [`crate::sampler::draw_length_errors`] gives for the
+    /// same sample (the measured members of `truss-diagnose` are compared with these).
+    pub fn last_drawn_errors(&self) -> &[f64] {
         &self.errors
     }
 
@@ -217,5 +244,71 @@ impl<'j> SampleSolver<'j> {
     /// The solver of case `c`, after it solved a sample of that case.
     pub fn solver(&self, c: usize) -> Option<&Solver> {
         self.solvers[c].as_ref()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::draw_length_errors;
+    use std::path::Path;
+
+    /// A 5-stage prism job, with the case's `effects` JSON.
+    fn job(effects: &str) -> Job {
+        let text = format!(
+            r#"{{"model": {{"prism": {{"stages": 5}}}}, "seed": 7,
+                "cases": [{{"name": "c", "samples": 4, {effects}
+                            "length_errors": {{"batten": {{"normal": {{"sigma": 0.0063}}}},
+                                               "longeron": {{"normal": {{"sigma": 0.0063}}}}}}}}]}}"#
+        );
+        Job::from_json(&text, Path::new(".")).unwrap()
+    }
+
+    /// Without thermal changes the solver's length errors are the drawn ones; with them,
+    /// the drawn ones stay what `draw_length_errors` gives, and the solver's are each
+    /// drawn error plus its member's thermal change, as the solve used them (its θ_P is
+    /// that of a solve given those errors).
+    #[test]
+    fn drawn_errors_are_kept_apart_from_thermal_changes() {
+        let thermal = r#""effects": {"thermal_gradient": {"gradient": [0, 0, 0.002], "offset": 0.5, "alpha": 23e-6}},"#;
+        for (effects, changed) in [("", false), (thermal, true)] {
+            let job = job(effects);
+            let case = &job.cases[0];
+            assert_eq!(case.applied.length_changes.is_empty(), !changed);
+            let key = crate::sampler::stream_key(job.seed, &case.name);
+            let mut solver = SampleSolver::new(&job);
+            let mut drawn = Vec::new();
+            for k in 0..4 {
+                let result = solver.solve(k);
+                draw_length_errors(&key, case, k, &mut drawn);
+                assert_eq!(solver.last_drawn_errors(), &drawn[..]);
+                let want: Vec<f64> = if changed {
+                    drawn
+                        .iter()
+                        .zip(&case.applied.length_changes)
+                        .map(|(e, t)| e + t)
+                        .collect()
+                } else {
+                    drawn.clone()
+                };
+                assert_eq!(solver.last_errors(), &want[..]);
+                assert!(!changed || want != drawn);
+                let mut alone = Solver::with_structure(case.structure.clone(), Default::default());
+                alone
+                    .solve_perturbed(Perturbation {
+                        length_errors: &want,
+                        extra_loads: &case.applied.loads,
+                        clearances: &[],
+                    })
+                    .unwrap();
+                let Outcome::Converged(c) = result.outcome else {
+                    panic!("sample {k} failed")
+                };
+                assert_eq!(
+                    c.distortion.theta_p.to_bits(),
+                    alone.distortion().unwrap().theta_p.to_bits()
+                );
+            }
+        }
     }
 }

@@ -43,9 +43,16 @@ pub struct Simulation {
     pub tan_y: Vec<f64>,
     /// θ_P of the noisy positions \[rad\].
     pub theta_p: Vec<f64>,
-    /// The sample index of each converged row (rows of `x`), for draws made again from
-    /// the same streams (the member length errors of [`crate::likelihood::conditional`]).
+    /// The sample index of each converged row (rows of `x`): the key of its simulated
+    /// gauge noise in [`crate::likelihood::conditional`].
     pub indices: Vec<u64>,
+    /// Members per sample in `errors`: the case model's.
+    pub members: usize,
+    /// `N × members` length errors each converged sample drew \[mm\] (rows as `x`, the case
+    /// model's member order, thermal length changes not added): the member measurements'
+    /// simulated counterparts in [`crate::likelihood::conditional`], kept from the solve
+    /// rather than drawn again.
+    pub errors: Vec<f64>,
     /// Samples whose solve failed (left out).
     pub failed: usize,
     /// The first failure's reason.
@@ -84,6 +91,7 @@ pub fn top_indices(coords: &[Coordinate], top: [usize; 3]) -> Option<[[usize; 3]
 
 struct Row {
     x: Vec<f64>,
+    errors: Vec<f64>,
     failure: Option<String>,
 }
 
@@ -124,21 +132,25 @@ pub fn simulate(
         if let Outcome::Failed(reason) = result.outcome {
             return Row {
                 x: Vec::new(),
+                errors: Vec::new(),
                 failure: Some(reason),
             };
         }
+        let errors = solver.last_drawn_errors().to_vec();
         let solver = solver.solver(0).expect("the case was solved");
         Row {
             x: nodes
                 .iter()
                 .map(|&(node, axis)| solver.displacement(node)[axis])
                 .collect(),
+            errors,
             failure: None,
         }
     });
     let case = &job.cases[0];
     let mut sim = Simulation {
         d,
+        members: model.members().len(),
         ..Simulation::default()
     };
     for (k, row) in rows.into_iter().enumerate() {
@@ -164,6 +176,7 @@ pub fn simulate(
             sim.x_noisy.extend(noisy);
         }
         sim.x.extend(row.x);
+        sim.errors.extend(row.errors);
         sim.indices.push(k as u64);
         sim.n += 1;
     }

@@ -14,9 +14,10 @@
 //! length error against the case's distribution of it). The first is the Gaussian
 //! conditional of the case's joint distribution of (x, ê), estimated from the same `N`
 //! simulated samples as the marginal one: every sample's length errors of the members in `P`
-//! are drawn again from its stream (common random numbers), the gauge noise `σ_m·z` added
-//! (`z` from the counter-based generator under [`GAUGE_SEED`], key (sample, member)), and the
-//! displacements `x` regressed on them by least squares:
+//! are those its solve drew (common random numbers: [`Simulation::errors`], the same words
+//! as every other case's), the gauge noise `σ_m·z` added (`z` from the counter-based
+//! generator under [`GAUGE_SEED`], key (sample, member), drawn once per diagnosis:
+//! [`GaugeNoise`]), and the displacements `x` regressed on them by least squares:
 //!
 //! ```text
 //! x = x̄ + Bᵀ(ê − ē) + r,     p(yᵢ | êᵢ) ≈ N(yᵢ; x̄ + Bᵀ(êᵢ − ē), S_r + (σ_m² + τ²)·I)
@@ -50,14 +51,63 @@ use truss_job::Job;
 /// Seed of the simulated gauge noise on member measurements.
 pub const GAUGE_SEED: u64 = 0x6761_7567_6500;
 
+/// The standard normals `z` of the simulated gauge noise (module doc) of samples
+/// `0..samples` at the members the node specimens measured: a function of (sample, member)
+/// alone, so drawn at the first simulation and read by every later one.
+#[derive(Debug)]
+pub struct GaugeNoise {
+    samples: usize,
+    /// The members the node specimens measured (baseline indices, ascending).
+    members: Vec<usize>,
+    /// `z` of sample `k`, member `members[c]` at `k·members.len() + c`, once drawn.
+    z: std::cell::OnceCell<Vec<f64>>,
+}
+
+impl GaugeNoise {
+    /// The gauge noise of samples `0..samples` at the members `measured`'s node specimens
+    /// measured (none without member measurements), drawn when first read.
+    pub fn new(samples: usize, measured: &Measured) -> Self {
+        let mut members: Vec<usize> = measured.members.as_ref().map_or(Vec::new(), |data| {
+            data.observations
+                .iter()
+                .zip(&data.truss)
+                .filter(|&(_, &t)| t < measured.n())
+                .map(|(&(m, _), _)| m)
+                .collect()
+        });
+        members.sort_unstable();
+        members.dedup();
+        Self {
+            samples,
+            members,
+            z: std::cell::OnceCell::new(),
+        }
+    }
+
+    /// `z` (see the field), drawn on the first call.
+    fn z(&self) -> &[f64] {
+        self.z.get_or_init(|| {
+            (0..self.samples as u64)
+                .flat_map(|k| {
+                    self.members
+                        .iter()
+                        .map(move |&m| noise_normal(GAUGE_SEED, k, m as u64))
+                })
+                .collect()
+        })
+    }
+}
+
 /// Each specimen's term `ln p(yᵢ | êᵢ)` (module doc), or its marginal term where it has no
-/// measured member. `baseline` is the model the measured member indices refer to.
+/// measured member. `baseline` is the model the measured member indices refer to; `gauge`
+/// the gauge noise of `measured`, of at least the simulation's samples.
 pub fn log_densities(
     job: &Job,
     baseline: &Model,
     sim: &Simulation,
     measured: &Measured,
     sigma_m: f64,
+    gauge: &GaugeNoise,
 ) -> Result<Vec<f64>, DiagnoseError> {
     let n = measured.n();
     let d = sim.d;
@@ -86,7 +136,7 @@ pub fn log_densities(
     if groups.is_empty() {
         return Ok(out);
     }
-    let draws = Draws::new(job, baseline, sim, sigma_m);
+    let draws = Draws::new(job, baseline, sim, sigma_m, gauge)?;
     for (members, specimens) in groups {
         let regression = Regression::fit(sim, &draws, &members, sigma_m)?;
         for i in specimens {
@@ -97,38 +147,78 @@ pub fn log_densities(
     Ok(out)
 }
 
-/// The simulated samples' measured length errors ê (drawn again from each sample's stream,
-/// gauge noise added), by baseline member index.
+/// The simulated samples' measured length errors ê (each sample's drawn errors, gauge
+/// noise added), at the measured members.
 struct Draws {
-    /// `N × M` row-major, M the baseline's members.
+    /// `N × width` row-major: sample row r, measured member c at `r·width + c`.
     e: Vec<f64>,
-    members: usize,
+    width: usize,
+    /// Each baseline member's column in `e`, if measured.
+    column: Vec<Option<usize>>,
 }
 
 impl Draws {
-    fn new(job: &Job, baseline: &Model, sim: &Simulation, sigma_m: f64) -> Self {
+    fn new(
+        job: &Job,
+        baseline: &Model,
+        sim: &Simulation,
+        sigma_m: f64,
+        gauge: &GaugeNoise,
+    ) -> Result<Self, DiagnoseError> {
         let case = &job.cases[0];
-        let key = truss_job::sampler::stream_key(job.seed, &case.name);
+        let (members, z) = (&gauge.members, gauge.z());
+        let width = members.len();
+        if sim.errors.len() != sim.n * sim.members || sim.members != case.model.members().len() {
+            return Err(DiagnoseError::Simulation {
+                what: case.name.clone(),
+                message: format!(
+                    "the simulation kept {} length errors for {} samples of {} members",
+                    sim.errors.len(),
+                    sim.n,
+                    case.model.members().len()
+                ),
+            });
+        }
         // A derived case's model may number members differently (backlash): found by id.
-        let index: Vec<Option<usize>> = baseline
-            .members()
+        let index: Vec<Option<usize>> = members
             .iter()
-            .enumerate()
-            .map(|(m, member)| match case.model.members().get(m) {
-                Some(x) if x.id == member.id => Some(m),
-                _ => case.model.member_index(&member.id),
+            .map(|&m| {
+                let id = &baseline.members()[m].id;
+                match case.model.members().get(m) {
+                    Some(x) if &x.id == id => Some(m),
+                    _ => case.model.member_index(id),
+                }
             })
             .collect();
-        let members = index.len();
-        let mut e = Vec::with_capacity(sim.n * members);
-        let mut drawn = Vec::new();
-        for &k in &sim.indices {
-            truss_job::sampler::draw_length_errors(&key, case, k, &mut drawn);
-            e.extend(index.iter().enumerate().map(|(m, i)| {
-                i.map_or(0.0, |i| drawn[i]) + sigma_m * noise_normal(GAUGE_SEED, k, m as u64)
-            }));
+        let mut column = vec![None; baseline.members().len()];
+        for (c, &m) in members.iter().enumerate() {
+            column[m] = Some(c);
         }
-        Self { e, members }
+        if sim
+            .indices
+            .iter()
+            .any(|&k| (k as usize + 1) * width > z.len())
+        {
+            return Err(DiagnoseError::Simulation {
+                what: case.name.clone(),
+                message: "a sample beyond the diagnosis's samples has no gauge noise".into(),
+            });
+        }
+        let mut e = Vec::with_capacity(sim.n * width);
+        for (drawn, &k) in sim
+            .errors
+            .chunks_exact(sim.members.max(1))
+            .zip(&sim.indices)
+        {
+            let z = &z[k as usize * width..(k as usize + 1) * width];
+            e.extend(
+                index
+                    .iter()
+                    .zip(z)
+                    .map(|(i, z)| i.map_or(0.0, |i| drawn[i]) + sigma_m * z),
+            );
+        }
+        Ok(Self { e, width, column })
     }
 }
 
@@ -160,9 +250,8 @@ impl Regression {
     ) -> Result<Self, DiagnoseError> {
         let (n, d) = (sim.n, sim.d);
         let column = |j: usize| -> Vec<f64> {
-            (0..n)
-                .map(|r| draws.e[r * draws.members + members[j]])
-                .collect()
+            let c = draws.column[members[j]].expect("a group's members are measured");
+            (0..n).map(|r| draws.e[r * draws.width + c]).collect()
         };
         let mut kept = Vec::new();
         let mut cols = Vec::new();
@@ -255,6 +344,88 @@ impl Regression {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::comparison::measured::{Coordinate, MemberData};
+    use crate::comparison::simulate::simulate;
+
+    /// A 5-stage prism job of `samples` samples, with pin joints in free play where
+    /// `backlash` (hole nodes and joints added to the rigid baseline's model) and a thermal
+    /// field (length changes the members' measurements do not see).
+    fn job(backlash: bool, samples: u64) -> Job {
+        let (model, clearance) = if backlash {
+            (
+                r#"{"prism": {"stages": 5, "backlash": true}}"#,
+                r#""backlash": {"clearance": {"uniform": {"low": 0.004, "high": 0.017}}},"#,
+            )
+        } else {
+            (r#"{"prism": {"stages": 5}}"#, "")
+        };
+        let text = format!(
+            r#"{{"model": {model}, "seed": 5,
+                "cases": [{{"name": "c", "samples": {samples}, {clearance}
+                            "effects": {{"thermal_gradient": {{"gradient": [0, 0, 0.002], "offset": 0.5, "alpha": 23e-6}}}},
+                            "length_errors": {{"batten": {{"normal": {{"sigma": 0.0067}}}},
+                                               "longeron": {{"normal": {{"sigma": 0.0067}}}},
+                                               "diagonal": {{"uniform": {{"low": -0.0201, "high": 0}}}}}}}}]}}"#
+        );
+        Job::from_json(&text, std::path::Path::new(".")).unwrap()
+    }
+
+    /// The measured members' simulated errors, read from the simulation and the gauge noise
+    /// drawn once, are exactly those drawn again from every sample's stream as the errors
+    /// were before (`draw_length_errors` plus `σ_m·z`, found by the baseline member's id in
+    /// the derived model), bit for bit; members no node specimen measured get no column.
+    #[test]
+    fn simulated_member_errors_are_those_drawn_again_from_each_stream() {
+        let samples = 24;
+        let baseline = job(false, samples).cases[0].model.clone();
+        let derived = job(true, samples);
+        let case = &derived.cases[0];
+        let top = baseline.top_surface().unwrap().nodes;
+        let sim = simulate(
+            &derived,
+            &Coordinate::of_nodes(&baseline, &top),
+            samples as usize,
+            None,
+            2,
+        )
+        .unwrap();
+        assert_eq!(sim.n, samples as usize);
+        // Specimen 0 measured members 3 and 1, specimen 1 member 1 again; member 0 only on
+        // a truss without node positions (index 2 of 2 node specimens).
+        let measured = Measured {
+            members: Some(MemberData {
+                observations: vec![(3, 0.001), (1, -0.002), (1, 0.0), (0, 0.003)],
+                truss: vec![0, 0, 1, 2],
+            }),
+            specimens: vec!["a".into(), "b".into()],
+            coords: Vec::new(),
+            y: Vec::new(),
+            tan_x: Vec::new(),
+            tan_y: Vec::new(),
+            theta_p: Vec::new(),
+            lines: Vec::new(),
+            report: Default::default(),
+        };
+        let gauge = GaugeNoise::new(samples as usize, &measured);
+        let sigma_m = 0.001;
+        let draws = Draws::new(&derived, &baseline, &sim, sigma_m, &gauge).unwrap();
+        assert_eq!(draws.width, 2);
+        assert_eq!(draws.column[..4], [None, Some(0), None, Some(1)]);
+        let key = truss_job::sampler::stream_key(derived.seed, &case.name);
+        let mut drawn = Vec::new();
+        for (r, &k) in sim.indices.iter().enumerate() {
+            truss_job::sampler::draw_length_errors(&key, case, k, &mut drawn);
+            for (c, m) in [(0, 1), (1, 3)] {
+                let i = case.model.member_index(&baseline.members()[m].id).unwrap();
+                let want = drawn[i] + sigma_m * noise_normal(GAUGE_SEED, k, m as u64);
+                assert_eq!(
+                    draws.e[r * 2 + c].to_bits(),
+                    want.to_bits(),
+                    "sample {k}, member {m}"
+                );
+            }
+        }
+    }
 
     /// One coordinate that is exactly twice one member's error plus independent scatter of
     /// SD 0.5: the regression recovers slope 2 and the residual variance 0.25, and the
@@ -275,7 +446,11 @@ mod tests {
             x,
             ..Simulation::default()
         };
-        let draws = Draws { e, members: 1 };
+        let draws = Draws {
+            e,
+            width: 1,
+            column: vec![Some(0)],
+        };
         let r = Regression::fit(&sim, &draws, &[0], 0.0).unwrap();
         assert!((r.b[(0, 0)] - 2.0).abs() < 0.03, "{}", r.b);
         let at = 1.0;

@@ -8,6 +8,7 @@ use crate::comparison::baseline::{Baseline, CaseEdit};
 use crate::comparison::measured::Measured;
 use crate::comparison::simulate::{Simulation, simulate};
 use crate::errors::DiagnoseError;
+use crate::likelihood::conditional::GaugeNoise;
 use crate::likelihood::derivatives::Terms;
 use crate::likelihood::fit::{Fit, Interval, Options, adjustments, maximise, wald_intervals};
 use crate::likelihood::gaussian::{Gaussian, member_log_likelihood};
@@ -208,6 +209,8 @@ pub(crate) struct Evaluator<'a> {
     pub simulations: std::cell::Cell<usize>,
     /// The terms of cases already simulated, if shared.
     pub memo: Option<&'a Memo>,
+    /// The simulated gauge noise of the member measurements, of `samples` samples.
+    pub gauge: &'a GaugeNoise,
 }
 
 impl Evaluator<'_> {
@@ -247,6 +250,7 @@ impl Evaluator<'_> {
                 sim,
                 self.measured,
                 self.sigma_m,
+                self.gauge,
             )?
         } else {
             Gaussian::from_simulation(sim, self.sigma_m)?.log_densities(&self.measured.y)

@@ -8,6 +8,7 @@ use crate::comparison::measured::Measured;
 use crate::comparison::simulate::{Noise, Simulation, simulate};
 use crate::comparison::statistics::{Comparison, compare};
 use crate::errors::DiagnoseError;
+use crate::likelihood::conditional::GaugeNoise;
 use crate::likelihood::score::{Evaluator, FittedParameter, Memo};
 use crate::settings::{Progress, Settings};
 use std::cell::{Cell, RefCell};
@@ -26,6 +27,8 @@ pub(crate) struct Context<'a> {
     pub simulations: Cell<usize>,
     /// ℓ's terms of the cases simulated so far.
     pub memo: Memo,
+    /// The simulated gauge noise of the member measurements, of `samples` samples.
+    pub gauge: GaugeNoise,
     /// Each stage's wall time and simulations, in order.
     pub stages: RefCell<Vec<StageTime>>,
 }
@@ -55,6 +58,7 @@ impl Context<'_> {
             threads: self.settings.thread_count(),
             simulations: Cell::new(0),
             memo: Some(&self.memo),
+            gauge: &self.gauge,
         }
     }
 

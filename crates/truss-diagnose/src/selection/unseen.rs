@@ -197,6 +197,7 @@ mod tests {
             threads: 1,
             simulations: Default::default(),
             memo: None,
+            gauge: &crate::likelihood::conditional::GaugeNoise::new(SAMPLES, &measured),
         };
         let null: Vec<f64> = c.parameters().iter().map(|p| p.null).collect();
         let l0: f64 = ev.terms_at(c, &null).unwrap().iter().sum();
