@@ -111,11 +111,10 @@ pub fn synth(options: &SynthOptions, out: &mut dyn Write) -> Result<usize, Diagn
     write_specimens(out, &model, &nodes, &sim.x_noisy).map_err(io)?;
     if let Some(path) = &options.members_out {
         let case = &job.cases[0];
-        let key = truss_job::sampler::stream_key(options.seed, &case.name);
         let mut text = String::from("specimen,member,length_error\n");
-        let mut errors = Vec::new();
-        for k in 0..sim.n {
-            truss_job::sampler::draw_length_errors(&key, case, k as u64, &mut errors);
+        // Specimen k is the simulation's row k (as in the node file): its sample's drawn
+        // length errors, as the solve used them.
+        for (k, errors) in sim.errors.chunks_exact(sim.members).enumerate() {
             for (m, member) in model.members().iter().enumerate() {
                 if case.member_errors[m].is_some() {
                     let e = errors[m]
