@@ -380,7 +380,9 @@ fn path_independence(samples: usize) {
 /// batched: `truss_core::solver::lanes`), all of them, three times each; prints the median
 /// time per sample of each and their ratio, and checks that both give the same bits.
 fn in_lanes(solver: &Solver, errors: &[Vec<f64>]) {
-    use truss_core::solver::lanes::{BatchKernels, Kernels, LaneSolve, LaneWork, run_lanes};
+    use truss_core::solver::lanes::{
+        BatchKernels, Kernels, LaneSolve, LaneWork, in_flight_for, run_lanes,
+    };
     struct Work<'e> {
         structure: std::sync::Arc<truss_core::Structure>,
         errors: &'e [Vec<f64>],
@@ -438,7 +440,7 @@ fn in_lanes(solver: &Solver, errors: &[Vec<f64>]) {
             out: vec![0; errors.len()],
         };
         let t = Instant::now();
-        run_lanes(&mut work, &mut kernels);
+        run_lanes(&mut work, &mut kernels, in_flight_for(&structure));
         batched.push(t.elapsed().as_secs_f64() * 1e6 / errors.len() as f64);
         assert_eq!(work.out, want, "lanes and one at a time differ");
     }

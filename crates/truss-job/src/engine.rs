@@ -32,7 +32,9 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::mpsc::{RecvTimeoutError, sync_channel};
 use std::time::{Duration, Instant};
 use truss_core::SolveOptions;
-use truss_core::solver::lanes::{BatchKernels, Kernels, LANES, LaneSolve, LaneWork, run_lanes};
+use truss_core::solver::lanes::{
+    BatchKernels, Kernels, LANES, LaneSolve, LaneWork, in_flight_for, run_lanes,
+};
 
 /// Positions a worker takes at a time, for models up to [`CHUNK_UNKNOWNS`] unknowns. Each
 /// chunk wakes the calling thread once (the runner: one write): at 16 (about 0.2 ms of
@@ -55,14 +57,17 @@ pub const CHUNK_UNKNOWNS: u64 = 45;
 /// in a run only one thread would work. Which worker solves a sample never changes its
 /// result, so the chunk moves no byte of the output.
 pub fn chunk_for(job: &Job) -> u64 {
-    let largest = job
-        .cases
+    let largest = largest_model(job).max(1) as u64;
+    (CHUNK * CHUNK_UNKNOWNS / largest).clamp(LANES as u64, CHUNK)
+}
+
+/// The unknowns of `job`'s largest model (0 for a job without cases).
+fn largest_model(job: &Job) -> usize {
+    job.cases
         .iter()
-        .map(|c| c.structure.free_dofs() as u64)
+        .map(|c| c.structure.free_dofs())
         .max()
         .unwrap_or(0)
-        .max(1);
-    (CHUNK * CHUNK_UNKNOWNS / largest).clamp(LANES as u64, CHUNK)
 }
 
 /// How often the calling thread calls `take(None)` while a run lasts.
@@ -190,6 +195,13 @@ impl<'a> Engine<'a> {
         );
         let total = indices.len();
         let chunk_size = chunk_for(self.job);
+        let in_flight = self
+            .job
+            .cases
+            .iter()
+            .map(|c| in_flight_for(&c.structure))
+            .max()
+            .unwrap_or(LANES);
         let threads = (self.threads as u64).min(total.div_ceil(chunk_size)).max(1) as usize;
         let next = AtomicU64::new(0);
         let stop = AtomicBool::new(false);
@@ -225,7 +237,7 @@ impl<'a> Engine<'a> {
                                 each,
                                 halted,
                             };
-                            run_lanes(&mut work, &mut kernels);
+                            run_lanes(&mut work, &mut kernels, in_flight);
                             done = work.delivered - start;
                         } else {
                             let solver = &mut pool[0];

@@ -141,6 +141,11 @@ impl<const W: usize> BandLanes<W> {
         self.holds[l] = Some(m.identity());
     }
 
+    /// The lane that holds the factor of the matrix whose identity is `id`, if one does.
+    pub(super) fn lane_holding(&self, id: (u64, u64)) -> Option<usize> {
+        self.holds.iter().position(|&h| h == Some(id))
+    }
+
     /// Solves each lane's system with its matrix's factor, in place.
     ///
     /// # Panics

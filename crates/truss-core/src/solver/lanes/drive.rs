@@ -1,8 +1,8 @@
-//! The driver of a batch: fills [`LANES`] lanes with solves, polls each until it waits for
-//! a kernel or ends, runs the kernels the lanes wait for, and repeats; a lane whose solve
-//! ended takes the next one at once.
+//! The driver of a batch: fills its slots (as many as [`super::in_flight_for`] says, at most
+//! [`IN_FLIGHT`]) with solves, polls each until it waits for a kernel or ends, runs the
+//! kernels they wait for, and repeats; a slot whose solve ended takes the next one at once.
 
-use super::{BatchKernels, Kernels, LANES, LaneSlots};
+use super::{BatchKernels, IN_FLIGHT, Kernels, LaneSlots};
 use std::future::Future;
 use std::pin::Pin;
 use std::task::{Context, Poll, Waker};
@@ -25,11 +25,13 @@ pub trait LaneWork<'a> {
     fn done(&mut self, done: Self::Done);
 }
 
-/// Runs `work`'s solves [`LANES`] at a time until it has no more and every lane ended.
-/// `kernels` keeps the batched kernels' buffers from one call to the next.
-pub fn run_lanes<'a, W: LaneWork<'a>>(work: &mut W, kernels: &mut BatchKernels) {
-    let slots = LaneSlots::default();
-    let mut lanes: [Option<LaneSolve<'_, W::Done>>; LANES] = std::array::from_fn(|_| None);
+/// Runs `work`'s solves `in_flight` at a time (at most [`IN_FLIGHT`]; see
+/// [`super::in_flight_for`]) until it has no more and every one ended. `kernels` keeps the
+/// batched kernels' buffers from one call to the next.
+pub fn run_lanes<'a, W: LaneWork<'a>>(work: &mut W, kernels: &mut BatchKernels, in_flight: usize) {
+    let slots = LaneSlots::new(in_flight);
+    let mut all: [Option<LaneSolve<'_, W::Done>>; IN_FLIGHT] = std::array::from_fn(|_| None);
+    let lanes = &mut all[..slots.in_flight()];
     let mut context = Context::from_waker(Waker::noop());
     let mut more = true;
     loop {

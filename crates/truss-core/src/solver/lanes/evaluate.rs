@@ -89,6 +89,16 @@ impl<const W: usize> EvalLanes<W> {
         }
     }
 
+    /// The lane whose cached member constants are those of sample `key`, if one's are.
+    pub(super) fn lane_caching(&self, key: SampleKey) -> Option<usize> {
+        self.cached.iter().position(|&c| c == Some(key))
+    }
+
+    /// The sample whose member constants lane `l` caches, if any.
+    pub(super) fn cached_sample(&self, l: usize) -> Option<SampleKey> {
+        self.cached[l]
+    }
+
     /// Evaluates the samples of the lanes that hold one (`lanes[l]`: the sample's key, its
     /// inputs and where its results go), all of `structure`; returns each one's
     /// [`Evaluation`].

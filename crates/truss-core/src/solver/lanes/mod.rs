@@ -7,9 +7,12 @@
 //! kernels are awaited through its [`Kernels`]: [`Kernels::OneSample`] runs each kernel at
 //! once (the future never waits; [`finish`] drives it), [`Kernels::Lane`] posts the kernel's
 //! request in the lane's [`LaneSlot`] and waits. A driver ([`run_lanes`], used by the one
-//! sample engine of `truss-job`) polls the lanes' futures until each waits or is done, then
-//! calls [`BatchKernels::run`], and polls the answered lanes again. A lane that is done is
-//! refilled with the next sample, so a slow sample holds no other.
+//! sample engine of `truss-job`) polls the solves' futures until each waits or is done, then
+//! calls [`BatchKernels::run`], and polls the answered ones again. A slot whose solve is
+//! done is refilled with the next sample, so a slow sample holds no other. Where kernels
+//! are most of a solve's cost, twice as many solves as lanes are in flight
+//! ([`in_flight_for`]), so that a kernel finds more of them waiting for it; a solve then
+//! runs each kernel in whichever lane is free, preferably one whose caches hold its sample.
 //!
 //! The batched kernels are the three that cost most in a solve of the paper's prism:
 //! - the member evaluation (out-of-balance force, member states and strain energy at a
@@ -19,8 +22,8 @@
 //!
 //! while the rest of a solve (the linearised start and its Woodbury solves, assembly, the
 //! line search's arithmetic) runs in each lane's own code. Each round runs one kernel: the
-//! one most lanes wait for, unless a lane has waited [`PATIENCE`] rounds; the others keep
-//! waiting, so that lanes fall into step (a kernel costs as much for one lane as for four).
+//! one most solves wait for, unless one has waited [`PATIENCE`] rounds; the others keep
+//! waiting, so that solves fall into step (a kernel costs as much for one lane as for four).
 //! Structures above [`BATCHED_DOFS`] unknowns run their lanes' kernels one lane at a time.
 //!
 //! ## Bit for bit
@@ -28,7 +31,8 @@
 //! (see the `evaluate` and `band` modules): no fused multiply-add, no sum across lanes, no
 //! decision in one lane that depends on another. The control flow of a solve (iterations,
 //! line-search trials, slack sets) is the same code in both paths. So a sample's bytes
-//! depend neither on its lane, nor on its neighbours, nor on `W`, nor on the instruction set
+//! depend neither on its lane, nor on its neighbours, nor on `W` or how many solves are in
+//! flight, nor on the instruction set
 //! the kernels use: AVX2 where the processor has it, chosen at run time by the `pulp` crate
 //! (the default build targets baseline x86-64, whose SSE2 carries two lanes per
 //! instruction; `TRUSS_KERNELS=baseline` forces it). No `unsafe` code: a waiting lane's
@@ -54,6 +58,37 @@ use std::task::{Context, Poll, Waker};
 
 /// Lanes per batch: four f64 lanes fill an AVX2 register (two SSE2 ones).
 pub const LANES: usize = 4;
+
+/// The most solves in flight per batch ([`run_lanes`]'s `in_flight`): twice the kernels'
+/// lanes, so that a kernel finds more of them waiting for it.
+pub const IN_FLIGHT: usize = 2 * LANES;
+
+/// The solves a batch keeps in flight for `structure`: [`IN_FLIGHT`] where factorisations
+/// are most of what a solve costs (a model solved at the limit `r → 0`, whose samples
+/// factorise about 23 times each against 1.4 for the rigid 5-stage prism, or one larger
+/// than that prism), else [`LANES`], one per lane.
+///
+/// With one solve per lane, a kernel runs for 2.4 to 3.1 lanes on average (the solves wait
+/// for different kernels), at about the cost of four. With twice as many in flight it
+/// runs for 3.5 to 3.8, but eight solves share four lanes' caches (a sample's member
+/// constants, a factor for its solves), which then are gathered again. Measured with
+/// cachegrind (whole `mc-shard run`, one thread, instructions against one per lane): the
+/// paper's Fig. 16 case −7.7 %, the 10- and 30-stage prisms (90 and 270 unknowns) −7 %,
+/// but the rigid 5-stage prism (45) +1.7 %, whose kernels are cheap beside its one-sample
+/// work. Above [`BATCHED_DOFS`] the kernels run one lane at a time anyway. Which solve runs
+/// in which lane never changes a result (see the module doc).
+pub fn in_flight_for(structure: &Structure) -> usize {
+    let n = structure.free_dofs();
+    if n <= BATCHED_DOFS && (structure.near_the_limit() || n > WIDE_UNKNOWNS) {
+        IN_FLIGHT
+    } else {
+        LANES
+    }
+}
+
+/// Models of more unknowns than this (the paper's 5-stage prism) keep [`IN_FLIGHT`] solves
+/// in flight ([`in_flight_for`]).
+pub const WIDE_UNKNOWNS: usize = 45;
 
 pub(crate) use crate::block::arch;
 
@@ -170,19 +205,35 @@ impl LaneSlot {
 /// The lanes' mailboxes of a batch (borrowed by the lanes' futures).
 #[derive(Debug)]
 pub struct LaneSlots {
-    slots: [LaneSlot; LANES],
+    slots: [LaneSlot; IN_FLIGHT],
+    /// Solves in flight: the first this many slots hold them.
+    in_flight: usize,
 }
 
 impl Default for LaneSlots {
     fn default() -> Self {
         Self {
             slots: std::array::from_fn(|_| LaneSlot::default()),
+            in_flight: LANES,
         }
     }
 }
 
 impl LaneSlots {
-    /// Lane `l`'s mailbox, `l < LANES`.
+    /// Mailboxes for `in_flight` solves (at most [`IN_FLIGHT`]).
+    pub fn new(in_flight: usize) -> Self {
+        Self {
+            in_flight: in_flight.clamp(1, IN_FLIGHT),
+            ..Self::default()
+        }
+    }
+
+    /// How many solves these mailboxes serve.
+    pub fn in_flight(&self) -> usize {
+        self.in_flight
+    }
+
+    /// Solve `l`'s mailbox, `l <` [`LaneSlots::in_flight`].
     pub fn lane(&self, l: usize) -> &LaneSlot {
         &self.slots[l]
     }
@@ -256,34 +307,76 @@ impl BatchKernels {
         &mut self.structures[at].1
     }
 
-    /// Runs one kernel for the lanes that wait for it: the kernel (and structure) most
-    /// lanes wait for, unless a lane has waited [`PATIENCE`] rounds, whose kernel then
-    /// runs. The other lanes keep waiting, so that lanes fall into step (a kernel run for
-    /// one lane costs as much as for four). Returns how many lanes were answered.
+    /// Runs one kernel for the solves that wait for it: the kernel (and structure) most
+    /// solves wait for, unless one has waited [`PATIENCE`] rounds, whose kernel then runs,
+    /// for at most [`LANES`] of them (those that waited longest, each preferably in a lane
+    /// whose caches hold its sample). The others keep waiting, so that solves fall into step
+    /// (a kernel run for one lane costs as much as for four). Returns how many solves were
+    /// answered.
     pub fn run(&mut self, slots: &LaneSlots) -> usize {
-        let Some((structure, kind)) = choose(slots) else {
+        let asked = asked(slots);
+        let Some(first) = choose(&asked) else {
             return 0;
         };
+        let Some(chosen) = asked[first] else {
+            return 0;
+        };
+        let (kind, structure) = {
+            let posted = slots.slots[first].posted.borrow();
+            let p = posted.as_ref().expect("a solve that asked has posted");
+            (p.request.kind(), Arc::clone(&p.structure))
+        };
+        let lanes = self.of(&structure);
+        let wants = |a: &Asked| a.same_kernel(&chosen);
+        let lane_of = match (&lanes.batched, slots.in_flight > LANES) {
+            (Some((evaluation, band)), true) => {
+                // The lane whose caches already hold what a solve's request needs: its
+                // factor for a solve, else its sample's member constants (where its last
+                // factor is likely held).
+                let cached = |s: usize, a: &Asked| {
+                    let sample = evaluation.lane_caching(a.key);
+                    match &slots.slots[s].posted.borrow().as_ref()?.request {
+                        Request::Solve { matrix, .. } => {
+                            band.lane_holding(matrix.identity()).or(sample)
+                        }
+                        _ => sample,
+                    }
+                };
+                // A lane whose caches belong to no solve in flight (its sample ended): taken
+                // before one whose caches another solve will want again.
+                let dead = |l: usize| {
+                    evaluation
+                        .cached_sample(l)
+                        .is_none_or(|key| !asked.iter().flatten().any(|a| a.key == key))
+                };
+                assign_lanes(&asked, wants, cached, dead)
+            }
+            // No lanes' caches (the kernels run one lane at a time).
+            (None, true) => assign_lanes(&asked, wants, |_, _| None, |_| true),
+            // One solve per lane: each keeps its own.
+            (_, false) => {
+                std::array::from_fn(|l| asked[l].as_ref().is_some_and(wants).then_some(l))
+            }
+        };
+        for (slot, a) in slots.slots.iter().zip(&asked) {
+            if a.is_some() {
+                slot.waited.set(slot.waited.get() + 1);
+            }
+        }
+        // Kernel lane `l` serves the solve in slot `lane_of[l]`.
         let mut posted: [Option<std::cell::RefMut<'_, Option<Posted>>>; LANES] =
             std::array::from_fn(|l| {
-                let slot = &slots.slots[l];
-                let p = slot.posted.borrow_mut();
-                let chosen = !slot.answered.get()
-                    && p.as_ref().is_some_and(|p| {
-                        p.request.kind() == kind && Arc::ptr_eq(&p.structure, &structure)
-                    });
-                if chosen {
-                    slot.waited.set(0);
-                    Some(p)
-                } else {
-                    if p.is_some() && !slot.answered.get() {
-                        slot.waited.set(slot.waited.get() + 1);
-                    }
-                    None
-                }
+                lane_of[l].map(|s| {
+                    slots.slots[s].waited.set(0);
+                    slots.slots[s].posted.borrow_mut()
+                })
             });
-        let Some((evaluation, band)) = &mut self.of(&structure).batched else {
-            for (slot, p) in slots.slots.iter().zip(posted.iter_mut()) {
+        let served = lane_of.map(|s| s.map(|s| &slots.slots[s]));
+        let Some((evaluation, band)) = &mut lanes.batched else {
+            for (slot, p) in served.iter().zip(posted.iter_mut()) {
+                let Some(slot) = slot else {
+                    continue;
+                };
                 let Some(p) = p.as_mut().and_then(|p| p.as_mut()) else {
                     continue;
                 };
@@ -326,8 +419,8 @@ impl BatchKernels {
                         _ => None,
                     });
                 let evaluations = evaluation.evaluate(&structure, &mut io);
-                for (slot, e) in slots.slots.iter().zip(evaluations) {
-                    if e.is_some() {
+                for (slot, e) in served.iter().zip(evaluations) {
+                    if let (Some(slot), Some(_)) = (slot, e) {
                         slot.evaluation.set(e);
                     }
                 }
@@ -364,11 +457,9 @@ impl BatchKernels {
             }
         }
         let mut answered = 0;
-        for (slot, p) in slots.slots.iter().zip(&posted) {
-            if p.is_some() {
-                slot.answered.set(true);
-                answered += 1;
-            }
+        for slot in served.iter().flatten() {
+            slot.answered.set(true);
+            answered += 1;
         }
         answered
     }
@@ -382,31 +473,108 @@ impl BatchKernels {
 /// result (see the module doc).
 pub const PATIENCE: u32 = 8;
 
-/// The kernel to run next (see [`BatchKernels::run`]): its structure and kind.
-fn choose(slots: &LaneSlots) -> Option<(Arc<Structure>, Kind)> {
-    let posted: [_; LANES] = std::array::from_fn(|l| slots.slots[l].posted.borrow());
-    let same = |a: &Posted, b: &Posted| {
-        a.request.kind() == b.request.kind() && Arc::ptr_eq(&a.structure, &b.structure)
-    };
-    let mut best: Option<(bool, usize, usize)> = None;
-    let waiting: [bool; LANES] = std::array::from_fn(|l| !slots.slots[l].answered.get());
-    for (l, p) in posted.iter().enumerate() {
-        let Some(p) = p.as_ref().filter(|_| waiting[l]) else {
-            continue;
-        };
-        let count = posted
-            .iter()
-            .zip(waiting)
-            .filter(|(q, w)| *w && q.as_ref().is_some_and(|q| same(p, q)))
-            .count();
-        let overdue = slots.slots[l].waited.get() >= PATIENCE;
-        if best.is_none_or(|(o, c, _)| (overdue, count) > (o, c)) {
-            best = Some((overdue, count, l));
+/// What a solve waits for, read once per round: its kernel (kind and structure), its
+/// sample, and how many rounds it has waited.
+#[derive(Debug, Clone, Copy)]
+struct Asked {
+    kind: Kind,
+    structure: *const Structure,
+    key: SampleKey,
+    waited: u32,
+}
+
+impl Asked {
+    /// Whether both wait for the same kernel: of one kind, for one structure.
+    fn same_kernel(&self, other: &Asked) -> bool {
+        self.kind == other.kind && std::ptr::eq(self.structure, other.structure)
+    }
+}
+
+/// What each slot's solve waits for (`None`: answered, or no solve).
+fn asked(slots: &LaneSlots) -> [Option<Asked>; IN_FLIGHT] {
+    std::array::from_fn(|s| {
+        let slot = &slots.slots[s];
+        if s >= slots.in_flight || slot.answered.get() {
+            return None;
+        }
+        let posted = slot.posted.borrow();
+        let p = posted.as_ref()?;
+        Some(Asked {
+            kind: p.request.kind(),
+            structure: Arc::as_ptr(&p.structure),
+            key: p.key,
+            waited: slot.waited.get(),
+        })
+    })
+}
+
+/// The slots a kernel serves, by kernel lane: of the solves that `wants` (those waiting for
+/// it), at most [`LANES`], those that waited longest first (then in slot order); each in
+/// the lane whose caches hold what its request needs (`cached`: a sample's member
+/// constants, a factor for its solves) where that is free, else in its own lane
+/// (`slot % LANES`: with [`LANES`] solves in flight, each keeps its lane), else in a free
+/// lane whose caches no solve in flight needs (`dead`), else in the first free one.
+fn assign_lanes(
+    asked: &[Option<Asked>; IN_FLIGHT],
+    wants: impl Fn(&Asked) -> bool,
+    cached: impl Fn(usize, &Asked) -> Option<usize>,
+    dead: impl Fn(usize) -> bool,
+) -> [Option<usize>; LANES] {
+    let mut order: [usize; IN_FLIGHT] = [0; IN_FLIGHT];
+    let mut count = 0;
+    for (s, a) in asked.iter().enumerate() {
+        if a.as_ref().is_some_and(&wants) {
+            order[count] = s;
+            count += 1;
         }
     }
-    let (_, _, l) = best?;
-    let p = posted[l].as_ref().expect("chosen");
-    Some((Arc::clone(&p.structure), p.request.kind()))
+    let waited = |s: usize| asked[s].map_or(0, |a| a.waited);
+    let order = &mut order[..count];
+    // Stable: equal waits keep slot order.
+    order.sort_by_key(|&s| std::cmp::Reverse(waited(s)));
+    let order = &order[..count.min(LANES)];
+    let mut lane_of: [Option<usize>; LANES] = [None; LANES];
+    let mut placed = [false; IN_FLIGHT];
+    for &s in order {
+        let own = asked[s].as_ref().and_then(|a| cached(s, a));
+        if let Some(own) = own.filter(|&l| lane_of[l].is_none()) {
+            lane_of[own] = Some(s);
+            placed[s] = true;
+        }
+    }
+    for &s in order.iter().filter(|&&s| !placed[s]) {
+        let free = Some(s % LANES)
+            .filter(|&l| lane_of[l].is_none())
+            .or_else(|| (0..LANES).find(|&l| lane_of[l].is_none() && dead(l)))
+            .or_else(|| (0..LANES).find(|&l| lane_of[l].is_none()));
+        if let Some(l) = free {
+            lane_of[l] = Some(s);
+        }
+    }
+    lane_of
+}
+
+/// The slot whose kernel runs next (see [`BatchKernels::run`]): of the kernel most solves
+/// wait for (at most [`LANES`] count), unless one has waited [`PATIENCE`] rounds.
+fn choose(asked: &[Option<Asked>; IN_FLIGHT]) -> Option<usize> {
+    let mut best: Option<(bool, usize, usize)> = None;
+    for (s, a) in asked.iter().enumerate() {
+        let Some(a) = a else {
+            continue;
+        };
+        // A kernel serves at most `LANES` solves.
+        let count = asked
+            .iter()
+            .flatten()
+            .filter(|b| b.same_kernel(a))
+            .count()
+            .min(LANES);
+        let overdue = a.waited >= PATIENCE;
+        if best.is_none_or(|(o, c, _)| (overdue, count) > (o, c)) {
+            best = Some((overdue, count, s));
+        }
+    }
+    best.map(|(_, _, s)| s)
 }
 
 /// One sample's evaluation, its buffers borrowed from its solver (see [`evaluate_with`]).

@@ -189,6 +189,7 @@ fn in_lanes(
     samples: &[(usize, Vec<f64>)],
     arch: pulp::Arch,
     batched_dofs: usize,
+    in_flight: usize,
 ) -> Vec<String> {
     struct Work<'m> {
         structures: Vec<Arc<crate::Structure>>,
@@ -237,7 +238,7 @@ fn in_lanes(
     };
     let mut kernels = BatchKernels::with_arch(arch);
     kernels.batched_dofs = batched_dofs;
-    run_lanes(&mut work, &mut kernels);
+    run_lanes(&mut work, &mut kernels, in_flight);
     work.outcomes.into_iter().map(Option::unwrap).collect()
 }
 
@@ -261,15 +262,21 @@ fn solves_in_lanes_are_the_one_sample_solves_bit_for_bit() {
         })
         .collect();
     // Batched on both instruction sets, and one lane at a time (a structure too large to
-    // batch).
+    // batch); one solve per lane, and more solves in flight than lanes (solves then move
+    // between lanes, and meet lanes whose caches hold other samples).
     for (arch, batched_dofs) in [
         (pulp::Arch::Scalar, BATCHED_DOFS),
         (pulp::Arch::new(), BATCHED_DOFS),
         (pulp::Arch::new(), 0),
     ] {
-        let batched = in_lanes(&models, &samples, arch, batched_dofs);
-        for (i, (a, b)) in alone.iter().zip(&batched).enumerate() {
-            assert_eq!(a, b, "sample {i}, {arch:?}, batched up to {batched_dofs}");
+        for in_flight in [LANES, LANES + 1, IN_FLIGHT] {
+            let batched = in_lanes(&models, &samples, arch, batched_dofs, in_flight);
+            for (i, (a, b)) in alone.iter().zip(&batched).enumerate() {
+                assert_eq!(
+                    a, b,
+                    "sample {i}, {arch:?}, batched up to {batched_dofs}, {in_flight} in flight"
+                );
+            }
         }
     }
 }
