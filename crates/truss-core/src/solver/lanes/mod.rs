@@ -73,7 +73,7 @@ pub const IN_FLIGHT: usize = 2 * LANES;
 /// runs for 3.5 to 3.8, but eight solves share four lanes' caches (a sample's member
 /// constants, a factor for its solves), which then are gathered again. Measured with
 /// cachegrind (whole `mc-shard run`, one thread, instructions against one per lane): the
-/// paper's Fig. 16 case −7.7 %, the 10- and 30-stage prisms (90 and 270 unknowns) −7 %,
+/// paper's Fig. 16 case −7.4 %, the 10- and 30-stage prisms (90 and 270 unknowns) −7.5 %,
 /// but the rigid 5-stage prism (45) +1.7 %, whose kernels are cheap beside its one-sample
 /// work. Above [`BATCHED_DOFS`] the kernels run one lane at a time anyway. Which solve runs
 /// in which lane never changes a result (see the module doc).
