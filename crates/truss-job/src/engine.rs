@@ -57,17 +57,14 @@ pub const CHUNK_UNKNOWNS: u64 = 45;
 /// in a run only one thread would work. Which worker solves a sample never changes its
 /// result, so the chunk moves no byte of the output.
 pub fn chunk_for(job: &Job) -> u64 {
-    let largest = largest_model(job).max(1) as u64;
-    (CHUNK * CHUNK_UNKNOWNS / largest).clamp(LANES as u64, CHUNK)
-}
-
-/// The unknowns of `job`'s largest model (0 for a job without cases).
-fn largest_model(job: &Job) -> usize {
-    job.cases
+    let largest = job
+        .cases
         .iter()
-        .map(|c| c.structure.free_dofs())
+        .map(|c| c.structure.free_dofs() as u64)
         .max()
         .unwrap_or(0)
+        .max(1);
+    (CHUNK * CHUNK_UNKNOWNS / largest).clamp(LANES as u64, CHUNK)
 }
 
 /// How often the calling thread calls `take(None)` while a run lasts.

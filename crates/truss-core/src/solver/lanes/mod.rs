@@ -321,10 +321,11 @@ impl BatchKernels {
         let Some(chosen) = asked[first] else {
             return 0;
         };
-        let (kind, structure) = {
+        let kind = chosen.kind;
+        let structure = {
             let posted = slots.slots[first].posted.borrow();
             let p = posted.as_ref().expect("a solve that asked has posted");
-            (p.request.kind(), Arc::clone(&p.structure))
+            Arc::clone(&p.structure)
         };
         let lanes = self.of(&structure);
         let wants = |a: &Asked| a.same_kernel(&chosen);
