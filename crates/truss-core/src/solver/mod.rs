@@ -338,6 +338,8 @@ struct FactorCache {
     factor_slack: Vec<bool>,
     locked: Vec<bool>,
     active: ActiveSet,
+    /// The model stiffness of the current model step's point, unfactorised.
+    kept: step::KeptAssembly,
 }
 
 /// What the next step carries over from the last one.
@@ -407,6 +409,7 @@ impl Solver {
                 factor_slack: vec![false; m],
                 locked: vec![false; m],
                 active: ActiveSet::new(cables),
+                kept: step::KeptAssembly::new(&structure),
             },
             step: StepState {
                 damping: 0.0,

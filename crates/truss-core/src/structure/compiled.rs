@@ -32,6 +32,8 @@ pub struct Structure {
     /// Slots of the band (within it, not its padding) that no member adds to: zeroed at
     /// the start of each assembly (a factorisation fills them in).
     pub(crate) untouched: Vec<usize>,
+    /// Each slot's members in assembly order, for assembling a few slots again.
+    pub(crate) writers: super::sparsity::SlotWriters,
     /// External load per row (plus the zero slot) \[N\].
     pub(crate) loads: Vec<f64>,
     /// `K₀`, factorised.

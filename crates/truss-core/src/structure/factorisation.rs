@@ -60,70 +60,35 @@ impl Structure {
     /// written (the only part read).
     #[inline]
     pub(crate) fn add_block(&self, k: &mut BlockBandMatrix, c: &Link, e: &[f64; 6]) {
-        let [sii, sjj, sij] = c.slots;
         let storage = k.storage_mut();
-        if !c.masked {
-            // Masks of ones: `x·1·1` is `x` exactly, so this is the masked sum without the
-            // multiplications; a block's first member writes it (`0 + x` is `x`).
-            for (slot, first) in [(sii, c.first[0]), (sjj, c.first[1])] {
-                if slot != NONE {
-                    let b = &mut storage[slot];
-                    if first {
-                        b[0][0] = e[0];
-                        b[1][0] = e[1];
-                        b[1][1] = e[2];
-                        b[2][0] = e[3];
-                        b[2][1] = e[4];
-                        b[2][2] = e[5];
-                    } else {
-                        b[0][0] += e[0];
-                        b[1][0] += e[1];
-                        b[1][1] += e[2];
-                        b[2][0] += e[3];
-                        b[2][1] += e[4];
-                        b[2][2] += e[5];
-                    }
+        for role in [Role::Ii, Role::Jj, Role::Ij] {
+            add_to_slot(storage, c, e, role);
+        }
+    }
+
+    /// Assembles again, in `storage` (a matrix this structure assembled), the slots listed
+    /// in `slots`, with `block(m)` member `m`'s six entries as [`Structure::add_block`]
+    /// takes them: each slot is summed over the members that reach it, in assembly order,
+    /// with the operations of a whole assembly, and its identity rows set. So where only
+    /// the listed slots' members changed since `storage` was assembled, it then holds the
+    /// bits a whole assembly would give.
+    pub(crate) fn reassemble_slots(
+        &self,
+        storage: &mut [Block],
+        slots: &[usize],
+        block: impl Fn(usize) -> [f64; 6],
+    ) {
+        let w = &self.writers;
+        for &slot in slots {
+            let (from, to) = (w.start[slot] as usize, w.start[slot + 1] as usize);
+            for &(m, role) in &w.members[from..to] {
+                let m = m as usize;
+                add_to_slot(storage, &self.members[m].link, &block(m), role);
+            }
+            for (d, row) in storage[slot].iter_mut().enumerate() {
+                if w.identity[slot] & (1 << d) != 0 {
+                    row[d] = 1.0;
                 }
-            }
-            if sij != NONE {
-                let b = &mut storage[sij];
-                let full = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
-                if c.first[2] {
-                    // Written out: `full.map(|row| row.map(|x| −x))` is not inlined, and
-                    // its call cost a sixth of the assembly.
-                    for (row, f) in b.iter_mut().zip(&full) {
-                        for (x, y) in row.iter_mut().zip(f) {
-                            *x = -y;
-                        }
-                    }
-                } else {
-                    for (row, f) in b.iter_mut().zip(&full) {
-                        for (x, y) in row.iter_mut().zip(f) {
-                            *x -= y;
-                        }
-                    }
-                }
-            }
-            return;
-        }
-        let full: Block = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
-        let [mi, mj] = c.masks;
-        for (&slot, &first) in c.slots.iter().zip(&c.first) {
-            if slot != NONE && first {
-                storage[slot] = [[0.0; 3]; 3];
-            }
-        }
-        if sii != NONE {
-            add_masked(&mut storage[sii], &full, &mi, &mi, 1.0);
-        }
-        if sjj != NONE {
-            add_masked(&mut storage[sjj], &full, &mj, &mj, 1.0);
-        }
-        if sij != NONE {
-            if c.coupling_rows_i {
-                add_masked(&mut storage[sij], &full, &mi, &mj, -1.0);
-            } else {
-                add_masked(&mut storage[sij], &full, &mj, &mi, -1.0);
             }
         }
     }
@@ -135,6 +100,81 @@ impl Structure {
         for &(slot, d) in &self.identity_rows {
             storage[slot][d][d] = 1.0;
         }
+    }
+}
+
+/// Which of a link's three slots (see [`Link::slots`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Role {
+    /// Node `i`'s diagonal block.
+    Ii,
+    /// Node `j`'s diagonal block.
+    Jj,
+    /// The coupling block.
+    Ij,
+}
+
+/// [`Structure::add_block`]'s part for one slot of link `c`: the first element to reach it
+/// writes it (`0 + x` is `x`), later ones add; a masked link's first element zeroes it, then
+/// adds the masked block.
+#[inline(always)]
+fn add_to_slot(storage: &mut [Block], c: &Link, e: &[f64; 6], role: Role) {
+    let index = role as usize;
+    let slot = c.slots[index];
+    if slot == NONE {
+        return;
+    }
+    let first = c.first[index];
+    let b = &mut storage[slot];
+    if !c.masked {
+        // Masks of ones: `x·1·1` is `x` exactly, so this is the masked sum without the
+        // multiplications.
+        if role != Role::Ij {
+            if first {
+                b[0][0] = e[0];
+                b[1][0] = e[1];
+                b[1][1] = e[2];
+                b[2][0] = e[3];
+                b[2][1] = e[4];
+                b[2][2] = e[5];
+            } else {
+                b[0][0] += e[0];
+                b[1][0] += e[1];
+                b[1][1] += e[2];
+                b[2][0] += e[3];
+                b[2][1] += e[4];
+                b[2][2] += e[5];
+            }
+        } else {
+            let full = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
+            if first {
+                // Written out: `full.map(|row| row.map(|x| −x))` is not inlined, and its
+                // call cost a sixth of the assembly.
+                for (row, f) in b.iter_mut().zip(&full) {
+                    for (x, y) in row.iter_mut().zip(f) {
+                        *x = -y;
+                    }
+                }
+            } else {
+                for (row, f) in b.iter_mut().zip(&full) {
+                    for (x, y) in row.iter_mut().zip(f) {
+                        *x -= y;
+                    }
+                }
+            }
+        }
+        return;
+    }
+    let full: Block = [[e[0], e[1], e[3]], [e[1], e[2], e[4]], [e[3], e[4], e[5]]];
+    if first {
+        *b = [[0.0; 3]; 3];
+    }
+    let [mi, mj] = &c.masks;
+    match role {
+        Role::Ii => add_masked(b, &full, mi, mi, 1.0),
+        Role::Jj => add_masked(b, &full, mj, mj, 1.0),
+        Role::Ij if c.coupling_rows_i => add_masked(b, &full, mi, mj, -1.0),
+        Role::Ij => add_masked(b, &full, mj, mi, -1.0),
     }
 }
 

@@ -39,7 +39,7 @@ pub(crate) use basis::CableBasis;
 pub use compiled::Structure;
 pub(crate) use framing::tilt_loads;
 pub use framing::{FRAMED_RATIO, LIMIT_RATIO};
-pub(crate) use parts::{FIXED, Link};
+pub(crate) use parts::{FIXED, Link, NONE as NONE_SLOT};
 
 use crate::ModelError;
 use crate::model::Model;
@@ -54,6 +54,11 @@ impl Structure {
         let loads = numbering.loads(model);
         let mut k = numbering.matrix;
         let untouched = sparsity::mark_first_writers(&mut members, &k);
+        let writers = sparsity::slot_writers(
+            &members,
+            &numbering.identity_rows,
+            k.blocks() * (k.bandwidth() + 1),
+        );
         let mut structure = Self {
             node_ids: nodes.iter().map(|n| n.id.clone()).collect(),
             node_xyz: nodes.iter().map(|n| n.xyz).collect(),
@@ -66,6 +71,7 @@ impl Structure {
             joints,
             identity_rows: numbering.identity_rows,
             untouched,
+            writers,
             loads,
             nominal: crate::block::BlockBandMatrix::new(0, 0),
             basis: None,

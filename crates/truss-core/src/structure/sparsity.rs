@@ -3,6 +3,7 @@
 //! so that assembling needs no clearing, and only the slots of the band that no member
 //! reaches are zeroed before each assembly.
 
+use super::factorisation::Role;
 use super::parts::{CompiledMember, NONE};
 use crate::block::BlockBandMatrix;
 
@@ -26,4 +27,52 @@ pub(super) fn mark_first_writers(
         .map(|(i, j)| k.slot(i, j))
         .filter(|&slot| !touched[slot])
         .collect()
+}
+
+/// For each slot of the band, the elements that reach it, in assembly order, and its
+/// identity rows: what [`Structure::reassemble_slots`](super::Structure::reassemble_slots)
+/// sums again where only some members changed.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SlotWriters {
+    /// `members[start[s]..start[s + 1]]` reach slot `s`.
+    pub start: Vec<u32>,
+    /// Member index and which of its link's slots is `s`.
+    pub members: Vec<(u32, Role)>,
+    /// Bit `d` set: direction `d` of the slot's (diagonal) block is an identity row.
+    pub identity: Vec<u8>,
+}
+
+/// The [`SlotWriters`] of `members` and `identity_rows` in a band of `slots` slots.
+pub(super) fn slot_writers(
+    members: &[CompiledMember],
+    identity_rows: &[(usize, usize)],
+    slots: usize,
+) -> SlotWriters {
+    let mut lists: Vec<Vec<(u32, Role)>> = vec![Vec::new(); slots];
+    for (m, c) in members.iter().enumerate() {
+        for (role, &slot) in [Role::Ii, Role::Jj, Role::Ij]
+            .into_iter()
+            .zip(&c.link.slots)
+        {
+            if slot != NONE {
+                lists[slot].push((m as u32, role));
+            }
+        }
+    }
+    let mut identity = vec![0u8; slots];
+    for &(slot, d) in identity_rows {
+        identity[slot] |= 1 << d;
+    }
+    let mut start = Vec::with_capacity(slots + 1);
+    let mut flat = Vec::new();
+    for list in lists {
+        start.push(flat.len() as u32);
+        flat.extend(list);
+    }
+    start.push(flat.len() as u32);
+    SlotWriters {
+        start,
+        members: flat,
+        identity,
+    }
 }
