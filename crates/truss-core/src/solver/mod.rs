@@ -91,6 +91,7 @@ mod evaluate;
 mod floating;
 mod held;
 mod holding;
+mod kept;
 pub mod lanes;
 mod limit;
 mod line_search;
@@ -339,7 +340,7 @@ struct FactorCache {
     locked: Vec<bool>,
     active: ActiveSet,
     /// The model stiffness of the current model step's point, unfactorised.
-    kept: step::KeptAssembly,
+    kept: kept::KeptAssembly,
 }
 
 /// What the next step carries over from the last one.
@@ -409,7 +410,7 @@ impl Solver {
                 factor_slack: vec![false; m],
                 locked: vec![false; m],
                 active: ActiveSet::new(cables),
-                kept: step::KeptAssembly::new(&structure),
+                kept: kept::KeptAssembly::new(&structure),
             },
             step: StepState {
                 damping: 0.0,

@@ -27,8 +27,6 @@ use super::Solver;
 use super::evaluate::{dot_n, max_abs};
 use super::lanes::Kernels;
 use crate::SolveError;
-use crate::block::Block;
-use crate::structure::{NONE_SLOT, Structure};
 
 /// Most negative pivots of one factorisation whose directions engage a cable each.
 const ENGAGE_AT_ONCE: usize = 32;
@@ -59,33 +57,6 @@ const SHIFT_LIMIT_FACTOR: f64 = 1e3;
 /// the same θ_P as at 1e-7, within 3e-9). A true mechanism has a zero pivot whatever μ, and
 /// is still refused, after two more factorisations.
 const SHIFT_LIMIT_MIN: f64 = 1e4;
-
-/// The model stiffness `K(S)` as a model step at the limit last assembled it in whole at
-/// its point, unfactorised, and the model's slack set it was assembled for: the step's later
-/// pieces and engagement rounds (the same point, a few cables switched) assemble again only
-/// the slots those cables reach ([`Solver::reassemble_model`]), to the same bits.
-#[derive(Debug, Clone, Default)]
-pub(super) struct KeptAssembly {
-    /// The assembled blocks (the band's storage).
-    pub(super) storage: Vec<Block>,
-    /// `factor_slack` as assembled.
-    slack: Vec<bool>,
-    /// Slots to assemble again, listed once each.
-    dirty: Vec<bool>,
-    slots: Vec<usize>,
-}
-
-impl KeptAssembly {
-    pub(super) fn new(s: &Structure) -> Self {
-        let slots = s.nominal.blocks() * (s.bandwidth() + 1);
-        Self {
-            storage: vec![[[0.0; 3]; 3]; slots],
-            slack: vec![false; s.members.len()],
-            dirty: vec![false; slots],
-            slots: Vec::with_capacity(slots),
-        }
-    }
-}
 
 /// What a model step produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -433,15 +404,19 @@ impl Solver {
     pub(super) fn assemble_model_keeping(&mut self, keep: bool) {
         let s = &*self.structure;
         s.begin_assembly(&mut self.factor.k);
-        for m in 0..s.members.len() {
-            let block = self.model_block(m);
-            s.add_block(&mut self.factor.k, &s.members[m].link, &block);
+        for (m, (c, st)) in s.members.iter().zip(&self.work.states).enumerate() {
+            let stiffness = self.model_stiffness(m).unwrap_or(st.stiffness);
+            s.add_block(
+                &mut self.factor.k,
+                &c.link,
+                &st.tangent_block_with(stiffness),
+            );
         }
         s.set_identity_rows(&mut self.factor.k);
         if keep {
-            let kept = &mut self.factor.kept;
-            kept.storage.copy_from_slice(self.factor.k.storage_mut());
-            kept.slack.copy_from_slice(&self.factor.factor_slack);
+            self.factor
+                .kept
+                .keep(&mut self.factor.k, &self.factor.factor_slack);
         }
     }
 
@@ -461,29 +436,10 @@ impl Solver {
     /// in the same order, of the same blocks.
     pub(super) fn reassemble_model(&mut self) {
         let mut kept = std::mem::take(&mut self.factor.kept);
-        let s = &*self.structure;
-        for (m, (was, now)) in kept
-            .slack
-            .iter_mut()
-            .zip(&self.factor.factor_slack)
-            .enumerate()
-        {
-            if was != now {
-                *was = *now;
-                for &slot in &s.members[m].link.slots {
-                    if slot != NONE_SLOT && !kept.dirty[slot] {
-                        kept.dirty[slot] = true;
-                        kept.slots.push(slot);
-                    }
-                }
-            }
-        }
-        s.reassemble_slots(&mut kept.storage, &kept.slots, |m| self.model_block(m));
-        for &slot in &kept.slots {
-            kept.dirty[slot] = false;
-        }
-        kept.slots.clear();
-        self.factor.k.storage_mut().copy_from_slice(&kept.storage);
+        kept.reassemble(&self.structure, &self.factor.factor_slack, |m| {
+            self.model_block(m)
+        });
+        kept.copy_into(&mut self.factor.k);
         self.factor.kept = kept;
     }
 

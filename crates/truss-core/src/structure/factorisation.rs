@@ -5,7 +5,7 @@
 //! directions masked).
 
 use super::compiled::Structure;
-use super::parts::{Link, NONE};
+use super::parts::{Link, NONE, Role};
 use crate::ModelError;
 use crate::block::{Block, BlockBandMatrix};
 
@@ -101,17 +101,6 @@ impl Structure {
             storage[slot][d][d] = 1.0;
         }
     }
-}
-
-/// Which of a link's three slots (see [`Link::slots`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Role {
-    /// Node `i`'s diagonal block.
-    Ii,
-    /// Node `j`'s diagonal block.
-    Jj,
-    /// The coupling block.
-    Ij,
 }
 
 /// [`Structure::add_block`]'s part for one slot of link `c`: the first element to reach it

@@ -9,6 +9,17 @@ pub(crate) const FIXED: u32 = u32::MAX;
 /// Marks an assembly target that does not exist (a fully fixed node).
 pub(crate) const NONE: usize = usize::MAX;
 
+/// Which of a link's three slots (see [`Link::slots`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Role {
+    /// Node `i`'s diagonal block.
+    Ii,
+    /// Node `j`'s diagonal block.
+    Jj,
+    /// The coupling block.
+    Ij,
+}
+
 /// One member, compiled.
 #[derive(Debug, Clone)]
 pub(crate) struct CompiledMember {

@@ -3,8 +3,7 @@
 //! so that assembling needs no clearing, and only the slots of the band that no member
 //! reaches are zeroed before each assembly.
 
-use super::factorisation::Role;
-use super::parts::{CompiledMember, NONE};
+use super::parts::{CompiledMember, NONE, Role};
 use crate::block::BlockBandMatrix;
 
 /// Marks, in each member's link, the slots it is the first to reach, and returns the slots
