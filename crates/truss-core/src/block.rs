@@ -410,7 +410,10 @@ type Columns = [[f64; 4]; 3];
 /// valgrind 3.19 cannot decode (`scripts/bench-instructions.sh` then fails), and with a copy
 /// of the third row the factorisation of the 300-stage prism cost 3 % more instructions.
 #[inline(always)]
-#[allow(clippy::eq_op, reason = "b₂ − b₂ is the padding, on purpose: see the doc")]
+#[allow(
+    clippy::eq_op,
+    reason = "b₂ − b₂ is the padding, on purpose: see the doc"
+)]
 fn columns(b: &Block) -> Columns {
     std::array::from_fn(|c| [b[0][c], b[1][c], b[2][c], b[2][c] - b[2][c]])
 }
