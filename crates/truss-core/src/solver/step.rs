@@ -404,13 +404,9 @@ impl Solver {
     pub(super) fn assemble_model_keeping(&mut self, keep: bool) {
         let s = &*self.structure;
         s.begin_assembly(&mut self.factor.k);
-        for (m, (c, st)) in s.members.iter().zip(&self.work.states).enumerate() {
-            let stiffness = self.model_stiffness(m).unwrap_or(st.stiffness);
-            s.add_block(
-                &mut self.factor.k,
-                &c.link,
-                &st.tangent_block_with(stiffness),
-            );
+        for (m, c) in s.members.iter().enumerate() {
+            let block = self.model_block(m);
+            s.add_block(&mut self.factor.k, &c.link, &block);
         }
         s.set_identity_rows(&mut self.factor.k);
         if keep {

@@ -53,12 +53,12 @@ impl Structure {
         let joints = joints::compile_joints(model);
         let loads = numbering.loads(model);
         let mut k = numbering.matrix;
-        let untouched = sparsity::mark_first_writers(&mut members, &k);
         let writers = sparsity::slot_writers(
             &members,
             &numbering.identity_rows,
             k.blocks() * (k.bandwidth() + 1),
         );
+        let untouched = sparsity::mark_first_writers(&mut members, &writers, &k);
         let mut structure = Self {
             node_ids: nodes.iter().map(|n| n.id.clone()).collect(),
             node_xyz: nodes.iter().map(|n| n.xyz).collect(),

@@ -6,25 +6,30 @@
 use super::parts::{CompiledMember, NONE, Role};
 use crate::block::BlockBandMatrix;
 
-/// Marks, in each member's link, the slots it is the first to reach, and returns the slots
-/// of `k`'s band (within it, not its padding) that no member reaches.
+/// Marks, in each member's link, the slots it is the first to reach (the head of each
+/// slot's `writers`), and returns the slots of `k`'s band (within it, not its padding) that
+/// no member reaches.
 pub(super) fn mark_first_writers(
     members: &mut [CompiledMember],
+    writers: &SlotWriters,
     k: &BlockBandMatrix,
 ) -> Vec<usize> {
-    let mut touched = vec![false; k.blocks() * (k.bandwidth() + 1)];
-    for link in members.iter_mut().map(|c| &mut c.link) {
-        for (first, &slot) in link.first.iter_mut().zip(&link.slots) {
-            if slot != NONE && !touched[slot] {
-                touched[slot] = true;
-                *first = true;
-            }
+    let reaching = |slot: usize| {
+        let (from, to) = (
+            writers.start[slot] as usize,
+            writers.start[slot + 1] as usize,
+        );
+        &writers.members[from..to]
+    };
+    for slot in 0..writers.start.len() - 1 {
+        if let Some(&(m, role)) = reaching(slot).first() {
+            members[m as usize].link.first[role as usize] = true;
         }
     }
     (0..k.blocks())
         .flat_map(|i| (i.saturating_sub(k.bandwidth())..=i).map(move |j| (i, j)))
         .map(|(i, j)| k.slot(i, j))
-        .filter(|&slot| !touched[slot])
+        .filter(|&slot| reaching(slot).is_empty())
         .collect()
 }
 
