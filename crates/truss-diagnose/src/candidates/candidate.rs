@@ -60,6 +60,13 @@ pub trait Candidate: Send + Sync {
     }
     /// What a direct measurement of the hardware shows of the effect.
     fn trace(&self) -> Trace;
+    /// Whether the effect puts the joints in free play: ℓ then has a kink wherever a
+    /// sample's contact state changes, on the scale of its own standard error, and a fit
+    /// measures its curvature on a longer scale ([`crate::likelihood::fit`], a rough
+    /// likelihood). The default: where the trace is the joints' play.
+    fn free_play(&self) -> bool {
+        self.trace() == Trace::JointPlay
+    }
     /// The measurement that tells this effect from a rival whose trace is `rival`, where
     /// this effect knows one.
     fn separated_from(&self, _rival: Trace) -> Option<&'static str> {

@@ -96,6 +96,10 @@ impl Candidate for Combined<'_> {
     fn trace(&self) -> Trace {
         self.parts[0].trace()
     }
+    /// Whether any part puts the joints in free play.
+    fn free_play(&self) -> bool {
+        self.parts.iter().any(|c| c.free_play())
+    }
 }
 
 /// A joint fit of a model's effects.
@@ -138,6 +142,7 @@ pub(crate) fn joint_fit(
         steps,
         curvature: true,
         clusters: Some(&clusters),
+        rough: ev.rough(&combined),
     };
     let fit = maximise(&start, options, &|t| project(t, None), &mut objective)?;
     let n = ev.measured.n();

@@ -174,6 +174,7 @@ impl Profiler<'_, '_, '_> {
                 steps: Some(&steps),
                 curvature: false,
                 clusters: None,
+                rough: false,
             },
             &sub_project,
             &mut sub_f,

@@ -239,6 +239,13 @@ impl Evaluator<'_> {
         Ok(terms)
     }
 
+    /// Whether ℓ with candidate `c` applied to the current model is rough on the scale of
+    /// its standard error: the model's joints have free play (clearances in the case), or
+    /// `c` gives them some ([`Candidate::free_play`]; [`crate::likelihood::fit`]).
+    pub fn rough(&self, c: &dyn Candidate) -> bool {
+        self.start.case.backlash.is_some() || c.free_play()
+    }
+
     /// The terms of ℓ: each specimen's, then each member observation's.
     /// With member measurements, each specimen's node term is conditioned on its own
     /// measured members ([`crate::likelihood::conditional`]).
@@ -460,6 +467,7 @@ pub(crate) fn fit_candidate(ev: &Evaluator, c: &dyn Candidate, test: &Test) -> F
     let clusters = ev.measured.clusters();
     let options = Options {
         clusters: Some(&clusters),
+        rough: ev.rough(c),
         ..Options::default()
     };
     let fit = maximise(&start, options, &|t| project(t, None), &mut counted);
@@ -531,6 +539,7 @@ pub(crate) fn profile_candidate(
                 steps: Some(&fit.steps),
                 curvature: true,
                 clusters: Some(&clusters),
+                rough: ev.rough(c),
             };
             maximise(t, options, &|t| project(t, None), objective)
         },
