@@ -363,13 +363,13 @@ fn pairwise_inconsistent(a: &DMatrix<f64>) -> bool {
 /// `A = −H` and `B` at the maximum `t` from the derivatives `d` measured there; where that
 /// `A` is not positive definite and a pair of its entries is inconsistent
 /// ([`pairwise_inconsistent`]), measured again at steps [`LONGER_STEPS`] times longer, the
-/// first positive definite one kept (module doc), else `d`'s.
-#[allow(clippy::too_many_arguments)]
+/// first positive definite one kept (module doc), else `d`'s. `measured_at`: the steps `d`
+/// was measured at where they are not `d.steps` (a rough fit's, [`smoothing_steps`]).
 fn curvature_at_maximum(
     t: &[f64],
     terms: &Terms,
     d: Derivatives,
-    measured_at: &[f64],
+    measured_at: Option<&[f64]>,
     clusters: Option<&[usize]>,
     f: &mut Objective,
     evaluations: &mut usize,
@@ -379,7 +379,11 @@ fn curvature_at_maximum(
         return Ok((a, d.variability));
     }
     for factor in LONGER_STEPS {
-        let longer: Vec<f64> = measured_at.iter().map(|h| h * factor).collect();
+        let longer: Vec<f64> = measured_at
+            .unwrap_or(&d.steps)
+            .iter()
+            .map(|h| h * factor)
+            .collect();
         let again = derivatives_at_steps(t, terms, &longer, clusters, f, evaluations)?;
         let a_again = -&again.hessian;
         if nalgebra::Cholesky::new(a_again.clone()).is_some() {
@@ -409,7 +413,7 @@ pub fn maximise(
     let mut iterations = 0;
     // The model that decides the maximum: all finite differences, at `SMOOTHING` standard
     // errors where ℓ is rough (its steps are reported as the adapted ones); `measured_at`:
-    // the steps it was last measured at.
+    // the steps a rough fit's was last measured at.
     let mut measured_at: Vec<f64> = Vec::new();
     let mut measure = |t: &[f64],
                        terms: &Terms,
@@ -419,9 +423,7 @@ pub fn maximise(
                        evaluations: &mut usize|
      -> Result<Derivatives, DiagnoseError> {
         if !options.rough {
-            let d = derivatives(t, terms, steps, options.clusters, f, evaluations)?;
-            measured_at.clone_from(&d.steps);
-            return Ok(d);
+            return derivatives(t, terms, steps, options.clusters, f, evaluations);
         }
         measured_at = smoothing_steps(steps, h);
         let mut d = derivatives_at_steps(t, terms, &measured_at, options.clusters, f, evaluations)?;
@@ -506,14 +508,12 @@ pub fn maximise(
     }
     let (curvature, variability) = if options.curvature {
         steps.clone_from(&d.steps);
-        if measured_at.is_empty() {
-            measured_at.clone_from(&d.steps);
-        }
+        let smoothed = options.rough.then_some(measured_at.as_slice());
         curvature_at_maximum(
             &t,
             &terms,
             d,
-            &measured_at,
+            smoothed,
             options.clusters,
             f,
             &mut evaluations,
@@ -611,16 +611,8 @@ mod tests {
         assert_eq!(d.steps, [se, se]);
         let correlation = |a: &DMatrix<f64>| a[(0, 1)] / (a[(0, 0)] * a[(1, 1)]).sqrt();
         assert!((correlation(&a) - 2.0).abs() < 1e-9, "{a}");
-        let (a, _) = curvature_at_maximum(
-            &t,
-            &terms,
-            d.clone(),
-            &d.steps,
-            None,
-            &mut f,
-            &mut evaluations,
-        )
-        .unwrap();
+        let (a, _) =
+            curvature_at_maximum(&t, &terms, d, None, None, &mut f, &mut evaluations).unwrap();
         assert!(nalgebra::Cholesky::new(a.clone()).is_some(), "{a}");
         for i in 0..2 {
             assert!((a[(i, i)] * se * se - 1.0).abs() < 1e-9, "{a}");
@@ -652,16 +644,8 @@ mod tests {
         assert!(nalgebra::Cholesky::new(measured.clone()).is_none());
         assert!(!pairwise_inconsistent(&measured), "{measured}");
         let before = evaluations;
-        let (a, _) = curvature_at_maximum(
-            &t,
-            &terms,
-            d.clone(),
-            &d.steps,
-            None,
-            &mut f,
-            &mut evaluations,
-        )
-        .unwrap();
+        let (a, _) =
+            curvature_at_maximum(&t, &terms, d, None, None, &mut f, &mut evaluations).unwrap();
         assert_eq!(a, measured);
         assert_eq!(evaluations, before);
     }
