@@ -799,6 +799,7 @@ mod tests {
             fit.iterations
         );
     }
+
     /// A rough likelihood: ℓ = −(t − m)²/(2s²) plus a triangle wave of amplitude 0.3 and
     /// period 0.37·s (a kink wherever the wave turns, as a sample's contact state switches
     /// with a clearance). Hand derivation: the wave adds at most 4·0.3 = 1.2 to a central
