@@ -56,7 +56,7 @@
 //! to 5 (the battens' scatter 3.7, 4.3 and 18.5 µm wide). Measured again at those three
 //! points, each with steps adapted from a different start (0.02, 0.004, 0.0005), `A` was
 //! not positive definite at two of them; at four standard errors along each axis the widths
-//! agreed within 7 % (the clearance's 0.200, 0.201 and 0.204 µm, the battens' scatter 1.82,
+//! agreed within 8 % (the clearance's 0.200, 0.201 and 0.204 µm, the battens' scatter 1.82,
 //! 1.78 and 1.85 µm). So in a rough fit the model that decides the maximum (each full
 //! measurement of the quasi-Newton scheme above) and `A` there are measured at
 //! [`SMOOTHING`] = 4 standard errors along each axis, `4/√(−Hᵢᵢ)` from the latest model
