@@ -240,10 +240,13 @@ impl Evaluator<'_> {
     }
 
     /// Whether ℓ with candidate `c` applied to the current model is rough on the scale of
-    /// its standard error: the model's joints have free play (clearances in the case), or
-    /// `c` gives them some ([`Candidate::free_play`]; [`crate::likelihood::fit`]).
+    /// its standard error: the model's joints have free play (the baseline's model has pin
+    /// joints, or the current case gives it clearances), or `c` gives them some
+    /// ([`Candidate::free_play`]; [`crate::likelihood::fit`]).
     pub fn rough(&self, c: &dyn Candidate) -> bool {
-        self.start.case.backlash.is_some() || c.free_play()
+        !self.baseline.model().joints().is_empty()
+            || self.start.case.backlash.is_some()
+            || c.free_play()
     }
 
     /// The terms of ℓ: each specimen's, then each member observation's.
@@ -693,6 +696,71 @@ impl CandidateScore {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Which fits are rough: a length bias on a rigid baseline is not; the backlash
+    /// candidate on it is; any candidate on a baseline whose model has pin joints is
+    /// (section 4.2.3's backlash case), as on a rigid one given clearances by an earlier
+    /// step. No simulation is run.
+    #[test]
+    fn fits_with_joints_in_free_play_are_rough() {
+        let job =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../jobs/paper-4.2.3.json");
+        // Data only to make an evaluator with: five specimens of the rigid case.
+        let dir = tempfile::tempdir().unwrap();
+        let nodes = dir.path().join("nodes.csv");
+        let mut csv = Vec::new();
+        crate::synth::synth(
+            &crate::synth::SynthOptions {
+                job: job.clone(),
+                case: "rigid-sigma-0.033".into(),
+                specimens: 5,
+                seed: 1,
+                effect: "none".into(),
+                measurement_sigma: 0.001,
+                all_nodes: false,
+                members_out: None,
+            },
+            &mut csv,
+        )
+        .unwrap();
+        std::fs::write(&nodes, csv).unwrap();
+        let rigid = Baseline::read(&job, "rigid-sigma-0.033").unwrap();
+        let measured = crate::comparison::measured::read(rigid.model(), &nodes, None, 5).unwrap();
+        let gauge = GaugeNoise::new(0, &measured);
+        let verdicts = |case: &str| {
+            let baseline = Baseline::read(&job, case).unwrap();
+            let (library, _) = crate::candidates::library_for(&baseline, false);
+            let ev = Evaluator {
+                baseline: &baseline,
+                start: baseline.derived_case(),
+                measured: &measured,
+                samples: 0,
+                sigma_m: 0.001,
+                condition: false,
+                threads: 1,
+                simulations: Default::default(),
+                memo: None,
+                gauge: &gauge,
+            };
+            let pick = |name: &str| library.iter().find(|c| c.name() == name);
+            let bias = pick("length_bias").expect("a length bias applies to both");
+            let backlash = pick("backlash");
+            // Rough at the start; for the backlash candidate; for a length bias once an
+            // earlier step has given the model clearances.
+            let later = backlash.map(|c| ev.edit(c.as_ref(), &[0.01]).unwrap());
+            (
+                ev.rough(bias.as_ref()),
+                backlash.map(|c| ev.rough(c.as_ref())),
+                later.map(|start| Evaluator { start, ..ev }.rough(bias.as_ref())),
+            )
+        };
+        assert_eq!(
+            verdicts("rigid-sigma-0.033"),
+            (false, Some(true), Some(true))
+        );
+        // With joints already, the backlash candidate does not apply.
+        assert_eq!(verdicts("backlash-sigma-0.033"), (true, None, None));
+    }
 
     /// A fit at `x` with ℓ = `l` (one parameter), as a profile's tests need it.
     fn fit_at(x: f64, l: f64) -> Fit {
