@@ -34,6 +34,9 @@ pub struct Structure {
     pub(crate) untouched: Vec<usize>,
     /// Each slot's members in assembly order, for assembling a few slots again.
     pub(crate) writers: super::sparsity::SlotWriters,
+    /// The one-sided members with the lowest row each reaches, in the order of that row
+    /// (then of the member): those a direction zero above a row can move.
+    pub(crate) one_sided_by_row: Vec<(usize, usize)>,
     /// External load per row (plus the zero slot) \[N\].
     pub(crate) loads: Vec<f64>,
     /// `K₀`, factorised.

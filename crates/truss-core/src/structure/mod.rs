@@ -16,8 +16,8 @@
 //!    member with joints at its ends becomes two one-sided members in parallel, its
 //!    tension-only half in the member's own place and its compression-only half after all
 //!    the model's members;
-//! 3. **sparsity** (`sparsity.rs`): which member first writes each block of the band, and
-//!    which blocks none reaches;
+//! 3. **sparsity** (`sparsity.rs`): which member first writes each block of the band,
+//!    which blocks none reaches, and the lowest row each one-sided member reaches;
 //! 4. **factorisation** (`factorisation.rs`): `K₀` assembled and factorised; then
 //!    (`framing.rs`) the working compression ratio of the cables of ratio 0, from whether the
 //!    bars frame the top surface's tilt (what the ratios stand for: [`crate::limit`]);
@@ -59,6 +59,7 @@ impl Structure {
             k.blocks() * (k.bandwidth() + 1),
         );
         let untouched = sparsity::mark_first_writers(&mut members, &writers, &k);
+        let one_sided_by_row = sparsity::one_sided_by_lowest_row(&members, numbering.free);
         let mut structure = Self {
             node_ids: nodes.iter().map(|n| n.id.clone()).collect(),
             node_xyz: nodes.iter().map(|n| n.xyz).collect(),
@@ -72,6 +73,7 @@ impl Structure {
             identity_rows: numbering.identity_rows,
             untouched,
             writers,
+            one_sided_by_row,
             loads,
             nominal: crate::block::BlockBandMatrix::new(0, 0),
             basis: None,

@@ -80,3 +80,25 @@ pub(super) fn slot_writers(
         identity,
     }
 }
+
+/// The one-sided members (cables and the halves of members in clearance holes), each with the
+/// lowest row it reaches (`usize::MAX` for one that reaches none), in the order of that row,
+/// then of the member: a direction that is zero above row `i` (a failed pivot's, see
+/// [`BlockBandMatrix::failed_pivot_direction`]) moves only the prefix whose row is at most
+/// `i`, and only those can engage along it.
+pub(super) fn one_sided_by_lowest_row(
+    members: &[CompiledMember],
+    free: usize,
+) -> Vec<(usize, usize)> {
+    let mut list: Vec<(usize, usize)> = members
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.is_cable)
+        .map(|(m, c)| {
+            let lowest = c.link.dofs.iter().copied().filter(|&d| d < free).min();
+            (lowest.unwrap_or(usize::MAX), m)
+        })
+        .collect();
+    list.sort_unstable();
+    list
+}

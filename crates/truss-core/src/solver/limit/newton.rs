@@ -164,7 +164,7 @@ impl Solver {
                             .k
                             .failed_pivot_direction(failure.index, &mut self.work.scratch);
                         self.work.scratch[n] = 0.0;
-                        if let Some(m) = self.first_to_engage(f64::INFINITY) {
+                        if let Some(m) = self.first_to_engage(f64::INFINITY, failure.index) {
                             self.factor.factor_slack[m] = false;
                             locked[m] = true;
                             any = true;
