@@ -90,11 +90,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "ca2fc0bed8a566a6d94802440660f06dba9bef28dded83b4434bc05266272c0e",
+        "ee8665220c5639c9556fd4e3517c9993621d6a54b3792712d17c4b8519f9102d",
         "94ce944399e4677c5705bde025cc92a70f975a9f2ab7c855a7e8f13ecf665d24",
         "546cf9d696c4c41815489fa90b763f7db5a7158a8fe8896316e035a3f1ee86a1",
         "7b94c46945c2820f627e0bdcc5aa42e331a0f6fe76f9a1cbbfa384b72441d183",
-        "978c87100c69c403af4bd7862dcbfcef14193fe23d707c09c5c3ff549e625ca7",
+        "be9f4523c00f21a5a02b828af928e7dc438140d02c34ca07bc7e99d3e9d28b42",
     ];
     for (what, (g, w)) in [
         "job id",

@@ -146,7 +146,7 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "a3d090067f7e7348d49477059da0a678ff4d5b57b8f06ee6a8ced901e10006d5"
+        "1e0fed11f138820b3ef0a7a88a5960a41b440397c07a863e393bac6b8340f543"
     );
     assert_eq!(
         digest,
@@ -221,17 +221,19 @@ fn a_node_held_by_slack_diagonals_alone_is_not_a_mechanism() {
 
 /// The 300-stage prism with pin joints in free play (σ = 6.3 µm, diagonals U[−3σ, 0],
 /// clearances U[0.004, 0.017] mm: the job of the README's figures, as
-/// `scripts/bench-instructions.sh`'s `tall-backlash` but for its case's name), sample 2:
-/// Newton at the continuation's first ratio does not converge from the linearised start (the out-of-balance force stalls at 1e-3 N after 120 iterations: many
-/// panels rack at once), so the anchor is reached from a stiffer one and the stages that
-/// stall are bridged by smaller steps of the ratio (`continue_down`). Before, this sample
-/// failed (out-of-balance force 1.3e-7 N, the line search stuck); now it converges at the
-/// limit, floating in its joints' clearances. (About 10 s in release.)
+/// `scripts/bench-instructions.sh`'s `tall-backlash` but for its case's name), sample 9:
+/// Newton at the continuation's first ratio does not converge from the linearised start
+/// (the out-of-balance force stalls at 2e-3 N after 120 iterations: many panels rack at
+/// once), so the anchor is reached from a stiffer one and the stages that stall are bridged
+/// by smaller steps of the ratio (`continue_down`); it converges at the limit, floating in
+/// its joints' clearances. (Sample 2, which this test solved when it was written, reaches
+/// its anchor directly today; of the first 12 samples, 0, 1, 6, 9 and 11 fall back.)
+/// About 2 s in release.
 #[test]
 #[ignore = "slow: a 300-stage solve at the limit (run in release with --ignored)"]
 fn a_tall_truss_in_free_play_reaches_the_limit_where_tenfold_stages_stall() {
     let job = Job::from_json(&tall_free_play_job(), Path::new(".")).unwrap();
-    let line = mc_shard::reproduce::reproduce(&job, 0, 2, false);
+    let line = mc_shard::reproduce::reproduce(&job, 0, 9, false);
     let v: serde_json::Value = serde_json::from_str(&line).unwrap();
     assert_eq!(v["status"], "converged", "{line}");
     assert_eq!(v["floating"], true, "{line}");

@@ -87,7 +87,10 @@ const LAST_RATIO: f64 = 1e-12;
 
 impl Solver {
     /// Step 1 of the module doc at `ratio`: the linearised start from rest, then Newton
-    /// there (the start's factorisations counted even where Newton fails).
+    /// there. Where Newton fails, the work it did is counted all the same (the start's
+    /// factorisations, and the iterations of a Newton that did not converge), as
+    /// [`Solver::continue_down`] counts its failed steps: a sample's iterations are all the
+    /// linear solves it took, on the path it ended on or not.
     async fn anchor_at(
         &mut self,
         ratio: f64,
@@ -100,7 +103,15 @@ impl Solver {
         self.linearised_from_rest(&mut start_factorisations, kernels)
             .await;
         counts.factorisations += start_factorisations;
-        let r = self.newton_warm(kernels).await?;
+        let r = match self.newton_warm(kernels).await {
+            Ok(r) => r,
+            Err(e) => {
+                if let SolveError::NotConverged { iterations, .. } = e {
+                    counts.iterations += iterations;
+                }
+                return Err(e);
+            }
+        };
         counts.iterations += r.iterations;
         counts.factorisations += r.factorisations;
         Ok(())
@@ -258,5 +269,65 @@ impl Solver {
             holding_force: self.holding.map(|h| h.force),
             limit_ratio,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::SolveOptions;
+    use crate::prism::{BacklashOptions, PrismOptions};
+    use crate::solver::Perturbation;
+    use crate::solver::lanes::finish;
+
+    /// An anchor whose Newton does not converge (here: allowed one iteration, from the
+    /// linearised start of the paper's 5-stage truss with pin joints in free play and
+    /// shortened diagonals) counts its iterations in the solve's all the same, as a failed
+    /// step of `continue_down` does: before, the 300-stage prism with free play fell back
+    /// from such an anchor after 120 iterations that its line did not count.
+    #[test]
+    fn a_failed_anchor_counts_its_iterations() {
+        let model = PrismOptions {
+            backlash: Some(BacklashOptions {
+                clearance: 0.0105,
+                ..BacklashOptions::default()
+            }),
+            ..PrismOptions::with_stages(5)
+        }
+        .model()
+        .unwrap();
+        let options = SolveOptions {
+            max_iterations: 1,
+            ..SolveOptions::default()
+        };
+        let mut solver = Solver::new(&model, options).unwrap();
+        assert!(solver.structure.near_the_limit());
+        let errors: Vec<f64> = model
+            .members()
+            .iter()
+            .enumerate()
+            .map(|(m, member)| {
+                let e = 0.0067 * (((m * 7919) % 13) as f64 / 6.0 - 1.0);
+                if member.id.starts_with("diagonal") {
+                    -0.01 - 0.5 * e.abs()
+                } else {
+                    e
+                }
+            })
+            .collect();
+        solver
+            .set_sample(Perturbation {
+                length_errors: &errors,
+                ..Perturbation::default()
+            })
+            .unwrap();
+        let mut counts = Counts::default();
+        let result = finish(solver.anchor_at(FIRST_RATIO, &mut counts, Kernels::OneSample));
+        let Err(SolveError::NotConverged { iterations, .. }) = result else {
+            panic!("one iteration should not converge: {result:?}");
+        };
+        assert!(iterations >= 1);
+        assert_eq!(counts.iterations, iterations);
+        assert!(counts.factorisations >= 1);
     }
 }
