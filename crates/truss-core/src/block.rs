@@ -126,6 +126,12 @@ impl BlockBandMatrix {
         (&self.a, &self.inv_diag)
     }
 
+    /// Each block row's original diagonal, as the last factorisation read it (the pivots'
+    /// tolerance is relative to it).
+    pub(crate) fn original_diagonal(&self) -> &[[f64; 3]] {
+        &self.diag
+    }
+
     /// Installs a factor computed elsewhere (the batched factorisation, bit for bit
     /// [`BlockBandMatrix::factor_collecting`]'s): `fill` writes the blocks, each row's
     /// original diagonal and the inverse pivots; the matrix is then factorised unless some
@@ -180,8 +186,14 @@ impl BlockBandMatrix {
 
     /// Multiplies every diagonal entry by `factor` (a Levenberg shift `1 + μ`).
     pub fn scale_diagonal(&mut self, factor: f64) {
+        self.scale_diagonal_from(0, factor);
+    }
+
+    /// Multiplies the diagonal entries of block rows `from ..` by `factor` (rows assembled
+    /// again before [`BlockBandMatrix::refactor_collecting`]).
+    pub fn scale_diagonal_from(&mut self, from: usize, factor: f64) {
         let w = self.q + 1;
-        for i in 0..self.nb {
+        for i in from..self.nb {
             let d = &mut self.a[i * w + self.q];
             for (k, row) in d.iter_mut().enumerate() {
                 row[k] *= factor;
@@ -239,27 +251,65 @@ impl BlockBandMatrix {
     /// first); stops at the `max`-th. The matrix counts as factorised only if none failed;
     /// after failures, [`BlockBandMatrix::failed_pivot_direction`] works for each of them.
     pub fn factor_collecting(&mut self, failures: &mut Vec<PivotFailure>, max: usize) {
-        self.factor_collecting_with(arch(), failures, max);
+        self.factor_collecting_with(arch(), 0, failures, max);
     }
 
-    /// [`BlockBandMatrix::factor_collecting`] with the kernels compiled for `arch`: the same
-    /// bits with any.
-    fn factor_collecting_with(
+    /// [`BlockBandMatrix::factor_collecting`] again after only block rows `from ..` were
+    /// assembled again (each written whole, as an assembly writes it, into the storage of
+    /// the last factorisation, whose rows before `from` are kept): those rows are
+    /// factorised, the others' factor and inverse pivots kept, and of `failures` (on entry,
+    /// the last factorisation's) those before row `from` are kept and the later ones found
+    /// again. Row `i` of the factor depends only on rows `..= i` of the matrix, so the
+    /// result is bit for bit that of factorising the whole matrix, failures included,
+    /// provided the last factorisation was of this matrix's rows before `from` with the same
+    /// pivot tolerance, and was made by `factor_collecting` or this.
+    ///
+    /// (Where the last factorisation stopped at its `max`-th failure before `from`, so would
+    /// the whole one: the rows it left are the matrix's, as assembled, in both.)
+    pub fn refactor_collecting(
         &mut self,
-        arch: pulp::Arch,
+        from: usize,
         failures: &mut Vec<PivotFailure>,
         max: usize,
     ) {
-        failures.clear();
+        self.factor_collecting_with(arch(), from, failures, max);
+    }
+
+    /// [`BlockBandMatrix::factor_collecting`] with the kernels compiled for `arch`, from
+    /// block row `from` (see [`BlockBandMatrix::refactor_collecting`]; 0: the whole
+    /// matrix): the same bits with any.
+    fn factor_collecting_with(
+        &mut self,
+        arch: pulp::Arch,
+        from: usize,
+        failures: &mut Vec<PivotFailure>,
+        max: usize,
+    ) {
+        let from = from.min(self.nb);
+        let kept = failures.partition_point(|f| f.index < 3 * from);
+        failures.truncate(kept);
         self.touched();
         let q = self.q;
         let w = q + 1;
-        for (d, row) in self.diag.iter_mut().zip(self.a.chunks_exact(w)) {
+        for (d, row) in self.diag[from..]
+            .iter_mut()
+            .zip(self.a[from * w..].chunks_exact(w))
+        {
             let a = &row[q];
             *d = [a[0][0], a[1][1], a[2][2]];
         }
+        debug_assert!(
+            max >= 1 || from == 0,
+            "a refactorisation collects at least one failure"
+        );
+        if from > 0 && failures.len() >= max {
+            // The whole factorisation stops before `from` too.
+            self.factored = false;
+            return;
+        }
         let done = arch.dispatch(Factorise {
             q,
+            from,
             a: &mut self.a,
             diag: &self.diag,
             inv_diag: &mut self.inv_diag,
@@ -439,6 +489,8 @@ fn sub_mul_t(s: &mut Columns, x: &Columns, y: &Block) {
 /// instruction set).
 struct Factorise<'m> {
     q: usize,
+    /// The first block row factorised (the rows before hold their factor already).
+    from: usize,
     a: &'m mut [Block],
     diag: &'m [[f64; 3]],
     inv_diag: &'m mut [[f64; 3]],
@@ -468,7 +520,7 @@ impl pulp::WithSimd for Factorise<'_> {
             heap.resize(w, zero);
             &mut heap
         };
-        for i in 0..nb {
+        for i in self.from..nb {
             let j0 = i.saturating_sub(q);
             let first = q - (i - j0);
             let (done, from_i) = self.a.split_at_mut(i * w);
@@ -749,7 +801,7 @@ mod tests {
             for arch in [pulp::Arch::Scalar, pulp::Arch::new()] {
                 let mut fast = a.clone();
                 let mut ff = Vec::new();
-                fast.factor_collecting_with(arch, &mut ff, 2);
+                fast.factor_collecting_with(arch, 0, &mut ff, 2);
                 assert_eq!(ff, fs, "nb={nb} q={q}");
                 assert_eq!(ff.len(), if indefinite { 2 } else { 0 });
                 let rows = ff.last().map_or(nb, |f| f.index / 3 + 1);

@@ -7,6 +7,10 @@
 //! changed only for the switched cables: every slot is then the same sum, in the same order,
 //! of the same numbers, and the matrix has the bits of a whole assembly (tested against it,
 //! bit for bit, in the solver's tests). Units: stiffness entries \[N/mm\].
+//!
+//! The block rows before the first one that changed are those of the last factorisation's
+//! matrix, whose factor the matrix still holds there: the factorisation starts again at
+//! that row ([`BlockBandMatrix::refactor_collecting`]), with the same bits as a whole one.
 
 use crate::block::{Block, BlockBandMatrix};
 use crate::structure::{NONE_SLOT, Structure};
@@ -44,13 +48,15 @@ impl KeptAssembly {
     /// The kept matrix assembled again for the slack set `slack` at the same point, with
     /// `block(m)` member `m`'s six entries as [`Structure::add_block`] takes them (changed
     /// since the whole assembly only for the members whose place in `slack` changed): the
-    /// slots those members reach are summed again (see the module doc).
+    /// slots those members reach are summed again (see the module doc). Returns the first
+    /// block row that changed (the number of block rows where none did): the rows before
+    /// it are as they were.
     pub(super) fn reassemble(
         &mut self,
         s: &Structure,
         slack: &[bool],
         block: impl Fn(usize) -> [f64; 6],
-    ) {
+    ) -> usize {
         for (m, (was, now)) in self.slack.iter_mut().zip(slack).enumerate() {
             if was != now {
                 *was = *now;
@@ -63,14 +69,18 @@ impl KeptAssembly {
             }
         }
         s.reassemble_slots(&mut self.storage, &self.slots, block);
+        let mut lowest = usize::MAX;
         for &slot in &self.slots {
             self.dirty[slot] = false;
+            lowest = lowest.min(slot);
         }
         self.slots.clear();
+        (lowest / (s.bandwidth() + 1)).min(s.nominal.blocks())
     }
 
-    /// `k` = the kept matrix.
-    pub(super) fn copy_into(&self, k: &mut BlockBandMatrix) {
-        k.storage_mut().copy_from_slice(&self.storage);
+    /// Block rows `from ..` of `k` = the kept matrix's.
+    pub(super) fn copy_rows_into(&self, k: &mut BlockBandMatrix, from: usize) {
+        let at = (from * (k.bandwidth() + 1)).min(self.storage.len());
+        k.storage_mut()[at..].copy_from_slice(&self.storage[at..]);
     }
 }

@@ -115,11 +115,15 @@ pub enum Kernels<'p> {
 enum Request {
     /// The out-of-balance force and member states at a point.
     Evaluate(EvalBuffers),
-    /// A factorisation, collecting up to `max` failed pivots.
+    /// A factorisation, collecting up to `max` failed pivots, from block row `from` (the
+    /// rows before hold their factor: [`BlockBandMatrix::refactor_collecting`]). Both fit
+    /// in 32 bits (a band of at most 2³² rows), so that the request is no larger than an
+    /// evaluation's, which moves far more often.
     Factor {
         matrix: BlockBandMatrix,
         failures: Vec<PivotFailure>,
-        max: usize,
+        max: u32,
+        from: u32,
     },
     /// A solve with a factorised matrix, in place.
     Solve {
@@ -395,7 +399,8 @@ impl BatchKernels {
                         matrix,
                         failures,
                         max,
-                    } => matrix.factor_collecting(failures, *max),
+                        from,
+                    } => matrix.refactor_collecting(*from as usize, failures, *max as usize),
                     Request::Solve { matrix, rhs } => {
                         let n = matrix.size();
                         matrix.solve_in_place(&mut rhs[..n]);
@@ -435,9 +440,10 @@ impl BatchKernels {
                                     matrix,
                                     failures,
                                     max,
+                                    from,
                                 },
                             ..
-                        }) => Some((matrix, failures, *max)),
+                        }) => Some((matrix, failures, *max as usize, *from as usize)),
                         _ => None,
                     });
                 band.factor(&mut io);
@@ -626,6 +632,19 @@ impl Kernels<'_> {
         }
     }
 
+    /// Whether a factorisation again from a later block row
+    /// ([`Kernels::refactor`]) saves work for `structure`: where its factorisations run one
+    /// lane at a time (one sample at a time, or a structure above [`BATCHED_DOFS`]). In a
+    /// batch the kernel runs from the earliest row any of its lanes starts at, which is
+    /// rarely a late one, and its rows' masks cost more than that saves (the paper's Fig. 16
+    /// case: 0.6 % more instructions a sample).
+    pub(super) fn refactors_from_a_row(self, structure: &Structure) -> bool {
+        match self {
+            Kernels::OneSample => true,
+            Kernels::Lane(_) => structure.free_dofs() > BATCHED_DOFS,
+        }
+    }
+
     /// Factorises `matrix` in place, collecting up to `max` failed pivots into `failures`
     /// (see [`BlockBandMatrix::factor_collecting`]): at once, or in the batch.
     pub(super) async fn factor(
@@ -636,13 +655,31 @@ impl Kernels<'_> {
         failures: &mut Vec<PivotFailure>,
         max: usize,
     ) {
+        self.refactor(structure, key, matrix, failures, max, 0)
+            .await;
+    }
+
+    /// Factorises `matrix` in place again from block row `from`, its earlier rows holding
+    /// their factor and `failures` the last factorisation's (see
+    /// [`BlockBandMatrix::refactor_collecting`]; 0: the whole matrix, as
+    /// [`Kernels::factor`]): at once, or in the batch.
+    pub(super) async fn refactor(
+        self,
+        structure: &Arc<Structure>,
+        key: SampleKey,
+        matrix: &mut BlockBandMatrix,
+        failures: &mut Vec<PivotFailure>,
+        max: usize,
+        from: usize,
+    ) {
         match self {
-            Kernels::OneSample => matrix.factor_collecting(failures, max),
+            Kernels::OneSample => matrix.refactor_collecting(from, failures, max),
             Kernels::Lane(slot) => {
                 let request = Request::Factor {
                     matrix: std::mem::replace(matrix, BlockBandMatrix::new(0, 0)),
                     failures: std::mem::take(failures),
-                    max,
+                    max: u32::try_from(max).unwrap_or(u32::MAX),
+                    from: u32::try_from(from).unwrap_or(u32::MAX),
                 };
                 let answer = slot.ask(structure, key, request).await;
                 let (
