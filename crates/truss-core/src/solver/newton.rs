@@ -132,12 +132,13 @@ impl Solver {
     pub(super) async fn factor_tangent(&mut self, kernels: Kernels<'_>, max: usize) -> bool {
         let s = Arc::clone(&self.structure);
         kernels
-            .factor(
+            .refactor(
                 &s,
                 self.sample_key,
                 &mut self.factor.k,
                 &mut self.work.failures,
                 max,
+                0,
             )
             .await;
         self.work.failures.is_empty()

@@ -19,13 +19,7 @@ fn solver_with(seed: u64, backlash: Option<BacklashOptions>) -> (Solver, Vec<f64
     .model()
     .unwrap();
     let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
-    let mut x = seed;
-    let mut next = move || {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((x >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
-    };
+    let mut next = uniform(seed);
     let errors: Vec<f64> = (0..model.members().len()).map(|_| 0.01 * next()).collect();
     solver
         .set_sample(Perturbation {
@@ -42,6 +36,17 @@ fn solver_with(seed: u64, backlash: Option<BacklashOptions>) -> (Solver, Vec<f64
         }
     }
     (solver, u)
+}
+
+/// Numbers in [−0.5, 0.5) from a linear congruential generator seeded by `seed`.
+fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut x = seed;
+    move || {
+        x = x
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((x >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
+    }
 }
 
 /// Whether unknown `i` is a fixed direction of a partly fixed node (an identity row).
@@ -641,13 +646,7 @@ fn engagement_looks_only_at_the_members_a_failed_pivot_moves_and_finds_the_same_
         }
         None
     }
-    let mut x = 777u64;
-    let mut next = move || {
-        x = x
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((x >> 11) as f64) / ((1u64 << 53) as f64) - 0.5
-    };
+    let mut next = uniform(777);
     let mut found = 0;
     for (seed, backlash) in cases() {
         let (mut solver, u) = solver_with(seed, backlash);

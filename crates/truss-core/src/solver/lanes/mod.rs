@@ -645,24 +645,11 @@ impl Kernels<'_> {
         }
     }
 
-    /// Factorises `matrix` in place, collecting up to `max` failed pivots into `failures`
-    /// (see [`BlockBandMatrix::factor_collecting`]): at once, or in the batch.
-    pub(super) async fn factor(
-        self,
-        structure: &Arc<Structure>,
-        key: SampleKey,
-        matrix: &mut BlockBandMatrix,
-        failures: &mut Vec<PivotFailure>,
-        max: usize,
-    ) {
-        self.refactor(structure, key, matrix, failures, max, 0)
-            .await;
-    }
-
-    /// Factorises `matrix` in place again from block row `from`, its earlier rows holding
-    /// their factor and `failures` the last factorisation's (see
-    /// [`BlockBandMatrix::refactor_collecting`]; 0: the whole matrix, as
-    /// [`Kernels::factor`]): at once, or in the batch.
+    /// Factorises `matrix` in place from block row `from`, collecting up to `max` failed
+    /// pivots into `failures`: 0, the whole matrix (see
+    /// [`BlockBandMatrix::factor_collecting`]); later, its earlier rows holding their
+    /// factor and `failures` the last factorisation's (see
+    /// [`BlockBandMatrix::refactor_collecting`]). At once, or in the batch.
     pub(super) async fn refactor(
         self,
         structure: &Arc<Structure>,
