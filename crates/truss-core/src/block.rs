@@ -126,12 +126,6 @@ impl BlockBandMatrix {
         (&self.a, &self.inv_diag)
     }
 
-    /// Each block row's original diagonal, as the last factorisation read it (the pivots'
-    /// tolerance is relative to it).
-    pub(crate) fn original_diagonal(&self) -> &[[f64; 3]] {
-        &self.diag
-    }
-
     /// Installs a factor computed elsewhere (the batched factorisation, bit for bit
     /// [`BlockBandMatrix::factor_collecting`]'s): `fill` writes the blocks, each row's
     /// original diagonal and the inverse pivots; the matrix is then factorised unless some
@@ -819,6 +813,69 @@ mod tests {
                 assert_eq!(fast.inv_diag[..rows], slow.inv_diag[..rows]);
             }
         }
+    }
+
+    /// A factorisation again from a block row, after only the rows from there on changed
+    /// ([`BlockBandMatrix::refactor_collecting`]), against factorising the changed matrix
+    /// whole: the same factor, inverse pivots (up to where it stopped), original diagonals
+    /// and failed pivots, bit for bit, with both kernels. Positive definite and indefinite
+    /// matrices, collecting one failure or three (so that a factorisation stops before, at
+    /// or after the row it restarts from), restarting from the first row, a middle one, the
+    /// last and past the end. It fails if the kernel starts a row early.
+    #[test]
+    fn a_factorisation_again_from_a_row_is_the_whole_one_bit_for_bit() {
+        let (nb, q) = (9, 3);
+        let w = q + 1;
+        let mut cases = 0;
+        for (seed, negative) in [(1u64, false), (2, true), (3, true)] {
+            let indefinite = |mut m: BlockBandMatrix, at: usize| {
+                if negative {
+                    m.block_mut(at, at)[1][1] = -50.0;
+                    m.block_mut((at + 4) % nb, (at + 4) % nb)[0][0] = -50.0;
+                }
+                m
+            };
+            let before = indefinite(spd(nb, q, seed), 2);
+            for from in [0, 3, 6, 8, 12] {
+                let fresh = indefinite(spd(nb, q, seed + 100 + from as u64), 5);
+                let mut changed = before.clone();
+                let at = from.min(nb) * w;
+                changed.a[at..].copy_from_slice(&fresh.a[at..]);
+                for max in [1, 3] {
+                    for arch in [pulp::Arch::Scalar, pulp::Arch::new()] {
+                        let mut want = changed.clone();
+                        let mut want_f = Vec::new();
+                        want.factor_collecting_with(arch, 0, &mut want_f, max);
+                        let mut got = before.clone();
+                        let mut got_f = Vec::new();
+                        got.factor_collecting_with(arch, 0, &mut got_f, max);
+                        got.a[at..].copy_from_slice(&changed.a[at..]);
+                        got.factor_collecting_with(arch, from, &mut got_f, max);
+                        let what = format!("seed {seed} from {from} max {max} {arch:?}");
+                        assert_eq!(got_f, want_f, "{what}");
+                        assert_eq!(got.factored, want.factored, "{what}");
+                        let bits = |m: &BlockBandMatrix| -> Vec<u64> {
+                            m.a.as_flattened()
+                                .as_flattened()
+                                .iter()
+                                .map(|x| x.to_bits())
+                                .collect()
+                        };
+                        assert_eq!(bits(&got), bits(&want), "{what}: blocks");
+                        assert_eq!(got.diag, want.diag, "{what}: original diagonals");
+                        // Rows past a stop keep whatever inverse pivots they had: never read.
+                        let rows = if want_f.len() >= max {
+                            want_f[max - 1].index / 3 + 1
+                        } else {
+                            nb
+                        };
+                        assert_eq!(got.inv_diag[..rows], want.inv_diag[..rows], "{what}");
+                        cases += 1;
+                    }
+                }
+            }
+        }
+        assert_eq!(cases, 3 * 5 * 2 * 2);
     }
 
     /// Agrees with nalgebra's dense Cholesky solve, an independent implementation, on five

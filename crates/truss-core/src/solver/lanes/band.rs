@@ -39,15 +39,9 @@ pub(super) struct BandLanes<const W: usize> {
     records: [Vec<PivotFailure>; W],
 }
 
-/// A factorisation a lane waits for: its matrix, where its failed pivots go (on entry, the
-/// last factorisation's), how many to collect, and the first block row to factorise (see
-/// [`BlockBandMatrix::refactor_collecting`]; 0: all).
-pub(super) type FactorLane<'a> = (
-    &'a mut BlockBandMatrix,
-    &'a mut Vec<PivotFailure>,
-    usize,
-    usize,
-);
+/// A factorisation a lane waits for: its matrix, where its failed pivots go, and how many
+/// to collect (see [`BlockBandMatrix::factor_collecting`]).
+pub(super) type FactorLane<'a> = (&'a mut BlockBandMatrix, &'a mut Vec<PivotFailure>, usize);
 
 /// A solve a lane waits for: its factorised matrix and its right-hand side (the first
 /// `3·blocks` entries are solved).
@@ -76,78 +70,44 @@ impl<const W: usize> BandLanes<W> {
         }
     }
 
-    /// Factorises each lane's matrix (see the module doc), from its first row to factorise;
-    /// a lane's result is its matrix's, and its failed pivots, as
-    /// [`BlockBandMatrix::refactor_collecting`] leaves them. A lane that starts at a later
-    /// row keeps its earlier rows' factor, inverse pivots and original diagonals (gathered
-    /// with the matrix, and left alone), and the kernel runs from the earliest row any lane
-    /// starts at.
+    /// Factorises each lane's matrix (see the module doc); a lane's result is its
+    /// matrix's, and its failed pivots, as [`BlockBandMatrix::factor_collecting`] leaves
+    /// them.
     pub(super) fn factor(&mut self, lanes: &mut [Option<FactorLane<'_>>; W]) {
         let w = self.q + 1;
         let mut mask = [false; W];
         let mut tolerance = [PIVOT_TOLERANCE; W];
         let mut max = [0usize; W];
-        let mut from = [0usize; W];
-        for record in &mut self.records {
-            record.clear();
-        }
         for (l, lane) in lanes.iter().enumerate() {
-            let Some((m, failures, most, first)) = lane else {
+            let Some((m, _, most)) = lane else {
                 continue;
             };
-            let (blocks, inv) = m.factor_parts();
-            gather(&mut self.a, blocks, l);
-            let start = (*first).min(self.nb);
-            if start > 0 {
-                for (il, i) in self.inv[..start].iter_mut().zip(inv) {
-                    for k in 0..3 {
-                        il[k][l] = i[k];
-                    }
-                }
-                let kept = failures.partition_point(|f| f.index < 3 * start);
-                self.records[l].extend_from_slice(&failures[..kept]);
-            }
+            gather(&mut self.a, m.factor_parts().0, l);
             mask[l] = true;
             tolerance[l] = m.pivot_tolerance();
             max[l] = *most;
-            from[l] = start;
             self.holds[l] = None;
         }
         for (d, row) in self.diag.iter_mut().zip(self.a.chunks_exact(w)) {
             let a = &row[self.q];
             *d = [a[0][0], a[1][1], a[2][2]];
         }
-        for (l, lane) in lanes.iter().enumerate() {
-            let Some((m, ..)) = lane.as_ref().filter(|_| from[l] > 0) else {
-                continue;
-            };
-            for (dl, d) in self.diag[..from[l]].iter_mut().zip(m.original_diagonal()) {
-                for k in 0..3 {
-                    dl[k][l] = d[k];
-                }
-            }
+        for record in &mut self.records {
+            record.clear();
         }
-        let args = Factor {
+        let rows = self.arch.dispatch(Factor {
             nb: self.nb,
             q: self.q,
             mask,
-            from,
             tolerance,
             max,
             records: &mut self.records,
             a: &mut self.a,
             diag: &self.diag,
             inv: &mut self.inv,
-        };
-        // Every lane from its first row (the common case: one kernel without the rows'
-        // masks), or some from later rows.
-        let rows = if from.iter().all(|&f| f == 0) {
-            self.arch.dispatch(WholeOrFrom::<W, false>(args))
-        } else {
-            self.arch.dispatch(WholeOrFrom::<W, true>(args))
-        };
+        });
         for (l, lane) in lanes.iter_mut().enumerate() {
-            let Some((m, failures, ..)) = lane else {
+            let Some((m, failures, _)) = lane else {
                 continue;
             };
             failures.clear();
@@ -253,8 +213,6 @@ struct Factor<'k, const W: usize> {
     /// The lanes factorised: the others keep the factors they hold. A lane that has met
     /// its most failures stops after that block row, as the one-sample factorisation does.
     mask: [bool; W],
-    /// Each lane's first block row to factorise (its earlier rows hold their factor).
-    from: [usize; W],
     /// Each lane's pivot tolerance (see [`BlockBandMatrix::factor_collecting`]).
     tolerance: [f64; W],
     /// Each lane's most failures to record before it stops.
@@ -266,66 +224,28 @@ struct Factor<'k, const W: usize> {
     inv: &'k mut [[[f64; W]; 3]],
 }
 
-/// [`Factor`], compiled once with every lane from its first row (`FROM` false: no row
-/// masks) and once with lanes that start later.
-struct WholeOrFrom<'k, const W: usize, const FROM: bool>(Factor<'k, W>);
-
-impl<const W: usize, const FROM: bool> pulp::WithSimd for WholeOrFrom<'_, W, FROM> {
+impl<const W: usize> pulp::WithSimd for Factor<'_, W> {
     /// Each lane's block rows factorised (all, unless it stopped).
     type Output = [usize; W];
 
-    /// [`BlockBandMatrix::refactor_collecting`] one block row at a time, lane by lane: a
+    /// [`BlockBandMatrix::factor_collecting`] one block row at a time, lane by lane: a
     /// pivot not above its lane's tolerance times its row's diagonal is recorded and
     /// replaced by that diagonal, as the one-sample code does.
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _: S) -> [usize; W] {
-        let this = self.0;
-        this.rows::<FROM>()
-    }
-}
-
-impl<const W: usize> Factor<'_, W> {
-    /// See [`WholeOrFrom`]; `FROM` false requires every lane's `from` to be 0.
-    #[inline(always)]
-    fn rows<const FROM: bool>(self) -> [usize; W] {
         let (q, w) = (self.q, self.q + 1);
         let mut mask = self.mask;
         let mut rows = [self.nb; W];
-        let mut start = 0;
-        if FROM {
-            // A lane whose earlier rows already hold its most failures stops before its
-            // first row, as the whole factorisation would have stopped there (its rows are
-            // kept).
-            for (l, m) in mask.iter_mut().enumerate() {
-                if *m && self.from[l] > 0 && self.records[l].len() >= self.max[l] {
-                    *m = false;
-                    rows[l] = self.from[l];
-                }
-            }
-            start = (0..W)
-                .filter(|&l| mask[l])
-                .map(|l| self.from[l])
-                .min()
-                .unwrap_or(self.nb);
-        }
-        for i in start..self.nb {
+        for i in 0..self.nb {
             if !mask.iter().any(|&m| m) {
                 break;
             }
-            // The lanes that factorise this row.
-            let from_here: [bool; W];
-            let active: &[bool; W] = if FROM {
-                from_here = std::array::from_fn(|l| mask[l] && i >= self.from[l]);
-                &from_here
-            } else {
-                &mask
-            };
             let j0 = i.saturating_sub(q);
             let first = q - (i - j0);
             let (done, from_i) = self.a.split_at_mut(i * w);
             let row = &mut from_i[..w];
             for (n, row_j) in done[j0 * w..].chunks_exact(w).enumerate() {
-                off_diagonal(row, first, n, row_j, &self.inv[j0 + n], q, active);
+                off_diagonal(row, first, n, row_j, &self.inv[j0 + n], q, &mask);
             }
             let inv = diagonal(
                 row,
@@ -334,12 +254,11 @@ impl<const W: usize> Factor<'_, W> {
                 &self.diag[i],
                 &self.tolerance,
                 self.records,
-                active,
+                &mask,
             );
-            self.inv[i] = select3(active, inv, self.inv[i]);
+            self.inv[i] = select3(&mask, inv, self.inv[i]);
             for (l, m) in mask.iter_mut().enumerate() {
-                // `active[l]`, written so that the whole case's loop is the mask's alone.
-                if *m && (!FROM || i >= self.from[l]) && self.records[l].len() >= self.max[l] {
+                if *m && self.records[l].len() >= self.max[l] {
                     *m = false;
                     rows[l] = i + 1;
                 }

@@ -443,7 +443,13 @@ impl BatchKernels {
                                     from,
                                 },
                             ..
-                        }) => Some((matrix, failures, *max as usize, *from as usize)),
+                        }) => {
+                            // Batched solves never restart from a later row
+                            // (`Kernels::refactors_from_a_row`): the batched kernel
+                            // factorises whole matrices only.
+                            assert_eq!(*from, 0, "a batched factorisation restarted at a row");
+                            Some((matrix, failures, *max as usize))
+                        }
                         _ => None,
                     });
                 band.factor(&mut io);
@@ -632,12 +638,12 @@ impl Kernels<'_> {
         }
     }
 
-    /// Whether a factorisation again from a later block row
-    /// ([`Kernels::refactor`]) saves work for `structure`: where its factorisations run one
-    /// lane at a time (one sample at a time, or a structure above [`BATCHED_DOFS`]). In a
-    /// batch the kernel runs from the earliest row any of its lanes starts at, which is
-    /// rarely a late one, and its rows' masks cost more than that saves (the paper's Fig. 16
-    /// case: 0.6 % more instructions a sample).
+    /// Whether a factorisation of `structure` may start again from a later block row
+    /// ([`Kernels::refactor`]): where its factorisations run one lane at a time (one sample
+    /// at a time, or a structure above [`BATCHED_DOFS`]). The batched kernel factorises
+    /// whole matrices only: a version that started each lane at its own row ran from the
+    /// earliest of its four, rarely a late one, and its rows' masks cost more than that
+    /// saved (the paper's Fig. 16 case: 0.6 % more instructions a sample).
     pub(super) fn refactors_from_a_row(self, structure: &Structure) -> bool {
         match self {
             Kernels::OneSample => true,

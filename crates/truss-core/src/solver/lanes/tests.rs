@@ -346,7 +346,7 @@ fn the_band_in_lanes_is_the_one_sample_band_bit_for_bit() {
         {
             let mut io: [Option<FactorLane<'_>>; LANES] = std::array::from_fn(|_| None);
             for ((x, m), f) in io.iter_mut().zip(got.iter_mut()).zip(failures.iter_mut()) {
-                *x = Some((m, f, 1, 0));
+                *x = Some((m, f, 1));
             }
             lanes.factor(&mut io);
         }
@@ -391,7 +391,7 @@ fn the_band_in_lanes_is_the_one_sample_band_bit_for_bit() {
         let mut f = Vec::new();
         {
             let mut io: [Option<FactorLane<'_>>; LANES] = std::array::from_fn(|_| None);
-            io[1] = Some((&mut other, &mut f, 1, 0));
+            io[1] = Some((&mut other, &mut f, 1));
             lanes.factor(&mut io);
         }
         let mut xs = rhs.clone();
@@ -413,127 +413,4 @@ fn the_band_in_lanes_is_the_one_sample_band_bit_for_bit() {
             "{arch:?} another lane's factor"
         );
     }
-}
-
-/// A factorisation again from a block row, after only the rows from there on changed
-/// (`BlockBandMatrix::refactor_collecting`, and the batched one with each lane from its own
-/// row), against factorising the changed matrix whole: the same factor, inverse pivots,
-/// original diagonals and failed pivots, bit for bit. Positive definite and indefinite
-/// matrices, collecting one failure or several (so that a factorisation stops before,
-/// at or after the row it restarts from), restarting from the first row, a middle one, the
-/// last and past the end.
-#[test]
-fn a_factorisation_again_from_a_row_is_the_whole_one_bit_for_bit() {
-    use crate::block::BlockBandMatrix;
-    let (nb, q) = (9, 3);
-    let w = q + 1;
-    // The rows a factorisation reached: all, or up to its `max`-th failure's.
-    let reached = |failures: &[crate::block::PivotFailure], max: usize| {
-        if failures.len() >= max {
-            failures[max - 1].index / 3 + 1
-        } else {
-            nb
-        }
-    };
-    let compare = |got: &BlockBandMatrix,
-                   got_f: &[crate::block::PivotFailure],
-                   want: &BlockBandMatrix,
-                   want_f: &[crate::block::PivotFailure],
-                   max: usize,
-                   what: &str| {
-        assert_eq!(got_f, want_f, "{what}");
-        assert_eq!(got.is_factored(), want.is_factored(), "{what}");
-        let rows = reached(want_f, max);
-        let (gb, gi) = factor_bits(got);
-        let (wb, wi) = factor_bits(want);
-        assert_eq!(gb, wb, "{what}: blocks");
-        // Rows past a stop keep whatever inverse pivots they had: never read.
-        assert_eq!(gi[..3 * rows], wi[..3 * rows], "{what}: inverse pivots");
-        assert_eq!(
-            bits(got.original_diagonal().as_flattened()),
-            bits(want.original_diagonal().as_flattened()),
-            "{what}: original diagonals"
-        );
-    };
-    let mut stream = Stream(4242);
-    let mut cases = 0;
-    for arch in arches() {
-        for (diagonals, max) in [([20.0, 0.1, 15.0, 0.3], 1), ([0.2, 0.1, 25.0, 0.05], 3)] {
-            for froms in [[0, 4, 8, 9], [4, 4, 1, 7], [2, 6, 3, 12]] {
-                // The last factorisations (of the matrices before), and the changed matrices.
-                let before: Vec<BlockBandMatrix> = diagonals
-                    .iter()
-                    .map(|&d| band(nb, q, d, &mut stream))
-                    .collect();
-                let changed: Vec<BlockBandMatrix> = before
-                    .iter()
-                    .zip(&froms)
-                    .zip(&diagonals)
-                    .map(|((m, &from), &d)| {
-                        let fresh = band(nb, q, d, &mut stream);
-                        let mut c = m.clone();
-                        let from = from.min(nb);
-                        c.storage_mut()[from * w..]
-                            .copy_from_slice(&fresh.factor_parts().0[from * w..]);
-                        c
-                    })
-                    .collect();
-                let mut last = before.clone();
-                let mut last_f = vec![Vec::new(); LANES];
-                for (m, f) in last.iter_mut().zip(&mut last_f) {
-                    m.factor_collecting(f, max);
-                }
-                // Each matrix's rows from its row on, assembled again into the last factor.
-                let again = |l: usize| {
-                    let mut m = last[l].clone();
-                    let from = froms[l].min(nb);
-                    m.storage_mut()[from * w..]
-                        .copy_from_slice(&changed[l].factor_parts().0[from * w..]);
-                    m
-                };
-                let mut lanes = BandLanes::<LANES>::new(nb, q, arch);
-                let mut got: Vec<BlockBandMatrix> = (0..LANES).map(again).collect();
-                let mut got_f = last_f.clone();
-                {
-                    let mut io: [Option<FactorLane<'_>>; LANES] = std::array::from_fn(|_| None);
-                    for (l, ((x, m), f)) in io
-                        .iter_mut()
-                        .zip(got.iter_mut())
-                        .zip(got_f.iter_mut())
-                        .enumerate()
-                    {
-                        *x = Some((m, f, max, froms[l]));
-                    }
-                    lanes.factor(&mut io);
-                }
-                for l in 0..LANES {
-                    let mut want = changed[l].clone();
-                    let mut want_f = Vec::new();
-                    want.factor_collecting(&mut want_f, max);
-                    let mut alone = again(l);
-                    let mut alone_f = last_f[l].clone();
-                    alone.refactor_collecting(froms[l], &mut alone_f, max);
-                    let what = format!("{arch:?} max {max} lane {l} from {}", froms[l]);
-                    compare(
-                        &alone,
-                        &alone_f,
-                        &want,
-                        &want_f,
-                        max,
-                        &format!("alone, {what}"),
-                    );
-                    compare(
-                        &got[l],
-                        &got_f[l],
-                        &want,
-                        &want_f,
-                        max,
-                        &format!("lanes, {what}"),
-                    );
-                    cases += 1;
-                }
-            }
-        }
-    }
-    assert_eq!(cases, 2 * 2 * 3 * LANES);
 }
