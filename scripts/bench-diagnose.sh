@@ -18,6 +18,7 @@
 #
 # Usage (from anywhere): scripts/bench-diagnose.sh [WORKDIR]
 #   SPECIMENS=N, SEED=S, RUNS=R, THREADS=T (`truss diagnose --threads`; default all cores),
+#   SAMPLES=N (`truss diagnose --samples`; default the diagnosis's own, 4,000 at 200 specimens),
 #   TRUSS=PATH (a built `truss` binary instead of building the release one). Needs python3.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/lib/truss-binary.sh" "$@"
@@ -26,6 +27,8 @@ SEED="${SEED:-601}"
 RUNS="${RUNS:-1}"
 threads=()
 [[ -n "${THREADS:-}" ]] && threads=(--threads "$THREADS")
+samples=()
+[[ -n "${SAMPLES:-}" ]] && samples=(--samples "$SAMPLES")
 J="$REPO/jobs/paper-4.2.3.json"
 C=rigid-sigma-0.033
 "$T" synth-measured --job "$J" --case $C --specimens "$N" --seed "$SEED" \
@@ -36,7 +39,8 @@ for r in $(seq 1 "$RUNS"); do
   load=$(cut -d' ' -f1-3 /proc/loadavg)
   /usr/bin/time -v -o "$WORK/time-$r.txt" "$T" diagnose --job "$J" --case $C \
     --measured "$WORK/nodes.csv" --measured-members "$WORK/members.csv" \
-    --measurement-sigma 0.001 "${threads[@]}" --out "$out" --no-plots 2> "$out.stderr" > /dev/null
+    --measurement-sigma 0.001 "${threads[@]}" "${samples[@]}" --out "$out" --no-plots \
+    2> "$out.stderr" > /dev/null
   python3 - "$out/diagnosis.json" "$WORK/time-$r.txt" "$r" "$load" <<'PY'
 import json, re, sys
 path, timing, run, load = sys.argv[1:]

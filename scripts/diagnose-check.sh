@@ -56,8 +56,9 @@
 #   named with the seed),
 #   ONLY="null single pairs shifts backlash null-fpr" (a subset of the groups; null-fpr, the null
 #   false-positive rate at 30 specimens over 20 seeds, as the slow test does at 100, is
-#   not in the default set), TRUSS=PATH (a built `truss` binary to check, instead of building
-#   the release one). Needs python3.
+#   not in the default set), SAMPLES=N (`truss diagnose --samples` for every check but
+#   null-fpr; default the diagnosis's own, max(2000, 20·specimens)), TRUSS=PATH (a built
+#   `truss` binary to check, instead of building the release one). Needs python3.
 set -uo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/lib/truss-binary.sh" "$@"
 J="$REPO/jobs/diagnose-baseline.json"
@@ -67,6 +68,8 @@ NULL_SEEDS="${NULL_SEEDS:-101 102 103 104 105 106 107 108 109 110}"
 SINGLE_SEEDS="${SINGLE_SEEDS:-201 202 203}"
 PAIR_SEEDS="${PAIR_SEEDS:-301 302 303}"
 ONLY="${ONLY:-null single pairs shifts backlash}"
+samples=()
+[[ -n "${SAMPLES:-}" ]] && samples=(--samples "$SAMPLES")
 SINGLE_EFFECTS="${SINGLE_EFFECTS:-gravity thermal bias sigma pretension backlash}"
 PAPER_SEEDS="${PAPER_SEEDS:-401}"
 passed=0
@@ -95,7 +98,8 @@ check() {
   if ! "$T" synth-measured --job "$job" --case "$synth_case" --specimens "$N" --seed "$seed" \
       --effect "$effect" --measurement-sigma 0.001 "${synth_members[@]}" > "$WORK/$name.csv" \
     || ! "$T" diagnose --job "$job" --case "$case" --measured "$WORK/$name.csv" \
-      --measurement-sigma 0.001 "${diagnose_members[@]}" --out "$WORK/$name" --quiet --no-plots \
+      --measurement-sigma 0.001 "${diagnose_members[@]}" "${samples[@]}" --out "$WORK/$name" \
+      --quiet --no-plots \
       > /dev/null 2> "$WORK/$name.stderr"; then
     echo "$name: synth-measured or diagnose failed: $(tail -3 "$WORK/$name.stderr" 2>/dev/null)"
     echo "    FAILED"
