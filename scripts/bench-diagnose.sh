@@ -27,8 +27,6 @@ SEED="${SEED:-601}"
 RUNS="${RUNS:-1}"
 threads=()
 [[ -n "${THREADS:-}" ]] && threads=(--threads "$THREADS")
-samples=()
-[[ -n "${SAMPLES:-}" ]] && samples=(--samples "$SAMPLES")
 J="$REPO/jobs/paper-4.2.3.json"
 C=rigid-sigma-0.033
 "$T" synth-measured --job "$J" --case $C --specimens "$N" --seed "$SEED" \
@@ -39,7 +37,7 @@ for r in $(seq 1 "$RUNS"); do
   load=$(cut -d' ' -f1-3 /proc/loadavg)
   /usr/bin/time -v -o "$WORK/time-$r.txt" "$T" diagnose --job "$J" --case $C \
     --measured "$WORK/nodes.csv" --measured-members "$WORK/members.csv" \
-    --measurement-sigma 0.001 "${threads[@]}" "${samples[@]}" --out "$out" --no-plots \
+    --measurement-sigma 0.001 "${threads[@]}" "${SAMPLES_OPTION[@]}" --out "$out" --no-plots \
     2> "$out.stderr" > /dev/null
   python3 - "$out/diagnosis.json" "$WORK/time-$r.txt" "$r" "$load" <<'PY'
 import json, re, sys

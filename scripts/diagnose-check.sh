@@ -68,8 +68,6 @@ NULL_SEEDS="${NULL_SEEDS:-101 102 103 104 105 106 107 108 109 110}"
 SINGLE_SEEDS="${SINGLE_SEEDS:-201 202 203}"
 PAIR_SEEDS="${PAIR_SEEDS:-301 302 303}"
 ONLY="${ONLY:-null single pairs shifts backlash}"
-samples=()
-[[ -n "${SAMPLES:-}" ]] && samples=(--samples "$SAMPLES")
 SINGLE_EFFECTS="${SINGLE_EFFECTS:-gravity thermal bias sigma pretension backlash}"
 PAPER_SEEDS="${PAPER_SEEDS:-401}"
 passed=0
@@ -98,7 +96,7 @@ check() {
   if ! "$T" synth-measured --job "$job" --case "$synth_case" --specimens "$N" --seed "$seed" \
       --effect "$effect" --measurement-sigma 0.001 "${synth_members[@]}" > "$WORK/$name.csv" \
     || ! "$T" diagnose --job "$job" --case "$case" --measured "$WORK/$name.csv" \
-      --measurement-sigma 0.001 "${diagnose_members[@]}" "${samples[@]}" --out "$WORK/$name" \
+      --measurement-sigma 0.001 "${diagnose_members[@]}" "${SAMPLES_OPTION[@]}" --out "$WORK/$name" \
       --quiet --no-plots \
       > /dev/null 2> "$WORK/$name.stderr"; then
     echo "$name: synth-measured or diagnose failed: $(tail -3 "$WORK/$name.stderr" 2>/dev/null)"

@@ -104,8 +104,6 @@ for c in $CASES; do
     all) copt=() ;;
     *) copt=(--candidates "$CANDIDATES") ;;
   esac
-  sopt=()
-  [[ -n $SAMPLES ]] && sopt=(--samples "$SAMPLES")
   start=$(date +%s.%N)
   for s in $SEEDS; do
     name="$c-$s"
@@ -121,7 +119,7 @@ json.dump(j, open(sys.argv[3], "w"), indent=1)' "$J" "$s" "$job" || exit 4
     if ! "$T" synth-measured --job "$J" --case $B --specimens "$N" --seed "$s" --effect "$effect" \
         --measurement-sigma 0.001 > "$WORK/$name.csv" 2> "$WORK/$name.synth.stderr" \
       || ! "$T" diagnose --job "$job" --case $B --measured "$WORK/$name.csv" --measurement-sigma 0.001 \
-        "${copt[@]}" "${sopt[@]}" --out "$WORK/$name" --quiet --no-plots > /dev/null 2> "$WORK/$name.stderr"; then
+        "${copt[@]}" "${SAMPLES_OPTION[@]}" --out "$WORK/$name" --quiet --no-plots > /dev/null 2> "$WORK/$name.stderr"; then
       status=failed
     fi
     # One line per parameter: case seed cand param truth checked status value lower upper
