@@ -232,7 +232,7 @@ def backlash_section(runs, w):
       "limit r → 0 of their compression ratio, at the limit itself: one-sided members solved as contact, by "
       "continuation from r = 1e-5 to an exact solve at r = 0 (`crates/truss-core/src/solver/limit/`). Against an "
       "independent arbitrary-precision reference (`scripts/limit-reference.sh`, continuation to r = 1e-30), the "
-      "θ_P of 200 Fig. 16 samples agree within 7.4e-5, 192 within 1e-6 (`crates/mc-shard/tests/it/limit_reference.rs`; "
+      "θ_P of 200 Fig. 16 samples agree within 7.4e-5, 193 within 1e-6 (`crates/mc-shard/tests/it/limit_reference.rs`; "
       "the former working ratio, 1e-7, was 87 % off in one sample and 2.7 % in another). Where a stage's longerons "
       "float in their holes, it is held only by what pretension is left and by its slack diagonals' r × 404 N/mm, "
       "so any working ratio matters there: at the earlier "

@@ -80,7 +80,7 @@ use truss_core::{Model, Structure};
 
 /// Version of the numerics: bumped whenever the solver or the sampling would give different
 /// numbers for the same job, so that the job id changes and old and new shards never mix.
-pub const NUMERICS_VERSION: u32 = 13;
+pub const NUMERICS_VERSION: u32 = 14;
 
 /// The most samples a case may have, 10⁸. At 10⁸ samples the 95th percentile's relative
 /// standard error is about 10⁻⁴, far finer than any input of the model is known; and the

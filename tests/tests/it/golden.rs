@@ -90,11 +90,11 @@ fn golden_job_shards_and_report() {
         report,
     ];
     let want = [
-        "ee8665220c5639c9556fd4e3517c9993621d6a54b3792712d17c4b8519f9102d",
+        "16b2ae44ed7d9f651f0d6a789b98578c90bec62eb3db8d5548287afda231ed6b",
         "94ce944399e4677c5705bde025cc92a70f975a9f2ab7c855a7e8f13ecf665d24",
         "546cf9d696c4c41815489fa90b763f7db5a7158a8fe8896316e035a3f1ee86a1",
         "7b94c46945c2820f627e0bdcc5aa42e331a0f6fe76f9a1cbbfa384b72441d183",
-        "be9f4523c00f21a5a02b828af928e7dc438140d02c34ca07bc7e99d3e9d28b42",
+        "b2d6d0b9a68bae26b6af79ee68e9ab37330a68d67bf1f61fc46b378585fb46d1",
     ];
     for (what, (g, w)) in [
         "job id",

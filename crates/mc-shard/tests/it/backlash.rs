@@ -146,7 +146,7 @@ fn golden_backlash_job_is_pinned() {
     let digest = shard_record::hex(&hash.finalize());
     assert_eq!(
         job.id,
-        "1e0fed11f138820b3ef0a7a88a5960a41b440397c07a863e393bac6b8340f543"
+        "022376b91076d9732ed06224522c235a98dd8dbd2664357f080272830ccc6cc8"
     );
     assert_eq!(
         digest,

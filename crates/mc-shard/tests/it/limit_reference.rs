@@ -16,7 +16,7 @@ const JOB: &str = r#"{"model": {"prism": {"stages": 5, "backlash": true}}, "seed
                       "diagonal": {"uniform": {"low": -0.0201, "high": 0}}}}]}"#;
 
 /// Every sample converges to the reference's limit within 1e-4 of θ_P, and all but 5 %
-/// within 1e-6 (measured: all within 7.4e-5, 8 beyond 1e-6; those are samples with two
+/// within 1e-6 (measured: all within 7.4e-5, 7 beyond 1e-6; those are samples with two
 /// stable equilibria near the limit, 1e-5 to 7e-5 apart, which the reference found by
 /// continuing from each). The regularised default before the limit solver (r = 1e-7) was
 /// 87 % off in sample 48 and 2.7 % in sample 131: its state stops being an equilibrium

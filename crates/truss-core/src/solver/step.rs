@@ -95,7 +95,9 @@ impl Solver {
     /// stiffness of its slack cables), the piece's minimum along the direction of negative
     /// curvature that the failed pivot gives is where the first slack cable engages: that
     /// cable is made taut (and kept so for this step) and `K(S)` factorised again. Only when
-    /// no cable bounds the direction does the step become a search along it.
+    /// no cable bounds the direction does the step become a search along it. At the limit of
+    /// one-sided members, the cables one model step engaged start the next one bearing, where
+    /// they are still slack (see [`StepState`](super::StepState)'s `engaged`).
     pub(super) async fn model_step(
         &mut self,
         iteration: u32,
@@ -121,6 +123,17 @@ impl Solver {
                 self.work.slack[m] && (plain || !c.is_cable || se.abs() > kink);
         }
         self.factor.locked.fill(false);
+        // At the limit, a cable the last model step engaged that is still slack (the line
+        // search stopped short of its kink) bears from the start: the part of the truss that
+        // fell onto it still rests on it, and finding that again would cost a factorisation
+        // that fails at the same pivot (a third of the engagements in the paper's Fig. 16
+        // case). It is not locked: the pieces may free it.
+        if at_limit && !plain {
+            for (slack, &engaged) in self.factor.factor_slack.iter_mut().zip(&self.step.engaged) {
+                *slack &= !engaged;
+            }
+        }
+        self.step.engaged.fill(false);
         let mut pieces = 0;
         let mut engagements = 0;
         // Whether `self.factor.kept` holds this point's assembly (kept only at the limit,
@@ -341,6 +354,7 @@ impl Solver {
         };
         self.factor.factor_slack[m] = false;
         self.factor.locked[m] = true;
+        self.step.engaged[m] = true;
         true
     }
 

@@ -330,4 +330,68 @@ mod tests {
         assert_eq!(counts.iterations, iterations);
         assert!(counts.factorisations >= 1);
     }
+
+    /// A cable that a model step engaged (its model fell along a failed pivot's direction
+    /// until that cable bore) and that is still slack bears from the start of the next model
+    /// step. Taken again at the same point (as where the line search stops short of the
+    /// cable's kink), the step then does not fail at that pivot again: it takes fewer
+    /// factorisations. Here: the first model step from the linearised start at the first
+    /// ratio, on the first of the paper's Fig. 16 truss's samples (pin joints in free play,
+    /// shortened diagonals) whose first step engages a cable.
+    #[test]
+    fn a_model_step_starts_with_the_cables_the_last_one_engaged() {
+        let model = PrismOptions {
+            backlash: Some(BacklashOptions {
+                clearance: 0.0105,
+                ..BacklashOptions::default()
+            }),
+            ..PrismOptions::with_stages(5)
+        }
+        .model()
+        .unwrap();
+        for sample in 0..40 {
+            let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
+            let errors: Vec<f64> = model
+                .members()
+                .iter()
+                .enumerate()
+                .map(|(m, member)| {
+                    let e = 0.0067 * ((((m + 1) * (sample + 7) * 7919) % 13) as f64 / 6.0 - 1.0);
+                    if member.id.starts_with("diagonal") {
+                        -0.01 - 0.5 * e.abs()
+                    } else {
+                        e
+                    }
+                })
+                .collect();
+            solver
+                .set_sample(Perturbation {
+                    length_errors: &errors,
+                    ..Perturbation::default()
+                })
+                .unwrap();
+            solver.set_limit_ratio(FIRST_RATIO);
+            solver.work.u.fill(0.0);
+            let mut start = 0;
+            finish(solver.linearised_from_rest(&mut start, Kernels::OneSample));
+            finish(solver.evaluate_current(Kernels::OneSample));
+            let mut first = 0;
+            finish(solver.model_step(1, &mut first, Kernels::OneSample)).unwrap();
+            let engaged: Vec<usize> = (0..solver.step.engaged.len())
+                .filter(|&m| solver.step.engaged[m])
+                .collect();
+            if engaged.is_empty() {
+                continue;
+            }
+            assert!(engaged.iter().all(|&m| solver.work.slack[m]));
+            let mut second = 0;
+            finish(solver.model_step(2, &mut second, Kernels::OneSample)).unwrap();
+            assert!(
+                second < first,
+                "sample {sample}: {second} factorisations again after engaging {engaged:?} in {first}"
+            );
+            return;
+        }
+        panic!("no sample's first model step engaged a cable");
+    }
 }
