@@ -275,10 +275,42 @@ impl Solver {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Model;
     use crate::SolveOptions;
     use crate::prism::{BacklashOptions, PrismOptions};
     use crate::solver::Perturbation;
     use crate::solver::lanes::finish;
+
+    /// The paper's 5-stage truss with pin joints in free play (clearance 10.5 µm).
+    fn pin_jointed_prism() -> Model {
+        PrismOptions {
+            backlash: Some(BacklashOptions {
+                clearance: 0.0105,
+                ..BacklashOptions::default()
+            }),
+            ..PrismOptions::with_stages(5)
+        }
+        .model()
+        .unwrap()
+    }
+
+    /// Length errors \[mm\] spread over ±6.7 µm by `pick(m) mod 13` for member `m`, the
+    /// diagonals shortened by 10 µm and half an error more (so that they are pretensioned).
+    fn length_errors(model: &Model, pick: impl Fn(usize) -> usize) -> Vec<f64> {
+        model
+            .members()
+            .iter()
+            .enumerate()
+            .map(|(m, member)| {
+                let e = 0.0067 * ((pick(m) % 13) as f64 / 6.0 - 1.0);
+                if member.id.starts_with("diagonal") {
+                    -0.01 - 0.5 * e.abs()
+                } else {
+                    e
+                }
+            })
+            .collect()
+    }
 
     /// An anchor whose Newton does not converge (here: allowed one iteration, from the
     /// linearised start of the paper's 5-stage truss with pin joints in free play and
@@ -287,34 +319,14 @@ mod tests {
     /// from such an anchor after 120 iterations that its line did not count.
     #[test]
     fn a_failed_anchor_counts_its_iterations() {
-        let model = PrismOptions {
-            backlash: Some(BacklashOptions {
-                clearance: 0.0105,
-                ..BacklashOptions::default()
-            }),
-            ..PrismOptions::with_stages(5)
-        }
-        .model()
-        .unwrap();
+        let model = pin_jointed_prism();
         let options = SolveOptions {
             max_iterations: 1,
             ..SolveOptions::default()
         };
         let mut solver = Solver::new(&model, options).unwrap();
         assert!(solver.structure.near_the_limit());
-        let errors: Vec<f64> = model
-            .members()
-            .iter()
-            .enumerate()
-            .map(|(m, member)| {
-                let e = 0.0067 * (((m * 7919) % 13) as f64 / 6.0 - 1.0);
-                if member.id.starts_with("diagonal") {
-                    -0.01 - 0.5 * e.abs()
-                } else {
-                    e
-                }
-            })
-            .collect();
+        let errors = length_errors(&model, |m| m * 7919);
         solver
             .set_sample(Perturbation {
                 length_errors: &errors,
@@ -340,30 +352,10 @@ mod tests {
     /// shortened diagonals) whose first step engages a cable.
     #[test]
     fn a_model_step_starts_with_the_cables_the_last_one_engaged() {
-        let model = PrismOptions {
-            backlash: Some(BacklashOptions {
-                clearance: 0.0105,
-                ..BacklashOptions::default()
-            }),
-            ..PrismOptions::with_stages(5)
-        }
-        .model()
-        .unwrap();
+        let model = pin_jointed_prism();
         for sample in 0..40 {
             let mut solver = Solver::new(&model, SolveOptions::default()).unwrap();
-            let errors: Vec<f64> = model
-                .members()
-                .iter()
-                .enumerate()
-                .map(|(m, member)| {
-                    let e = 0.0067 * ((((m + 1) * (sample + 7) * 7919) % 13) as f64 / 6.0 - 1.0);
-                    if member.id.starts_with("diagonal") {
-                        -0.01 - 0.5 * e.abs()
-                    } else {
-                        e
-                    }
-                })
-                .collect();
+            let errors = length_errors(&model, |m| (m + 1) * (sample + 7) * 7919);
             solver
                 .set_sample(Perturbation {
                     length_errors: &errors,
