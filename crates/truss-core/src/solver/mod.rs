@@ -337,6 +337,9 @@ struct Workspace {
 struct FactorCache {
     k: BlockBandMatrix,
     factor_slack: Vec<bool>,
+    /// Cables a model step engaged (made to bear along a direction in which its model fell)
+    /// and kept bearing through its pieces; kept until the next model step, which starts
+    /// with them bearing at the limit of one-sided members (see `Solver::model_step`).
     locked: Vec<bool>,
     active: ActiveSet,
     /// The model stiffness of the current model step's point, unfactorised.
@@ -355,9 +358,6 @@ struct StepState {
     step_slack: Vec<bool>,
     /// Cables pinned at their kink for the next model step.
     pinned: Vec<bool>,
-    /// Cables the last model step engaged along a direction in which its model fell (at
-    /// the limit of one-sided members): the next model step starts with them bearing.
-    engaged: Vec<bool>,
 }
 
 impl Solver {
@@ -420,7 +420,6 @@ impl Solver {
                 plain_step: false,
                 step_slack: vec![false; m],
                 pinned: vec![false; m],
-                engaged: vec![false; m],
             },
             log: Vec::new(),
             last: None,
@@ -544,7 +543,7 @@ impl Solver {
         self.step.damping = 0.0;
         self.step.plain_step = false;
         self.step.pinned.fill(false);
-        self.step.engaged.fill(false);
+        self.factor.locked.fill(false);
         self.sample.loads.copy_from_slice(&s.loads);
         for (node, f) in p.extra_loads.iter().enumerate() {
             if f.iter().any(|x| !x.is_finite()) {

@@ -176,7 +176,7 @@ impl Solver {
         self.step.damping = 0.0;
         self.step.plain_step = false;
         self.step.pinned.fill(false);
-        self.step.engaged.fill(false);
+        self.factor.locked.fill(false);
         let p = Progress {
             iterations: 0,
             factorisations: 0,

@@ -97,7 +97,7 @@ impl Solver {
     /// cable is made taut (and kept so for this step) and `K(S)` factorised again. Only when
     /// no cable bounds the direction does the step become a search along it. At the limit of
     /// one-sided members, the cables one model step engaged start the next one bearing, where
-    /// they are still slack (see [`StepState`](super::StepState)'s `engaged`).
+    /// they are still slack (`locked` of the step's factor cache, kept until the next step).
     pub(super) async fn model_step(
         &mut self,
         iteration: u32,
@@ -122,18 +122,17 @@ impl Solver {
             self.factor.factor_slack[m] =
                 self.work.slack[m] && (plain || !c.is_cable || se.abs() > kink);
         }
-        self.factor.locked.fill(false);
-        // At the limit, a cable the last model step engaged that is still slack (the line
-        // search stopped short of its kink) bears from the start: the part of the truss that
-        // fell onto it still rests on it, and finding that again would cost a factorisation
-        // that fails at the same pivot (a third of the engagements in the paper's Fig. 16
-        // case). It is not locked: the pieces may free it.
+        // At the limit, a cable the last model step engaged (locked) that is still slack (the
+        // line search stopped short of its kink) bears from the start: the part of the truss
+        // that fell onto it still rests on it, and finding that again would cost a
+        // factorisation that fails at the same pivot (a third of the engagements in the
+        // paper's Fig. 16 case). It is not locked in this step: the pieces may free it.
         if at_limit && !plain {
-            for (slack, &engaged) in self.factor.factor_slack.iter_mut().zip(&self.step.engaged) {
+            for (slack, &engaged) in self.factor.factor_slack.iter_mut().zip(&self.factor.locked) {
                 *slack &= !engaged;
             }
         }
-        self.step.engaged.fill(false);
+        self.factor.locked.fill(false);
         let mut pieces = 0;
         let mut engagements = 0;
         // Whether `self.factor.kept` holds this point's assembly (kept only at the limit,
@@ -354,7 +353,6 @@ impl Solver {
         };
         self.factor.factor_slack[m] = false;
         self.factor.locked[m] = true;
-        self.step.engaged[m] = true;
         true
     }
 

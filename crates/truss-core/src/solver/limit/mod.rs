@@ -369,8 +369,8 @@ mod tests {
             finish(solver.evaluate_current(Kernels::OneSample));
             let mut first = 0;
             finish(solver.model_step(1, &mut first, Kernels::OneSample)).unwrap();
-            let engaged: Vec<usize> = (0..solver.step.engaged.len())
-                .filter(|&m| solver.step.engaged[m])
+            let engaged: Vec<usize> = (0..solver.factor.locked.len())
+                .filter(|&m| solver.factor.locked[m])
                 .collect();
             if engaged.is_empty() {
                 continue;
